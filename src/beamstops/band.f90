@@ -1,0 +1,222 @@
+!> Symmetric band storage (LAPACK 'U', kd = 3) of the assembled Hermite matrices,
+!> and the LAPACK calls on it, with info codes turned into messages.
+module beamstops_band
+   use beamstops_kinds, only: wp
+   use beamstops_error, only: error_type, fatal_error
+   implicit none
+   private
+   public :: kd, assemble_band, band_matvec, band_to_dense, cholesky_factor, cholesky_solve
+   public :: largest_eigenvalue_exact, largest_eigenvalue_iterative
+
+   !> Half-bandwidth of Hermite cubic matrices with (u, u') interleaved.
+   integer, parameter :: kd = 3
+
+   interface
+      subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
+         import :: wp
+         character, intent(in) :: uplo
+         integer, intent(in) :: n, kd, ldab
+         real(wp), intent(inout) :: ab(ldab, *)
+         integer, intent(out) :: info
+      end subroutine dpbtrf
+      subroutine dpbtrs(uplo, n, kd, nrhs, ab, ldab, b, ldb, info)
+         import :: wp
+         character, intent(in) :: uplo
+         integer, intent(in) :: n, kd, nrhs, ldab, ldb
+         real(wp), intent(in) :: ab(ldab, *)
+         real(wp), intent(inout) :: b(ldb, *)
+         integer, intent(out) :: info
+      end subroutine dpbtrs
+      subroutine dsbgv(jobz, uplo, n, ka, kb, ab, ldab, bb, ldbb, w, z, ldz, work, info)
+         import :: wp
+         character, intent(in) :: jobz, uplo
+         integer, intent(in) :: n, ka, kb, ldab, ldbb, ldz
+         real(wp), intent(inout) :: ab(ldab, *), bb(ldbb, *)
+         real(wp), intent(out) :: w(*), z(ldz, *), work(*)
+         integer, intent(out) :: info
+      end subroutine dsbgv
+      subroutine dgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
+         import :: wp
+         integer, intent(in) :: m, n, kl, ku, ldab
+         real(wp), intent(inout) :: ab(ldab, *)
+         integer, intent(out) :: ipiv(*), info
+      end subroutine dgbtrf
+      subroutine dgbtrs(trans, n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
+         import :: wp
+         character, intent(in) :: trans
+         integer, intent(in) :: n, kl, ku, nrhs, ldab, ipiv(*), ldb
+         real(wp), intent(in) :: ab(ldab, *)
+         real(wp), intent(inout) :: b(ldb, *)
+         integer, intent(out) :: info
+      end subroutine dgbtrs
+   end interface
+
+contains
+
+   !> Assemble J identical element matrices into band storage; node 0 (clamped) is removed,
+   !> unknowns are (u_1, u'_1, ..., u_J, u'_J).
+   pure subroutine assemble_band(elements, me, ab)
+      !> Number of elements J.
+      integer, intent(in) :: elements
+      !> Element matrix (4 x 4, symmetric).
+      real(wp), intent(in) :: me(4, 4)
+      !> Band storage (kd+1, 2J), overwritten.
+      real(wp), intent(out) :: ab(:, :)
+      integer :: e, a, b, i, j
+      ab = 0
+      do e = 1, elements
+         do b = 1, 4
+            j = 2*(e - 1) - 2 + b
+            if (j < 1) cycle
+            do a = 1, b
+               i = 2*(e - 1) - 2 + a
+               if (i < 1) cycle
+               ab(kd + 1 + i - j, j) = ab(kd + 1 + i - j, j) + me(a, b)
+            end do
+         end do
+      end do
+   end subroutine assemble_band
+
+   !> y = A x for a symmetric matrix in upper band storage with kd = 3.
+   pure subroutine band_matvec(ab, x, y)
+      !> Band storage (kd+1, n).
+      real(wp), intent(in) :: ab(:, :)
+      !> Vector (n).
+      real(wp), intent(in) :: x(:)
+      !> Product (n).
+      real(wp), intent(out) :: y(:)
+      integer :: j, i, n
+      n = size(x)
+      y = 0
+      do j = 1, n
+         y(j) = y(j) + ab(kd + 1, j)*x(j)
+         do i = max(1, j - kd), j - 1
+            y(i) = y(i) + ab(kd + 1 + i - j, j)*x(j)
+            y(j) = y(j) + ab(kd + 1 + i - j, j)*x(i)
+         end do
+      end do
+   end subroutine band_matvec
+
+   !> Dense copy of a symmetric band matrix (for tests and small checks).
+   pure function band_to_dense(ab) result(a)
+      !> Band storage (kd+1, n).
+      real(wp), intent(in) :: ab(:, :)
+      real(wp) :: a(size(ab, 2), size(ab, 2))
+      integer :: i, j
+      a = 0
+      do j = 1, size(ab, 2)
+         do i = max(1, j - kd), j
+            a(i, j) = ab(kd + 1 + i - j, j)
+            a(j, i) = a(i, j)
+         end do
+      end do
+   end function band_to_dense
+
+   !> Cholesky factorization A = U^T U in place (LAPACK dpbtrf).
+   subroutine cholesky_factor(ab, what, error)
+      !> Band storage, replaced by the factor U.
+      real(wp), intent(inout) :: ab(:, :)
+      !> Name of the matrix for messages.
+      character(len=*), intent(in) :: what
+      !> Set when the matrix is not positive definite.
+      type(error_type), allocatable, intent(out) :: error
+      integer :: info
+      character(len=16) :: buf
+      call dpbtrf('U', size(ab, 2), kd, ab, size(ab, 1), info)
+      if (info /= 0) then
+         write (buf, '(i0)') abs(info)
+         if (info > 0) then
+            call fatal_error(error, 'dpbtrf: the leading minor of order '//trim(buf)//' of '//what// &
+               & ' is not positive definite')
+         else
+            call fatal_error(error, 'dpbtrf: argument '//trim(buf)//' had an illegal value')
+         end if
+      end if
+   end subroutine cholesky_factor
+
+   !> Solve A x = b with the factor from cholesky_factor (LAPACK dpbtrs).
+   subroutine cholesky_solve(factor, b)
+      !> Factor U in band storage.
+      real(wp), intent(in) :: factor(:, :)
+      !> Right-hand side, replaced by the solution.
+      real(wp), intent(inout) :: b(:)
+      integer :: info
+      call dpbtrs('U', size(factor, 2), kd, 1, factor, size(factor, 1), b, size(b), info)
+   end subroutine cholesky_solve
+
+   !> Largest eigenvalue of S v = kappa M v, exactly (LAPACK dsbgv). Cost O(n^2): small n only.
+   subroutine largest_eigenvalue_exact(s, m, kappa, error)
+      !> Stiffness, band storage.
+      real(wp), intent(in) :: s(:, :)
+      !> Mass, band storage (positive definite).
+      real(wp), intent(in) :: m(:, :)
+      !> Largest generalized eigenvalue.
+      real(wp), intent(out) :: kappa
+      !> Set when LAPACK fails.
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: sa(:, :), ma(:, :), w(:), work(:)
+      real(wp) :: zdum(1, 1)
+      integer :: n, info
+      character(len=16) :: buf
+      n = size(s, 2)
+      allocate (sa, source=s)
+      allocate (ma, source=m)
+      allocate (w(n), work(3*n))
+      call dsbgv('N', 'U', n, kd, kd, sa, kd + 1, ma, kd + 1, w, zdum, 1, work, info)
+      if (info /= 0) then
+         write (buf, '(i0)') info
+         call fatal_error(error, 'dsbgv failed with info = '//trim(buf))
+         kappa = 0
+         return
+      end if
+      kappa = w(n)
+   end subroutine largest_eigenvalue_exact
+
+   !> Largest eigenvalue of S v = kappa M v by inverse iteration shifted at an upper bound
+   !> `shift` (O(n) per iteration; for meshes too large for dsbgv). Converges to the top of
+   !> the spectrum; its Rayleigh quotient is a lower bound, `shift` an upper bound.
+   subroutine largest_eigenvalue_iterative(s, m, shift, kappa, error)
+      !> Stiffness, band storage.
+      real(wp), intent(in) :: s(:, :)
+      !> Mass, band storage.
+      real(wp), intent(in) :: m(:, :)
+      !> An upper bound of the spectrum.
+      real(wp), intent(in) :: shift
+      !> Largest generalized eigenvalue (Rayleigh quotient at convergence).
+      real(wp), intent(out) :: kappa
+      !> Set when LAPACK fails.
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: kl = kd, ku = kd, ldab = 2*kl + ku + 1, max_iterations = 300
+      real(wp), allocatable :: ab(:, :), x(:), y(:), sx(:), mx(:)
+      integer, allocatable :: ipiv(:)
+      real(wp) :: previous
+      integer :: n, i, j, it, info
+      n = size(s, 2)
+      allocate (ab(ldab, n), x(n), y(n), sx(n), mx(n), ipiv(n))
+      ab = 0
+      do j = 1, n
+         do i = max(1, j - kd), j
+            ab(kl + ku + 1 + i - j, j) = s(kd + 1 + i - j, j) - shift*m(kd + 1 + i - j, j)
+            ab(kl + ku + 1 + j - i, i) = ab(kl + ku + 1 + i - j, j)
+         end do
+      end do
+      call dgbtrf(n, n, kl, ku, ab, ldab, ipiv, info)
+      if (info /= 0) then
+         call fatal_error(error, 'dgbtrf: the shifted matrix S - shift M is singular')
+         kappa = shift
+         return
+      end if
+      x = [(merge(1.0_wp, -1.0_wp, mod(i, 4) < 2), i=1, n)]
+      kappa = 0
+      do it = 1, max_iterations
+         call band_matvec(m, x, y)
+         call dgbtrs('N', n, kl, ku, 1, ab, ldab, ipiv, y, n, info)
+         x = y/norm2(y)
+         call band_matvec(s, x, sx)
+         call band_matvec(m, x, mx)
+         previous = kappa
+         kappa = dot_product(x, sx)/dot_product(x, mx)
+         if (abs(kappa - previous) <= 1.0e-14_wp*abs(kappa)) exit
+      end do
+   end subroutine largest_eigenvalue_iterative
+end module beamstops_band

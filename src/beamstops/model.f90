@@ -1,0 +1,220 @@
+!> What a scene implies before time runs: assembled M and S, the load vector,
+!> the factor of A = M + dt^2 beta S, the tip column z = A^{-1} e_tip, the
+!> initial data, kappa_h and the stability limits. Built once.
+module beamstops_model
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_positive_inf
+   use beamstops_kinds, only: wp
+   use beamstops_error, only: error_type, fatal_error
+   use beamstops_scene, only: scene_type, law_compliance, fmt_real
+   use beamstops_hermite, only: element_mass, element_stiffness, hermite_basis, gauss_points, gauss_weights
+   use beamstops_band, only: kd, assemble_band, cholesky_factor, cholesky_solve, &
+      & largest_eigenvalue_exact, largest_eigenvalue_iterative
+   use beamstops_forcing, only: lift_shape, lift_slope
+   implicit none
+   private
+   public :: model_type, build_model, check_stability, kappa_bound_constant, exact_eigen_limit
+
+   !> Constant C of the paper's bound (5.2): kappa_tilde = C k^2/dx^4, C = 24*420*19^2/37.
+   real(wp), parameter :: kappa_bound_constant = 24.0_wp*420.0_wp*19.0_wp**2/37.0_wp
+   !> Largest number of unknowns for which kappa_h is computed by dsbgv (O(n^2) work).
+   integer, parameter :: exact_eigen_limit = 6000
+
+   !> Matrices, vectors and constants of a discretized scene.
+   type :: model_type
+      !> Number of unknowns n = 2J.
+      integer :: n = 0
+      !> Index of the tip value (2J - 1).
+      integer :: tip = 0
+      !> Element length (m).
+      real(wp) :: h = 0
+      !> Time step and its square (s, s^2).
+      real(wp) :: dt = 0, dt2 = 0
+      !> Newmark beta.
+      real(wp) :: beta = 0
+      !> Mass matrix M, band storage (kd+1, n).
+      real(wp), allocatable :: mass(:, :)
+      !> Stiffness matrix S, band storage (kd+1, n).
+      real(wp), allocatable :: stiffness(:, :)
+      !> Cholesky factor U of A = M + dt^2 beta S, band storage (kd+1, n).
+      real(wp), allocatable :: factor(:, :)
+      !> Load vector g: G(t) = sin(omega t) g (n).
+      real(wp), allocatable :: load(:)
+      !> Tip column z = A^{-1} e_tip (n).
+      real(wp), allocatable :: z(:)
+      !> Initial displacement u0 and velocity v0 of the homogeneous unknown (n).
+      real(wp), allocatable :: u0(:), v0(:)
+      !> Node abscissae x_0 = 0, ..., x_J = L (J+1).
+      real(wp), allocatable :: x(:)
+      !> Lifting shape h(x) at the nodes (J+1): physical displacement = u + h phi(t).
+      real(wp), allocatable :: lift(:)
+      !> Largest generalized eigenvalue of (S, M) (1/s^2).
+      real(wp) :: kappa_h = 0
+      !> How kappa_h was computed: 'dsbgv' (exact) or 'inverse iteration'.
+      character(len=:), allocatable :: kappa_method
+      !> The paper's upper bound kappa_tilde of kappa_h (1/s^2).
+      real(wp) :: kappa_bound = 0
+      !> Largest eigenvalue with the compliance spring at the tip (= kappa_h without it).
+      real(wp) :: kappa_contact = 0
+      !> Linear Newmark limit 2/sqrt((1-4 beta) kappa) for beta < 1/4 (+Inf otherwise) (s).
+      real(wp) :: dt_newmark = 0
+      !> Paper's condition (3.1) with the exact kappa_h, alpha -> 0 (+Inf for beta = 1/2) (s).
+      real(wp) :: dt_paper_exact = 0
+      !> Paper's condition (3.1) with its bound kappa_tilde (s).
+      real(wp) :: dt_paper_bound = 0
+   end type model_type
+
+contains
+
+   !> Build the model of a validated scene.
+   subroutine build_model(scene, model, error)
+      !> Validated scene.
+      type(scene_type), intent(in) :: scene
+      !> Model to build.
+      type(model_type), intent(out) :: model
+      !> Set when a factorization fails.
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: bh(:), b1(:)
+      real(wp) :: me(4, 4), se(4, 4), forcing_scale
+      integer :: n, j
+
+      n = 2*scene%elements
+      model%n = n
+      model%tip = n - 1
+      model%h = scene%length/scene%elements
+      model%dt = scene%dt
+      model%dt2 = scene%dt**2
+      model%beta = scene%beta
+      me = element_mass(model%h)
+      se = element_stiffness(model%h, scene%k2)
+      allocate (model%mass(kd + 1, n), model%stiffness(kd + 1, n))
+      call assemble_band(scene%elements, me, model%mass)
+      call assemble_band(scene%elements, se, model%stiffness)
+
+      model%x = [(scene%length*j/scene%elements, j=0, scene%elements)]
+      model%lift = lift_shape(model%x, scene%length)
+      call load_shapes(scene%elements, model%h, scene%length, bh, b1)
+      forcing_scale = 8*scene%k2/scene%length**4
+      model%load = scene%amplitude*(scene%omega**2*bh + forcing_scale*b1)
+      allocate (model%u0(n), model%v0(n))
+      model%u0 = 0
+      model%v0(1::2) = -scene%amplitude*scene%omega*lift_shape(model%x(2:), scene%length)
+      model%v0(2::2) = -scene%amplitude*scene%omega*lift_slope(model%x(2:), scene%length)
+
+      model%factor = model%mass + model%dt2*model%beta*model%stiffness
+      call cholesky_factor(model%factor, 'A = M + dt^2 beta S', error)
+      if (allocated(error)) return
+      allocate (model%z(n))
+      model%z = 0
+      model%z(model%tip) = 1
+      call cholesky_solve(model%factor, model%z)
+
+      call spectrum(scene, model, error)
+   end subroutine build_model
+
+   !> Load shapes (h, phi_i) and (1, phi_i) by 4-point Gauss quadrature per element.
+   pure subroutine load_shapes(elements, h, length, bh, b1)
+      integer, intent(in) :: elements
+      real(wp), intent(in) :: h, length
+      real(wp), allocatable, intent(out) :: bh(:), b1(:)
+      real(wp) :: full_h(2*elements + 2), full_1(2*elements + 2), nq(4), xq
+      integer :: e, q
+      full_h = 0
+      full_1 = 0
+      do e = 1, elements
+         do q = 1, 4
+            nq = hermite_basis(gauss_points(q), h)*gauss_weights(q)*h
+            xq = (e - 1 + gauss_points(q))*h
+            full_h(2*e - 1:2*e + 2) = full_h(2*e - 1:2*e + 2) + nq*lift_shape(xq, length)
+            full_1(2*e - 1:2*e + 2) = full_1(2*e - 1:2*e + 2) + nq
+         end do
+      end do
+      bh = full_h(3:)
+      b1 = full_1(3:)
+   end subroutine load_shapes
+
+   !> kappa_h (exact for small meshes, inverse iteration beyond), the paper's bound and the limits.
+   subroutine spectrum(scene, model, error)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(inout) :: model
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: sc(:, :), mfac(:, :), e_tip(:)
+      real(wp) :: inf, spring, upper
+      inf = ieee_value(1.0_wp, ieee_positive_inf)
+      model%kappa_bound = kappa_bound_constant*scene%k2/model%h**4
+      spring = 0
+      if (scene%law == law_compliance) spring = scene%stiffness_per_mass
+      allocate (sc, source=model%stiffness)
+      sc(kd + 1, model%tip) = sc(kd + 1, model%tip) + spring
+      if (model%n <= exact_eigen_limit) then
+         model%kappa_method = 'dsbgv'
+         call largest_eigenvalue_exact(model%stiffness, model%mass, model%kappa_h, error)
+         if (allocated(error)) return
+         model%kappa_contact = model%kappa_h
+         if (spring > 0) call largest_eigenvalue_exact(sc, model%mass, model%kappa_contact, error)
+      else
+         model%kappa_method = 'inverse iteration'
+         ! (M^-1)_tip,tip bounds the Rayleigh quotient of the spring term.
+         mfac = model%mass
+         call cholesky_factor(mfac, 'M', error)
+         if (allocated(error)) return
+         allocate (e_tip(model%n))
+         e_tip = 0
+         e_tip(model%tip) = 1
+         call cholesky_solve(mfac, e_tip)
+         upper = element_bound(model%h, scene%k2)
+         call largest_eigenvalue_iterative(model%stiffness, model%mass, upper, model%kappa_h, error)
+         if (allocated(error)) return
+         model%kappa_contact = model%kappa_h
+         if (spring > 0) call largest_eigenvalue_iterative(sc, model%mass, &
+            & upper + spring*e_tip(model%tip), model%kappa_contact, error)
+      end if
+      if (allocated(error)) return
+      model%dt_newmark = inf
+      if (scene%beta < 0.25_wp) model%dt_newmark = 2/sqrt((1 - 4*scene%beta)*model%kappa_contact)
+      model%dt_paper_exact = inf
+      model%dt_paper_bound = inf
+      if (scene%beta < 0.5_wp) then
+         model%dt_paper_exact = 2/sqrt((1 - 2*scene%beta)*model%kappa_h)
+         model%dt_paper_bound = 2/sqrt((1 - 2*scene%beta)*model%kappa_bound)
+      end if
+   end subroutine spectrum
+
+   !> Upper bound of kappa_h: the largest eigenvalue of one element, slightly enlarged.
+   function element_bound(h, k2) result(bound)
+      real(wp), intent(in) :: h, k2
+      real(wp) :: bound
+      real(wp) :: mb(kd + 1, 4), sb(kd + 1, 4)
+      type(error_type), allocatable :: error
+      integer :: i, j
+      mb = 0
+      sb = 0
+      associate (me => element_mass(h), se => element_stiffness(h, k2))
+         do j = 1, 4
+            do i = max(1, j - kd), j
+               mb(kd + 1 + i - j, j) = me(i, j)
+               sb(kd + 1 + i - j, j) = se(i, j)
+            end do
+         end do
+      end associate
+      call largest_eigenvalue_exact(sb, mb, bound, error)
+      bound = bound*(1 + 1.0e-6_wp)
+   end function element_bound
+
+   !> Refuse a scheme with beta < 1/4 asked beyond its linear stability limit, unless allowed.
+   subroutine check_stability(scene, model, source, error)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      !> Its model.
+      type(model_type), intent(in) :: model
+      !> Where the scene came from, for the message.
+      character(len=*), intent(in) :: source
+      !> Set when dt exceeds the limit.
+      type(error_type), allocatable, intent(out) :: error
+      if (scene%allow_unstable .or. scene%beta >= 0.25_wp) return
+      if (scene%dt < model%dt_newmark) return
+      call fatal_error(error, source//': &time dt = '//fmt_real(scene%dt)//' is out of range; allowed: dt < '// &
+         & fmt_real(model%dt_newmark)//' s, the linear stability limit 2/sqrt((1-4 beta) kappa_h) for beta = '// &
+         & fmt_real(scene%beta)//' (kappa_h = '//fmt_real(model%kappa_contact)//' 1/s^2); set &time allow_unstable=.true.'// &
+         & ' to run it anyway')
+   end subroutine check_stability
+end module beamstops_model

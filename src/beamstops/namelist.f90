@@ -1,0 +1,353 @@
+!> Scene from a namelist file: groups &beam, &support, &stops, &mesh, &time, &output.
+!> Unknown or repeated groups, unknown keys, malformed and out-of-range values
+!> all end in one message naming the file, the group and the key.
+module beamstops_namelist
+   use, intrinsic :: iso_fortran_env, only: iostat_end
+   use beamstops_kinds, only: wp
+   use beamstops_error, only: error_type, fatal_error
+   use beamstops_scene, only: scene_type, validate_scene, tube_section, law_code, law_compliance, fmt_real
+   implicit none
+   private
+   public :: read_scene, group_names
+
+   !> Groups a scene file may hold, each at most once.
+   character(len=*), parameter :: group_names(6) = ['beam   ', 'support', 'stops  ', 'mesh   ', 'time   ', 'output ']
+   !> Keys of each group, for messages.
+   character(len=*), parameter :: group_keys(6) = [character(len=140) :: &
+      & 'length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness', &
+      & 'amplitude, omega', 'lower, upper, law, stiffness, stiffness_per_mass', 'elements', &
+      & 'dt, t_end, beta, load_rule, start, allow_unstable', 'file, record_every, snapshot_every']
+   real(wp), parameter :: unset = -huge(1.0_wp)
+   integer, parameter :: text_len = 4096
+
+contains
+
+   !> Read, derive and validate a scene from a namelist file; missing groups and keys keep
+   !> the paper's values. The output file defaults to the file's base name with '.h5'.
+   subroutine read_scene(path, scene, error)
+      !> Namelist file.
+      character(len=*), intent(in) :: path
+      !> Scene read.
+      type(scene_type), intent(out) :: scene
+      !> Set on any bad input.
+      type(error_type), allocatable, intent(out) :: error
+      ! &beam
+      real(wp) :: length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness
+      ! &support
+      real(wp) :: amplitude, omega
+      ! &stops
+      real(wp) :: lower, upper, stiffness, stiffness_per_mass
+      character(len=64) :: law
+      ! &mesh
+      integer :: elements
+      ! &time
+      real(wp) :: dt, t_end, beta
+      character(len=64) :: load_rule, start
+      logical :: allow_unstable
+      ! &output
+      character(len=text_len) :: file
+      integer :: record_every, snapshot_every
+      namelist /beam/ length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness
+      namelist /support/ amplitude, omega
+      namelist /stops/ lower, upper, law, stiffness, stiffness_per_mass
+      namelist /mesh/ elements
+      namelist /time/ dt, t_end, beta, load_rule, start, allow_unstable
+      namelist /output/ file, record_every, snapshot_every
+      character(len=text_len) :: groups_text(size(group_names))
+      logical :: present(size(group_names))
+      character(len=512) :: msg
+      integer :: unit, stat, g
+
+      call scan_groups(path, present, groups_text, error)
+      if (allocated(error)) return
+
+      length = scene%length; k2 = unset; mass_per_length = unset
+      youngs_modulus = unset; density = unset; outer_diameter = unset; wall_thickness = unset
+      amplitude = scene%amplitude; omega = scene%omega
+      lower = scene%lower; upper = scene%upper; law = 'signorini'; stiffness = unset; stiffness_per_mass = unset
+      elements = scene%elements
+      dt = scene%dt; t_end = scene%t_end; beta = scene%beta; load_rule = 'centered'; start = 'taylor'
+      allow_unstable = .false.
+      file = default_output(path); record_every = scene%record_every; snapshot_every = scene%snapshot_every
+
+      open (newunit=unit, file=path, status='old', action='read', iostat=stat, iomsg=msg)
+      if (stat /= 0) then
+         call fatal_error(error, path//': cannot open: '//trim(msg))
+         return
+      end if
+      do g = 1, size(group_names)
+         if (.not. present(g)) cycle
+         rewind (unit)
+         select case (g)
+         case (1); read (unit, nml=beam, iostat=stat, iomsg=msg)
+         case (2); read (unit, nml=support, iostat=stat, iomsg=msg)
+         case (3); read (unit, nml=stops, iostat=stat, iomsg=msg)
+         case (4); read (unit, nml=mesh, iostat=stat, iomsg=msg)
+         case (5); read (unit, nml=time, iostat=stat, iomsg=msg)
+         case (6); read (unit, nml=output, iostat=stat, iomsg=msg)
+         end select
+         if (stat /= 0) then
+            call fatal_error(error, path//': &'//trim(group_names(g))//': '//trim(explain(stat, msg))// &
+               & ' in `'//trim(groups_text(g))//'`; keys of &'//trim(group_names(g))//': '//trim(group_keys(g)))
+            close (unit)
+            return
+         end if
+      end do
+      close (unit)
+
+      call derive_beam(path, length, k2, mass_per_length, youngs_modulus, density, outer_diameter, &
+         & wall_thickness, scene, error)
+      if (allocated(error)) return
+      scene%amplitude = amplitude
+      scene%omega = omega
+      scene%lower = lower
+      scene%upper = upper
+      scene%law = law_code(law)
+      if (scene%law < 0) then
+         call fatal_error(error, path//": &stops law = '"//trim(law)//"' is out of range; allowed: "// &
+            & "'signorini', 'compliance' or 'none'")
+         return
+      end if
+      if (scene%law == law_compliance) then
+         if ((stiffness == unset) .eqv. (stiffness_per_mass == unset)) then
+            call fatal_error(error, path//": &stops law = 'compliance' needs exactly one of stiffness (N/m) "// &
+               & 'or stiffness_per_mass (1/s^2), both > 0')
+            return
+         end if
+         if (stiffness /= unset) then
+            if (.not. stiffness > 0) then
+               call fatal_error(error, path//': &stops stiffness = '//fmt_real(stiffness)// &
+                  & ' is out of range; allowed: stiffness > 0 (N/m)')
+               return
+            end if
+            scene%stiffness_per_mass = stiffness/scene%mass_per_length
+         else
+            scene%stiffness_per_mass = stiffness_per_mass
+         end if
+      end if
+      scene%elements = elements
+      scene%dt = dt
+      scene%t_end = t_end
+      scene%beta = beta
+      select case (trim(load_rule))
+      case ('centered'); scene%centered_load = .true.
+      case ('paper'); scene%centered_load = .false.
+      case default
+         call fatal_error(error, path//": &time load_rule = '"//trim(load_rule)//"' is out of range; "// &
+            & "allowed: 'centered' or 'paper'")
+         return
+      end select
+      select case (trim(start))
+      case ('taylor'); scene%taylor_start = .true.
+      case ('euler'); scene%taylor_start = .false.
+      case default
+         call fatal_error(error, path//": &time start = '"//trim(start)//"' is out of range; "// &
+            & "allowed: 'taylor' or 'euler'")
+         return
+      end select
+      scene%allow_unstable = allow_unstable
+      if (len_trim(file) == 0) then
+         call fatal_error(error, path//": &output file = '' is out of range; allowed: a file name")
+         return
+      end if
+      scene%output_file = trim(file)
+      scene%record_every = record_every
+      scene%snapshot_every = snapshot_every
+      call validate_scene(scene, path, error)
+   end subroutine read_scene
+
+   !> k2 and the mass per length, given directly or derived from the tube's material and geometry.
+   subroutine derive_beam(path, length, k2, mass_per_length, youngs_modulus, density, outer_diameter, &
+      & wall_thickness, scene, error)
+      character(len=*), intent(in) :: path
+      real(wp), intent(in) :: length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness
+      type(scene_type), intent(inout) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: material(4), area, inertia
+      character(len=*), parameter :: names(4) = ['youngs_modulus', 'density       ', 'outer_diameter', &
+         & 'wall_thickness']
+      integer :: i
+      scene%length = length
+      material = [youngs_modulus, density, outer_diameter, wall_thickness]
+      if (all(material == unset)) then
+         if (k2 /= unset) scene%k2 = k2
+         if (mass_per_length /= unset) scene%mass_per_length = mass_per_length
+         return
+      end if
+      do i = 1, 4
+         if (material(i) == unset) then
+            call fatal_error(error, path//': &beam '//trim(names(i))//' is missing; allowed: give all of '// &
+               & 'youngs_modulus, density, outer_diameter, wall_thickness, or none of them (then k2)')
+            return
+         end if
+         if (.not. (material(i) > 0 .and. material(i) < huge(1.0_wp))) then
+            call fatal_error(error, path//': &beam '//trim(names(i))//' = '//fmt_real(material(i))// &
+               & ' is out of range; allowed: '//trim(names(i))//' > 0')
+            return
+         end if
+      end do
+      if (k2 /= unset .or. mass_per_length /= unset) then
+         call fatal_error(error, path//': &beam gives k2 or mass_per_length together with the material; '// &
+            & 'allowed: either k2 (and mass_per_length) or youngs_modulus, density, outer_diameter, wall_thickness')
+         return
+      end if
+      if (.not. wall_thickness <= outer_diameter/2) then
+         call fatal_error(error, path//': &beam wall_thickness = '//fmt_real(wall_thickness)// &
+            & ' is out of range; allowed: 0 < wall_thickness <= outer_diameter/2 = '//fmt_real(outer_diameter/2))
+         return
+      end if
+      call tube_section(outer_diameter, wall_thickness, area, inertia)
+      scene%k2 = youngs_modulus*inertia/(density*area)
+      scene%mass_per_length = density*area
+   end subroutine derive_beam
+
+   !> Which groups the file holds (and their text, for messages); unknown or repeated groups are errors.
+   subroutine scan_groups(path, present, texts, error)
+      character(len=*), intent(in) :: path
+      logical, intent(out) :: present(:)
+      character(len=*), intent(out) :: texts(:)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=text_len) :: line
+      character(len=512) :: msg
+      character(len=:), allocatable :: name
+      integer :: unit, stat, i, j, g, current, line_no
+      logical :: quoted
+      character :: quote
+      present = .false.
+      texts = ''
+      open (newunit=unit, file=path, status='old', action='read', iostat=stat, iomsg=msg)
+      if (stat /= 0) then
+         call fatal_error(error, path//': cannot open: '//trim(msg))
+         return
+      end if
+      current = 0
+      line_no = 0
+      do
+         read (unit, '(a)', iostat=stat) line
+         if (stat == iostat_end) exit
+         line_no = line_no + 1
+         if (stat /= 0) then
+            call fatal_error(error, path//': line '//itoa(line_no)//' cannot be read as text')
+            exit
+         end if
+         if (is_binary(line(1:len_trim(line)))) then
+            call fatal_error(error, path//': line '//itoa(line_no)//' holds binary characters; '// &
+               & 'allowed: a namelist text file')
+            exit
+         end if
+         quoted = .false.
+         quote = ' '
+         i = 1
+         do while (i <= len_trim(line))
+            if (quoted) then
+               if (line(i:i) == quote) quoted = .false.
+            else if (line(i:i) == '"' .or. line(i:i) == "'") then
+               quoted = .true.
+               quote = line(i:i)
+            else if (line(i:i) == '!') then
+               exit
+            else if (line(i:i) == '/' .and. current > 0) then
+               texts(current) = trim(texts(current))//' /'
+               current = 0
+            else if (line(i:i) == '&' .or. line(i:i) == '$') then
+               j = i + 1
+               do while (j <= len(line))
+                  if (scan(line(j:j), 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_') == 0) exit
+                  j = j + 1
+               end do
+               name = lower(line(i + 1:j - 1))
+               if (name == 'end') then
+                  current = 0
+                  i = j
+                  cycle
+               end if
+               g = group_index(name)
+               if (g == 0) then
+                  call fatal_error(error, path//': line '//itoa(line_no)//': unknown group &'//name// &
+                     & '; allowed groups: &beam, &support, &stops, &mesh, &time, &output')
+                  exit
+               end if
+               if (present(g)) then
+                  call fatal_error(error, path//': line '//itoa(line_no)//': group &'//name// &
+                     & ' appears twice; allowed: each group once')
+                  exit
+               end if
+               present(g) = .true.
+               current = g
+               texts(g) = '&'//name
+               i = j
+               cycle
+            end if
+            if (current > 0 .and. len_trim(texts(current)) < 200) &
+               & texts(current) = trim(texts(current))//line(i:i)
+            i = i + 1
+         end do
+         if (allocated(error)) exit
+         if (current > 0) texts(current) = trim(texts(current))//' '
+      end do
+      close (unit)
+   end subroutine scan_groups
+
+   !> Clearer text for gfortran's namelist messages.
+   function explain(stat, msg) result(text)
+      integer, intent(in) :: stat
+      character(len=*), intent(in) :: msg
+      character(len=:), allocatable :: text
+      if (stat == iostat_end) then
+         text = 'a value is malformed or the group is not closed by /'
+      else if (index(msg, 'Cannot match namelist object name') > 0) then
+         text = 'unknown key '//trim(adjustl(msg(index(msg, 'name') + 4:)))
+      else
+         text = 'malformed value ('//trim(msg)//')'
+      end if
+   end function explain
+
+   !> Index of a group name in group_names (0 when unknown).
+   pure integer function group_index(name)
+      character(len=*), intent(in) :: name
+      do group_index = size(group_names), 1, -1
+         if (trim(group_names(group_index)) == name) return
+      end do
+   end function group_index
+
+   !> Whether a line holds control characters other than tab, line feed and carriage return.
+   pure logical function is_binary(s)
+      character(len=*), intent(in) :: s
+      integer :: i, code
+      is_binary = .false.
+      do i = 1, len(s)
+         code = iachar(s(i:i))
+         if (code < 9 .or. (code > 13 .and. code < 32) .or. code == 127) is_binary = .true.
+      end do
+   end function is_binary
+
+   pure function lower(s) result(t)
+      character(len=*), intent(in) :: s
+      character(len=len(s)) :: t
+      integer :: i
+      t = s
+      do i = 1, len(s)
+         if (s(i:i) >= 'A' .and. s(i:i) <= 'Z') t(i:i) = achar(iachar(s(i:i)) + 32)
+      end do
+   end function lower
+
+   pure function itoa(i) result(s)
+      integer, intent(in) :: i
+      character(len=:), allocatable :: s
+      character(len=16) :: buf
+      write (buf, '(i0)') i
+      s = trim(buf)
+   end function itoa
+
+   !> Base name of the input with '.h5' in place of its extension.
+   pure function default_output(path) result(file)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: file
+      integer :: slash, dot
+      slash = index(path, '/', back=.true.)
+      file = path(slash + 1:)
+      dot = index(file, '.', back=.true.)
+      if (dot > 1) file = file(:dot - 1)
+      file = file//'.h5'
+   end function default_output
+end module beamstops_namelist

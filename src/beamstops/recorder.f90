@@ -1,0 +1,52 @@
+!> The recorder interface: the time loop hands every `record_every`-th step's
+!> tip and energy values, and every `snapshot_every`-th step's shape, to a recorder.
+!> Implementations: the HDF5 file writer (program) and the array recorder (Python).
+module beamstops_recorder
+   use beamstops_kinds, only: wp, ik
+   implicit none
+   private
+   public :: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, col_work, col_dissipated
+
+   !> Columns of a record row.
+   integer, parameter :: col_t = 1, col_u = 2, col_v = 3, col_reaction = 4, col_energy = 5, &
+      & col_work = 6, col_dissipated = 7, n_columns = 7
+
+   !> Receives records from the time loop.
+   type, abstract :: recorder_type
+      !> Set by an implementation that can no longer write; the loop stops.
+      logical :: failed = .false.
+   contains
+      !> Take one row (t, tip u, tip v, reaction, energy, work, dissipated).
+      procedure(record_interface), deferred :: record
+      !> Take one snapshot of the physical displacement at the nodes x_0..x_J.
+      procedure(snapshot_interface), deferred :: snapshot
+      !> Told between blocks of steps how far the run is (default: nothing).
+      procedure :: progress
+   end type recorder_type
+
+   abstract interface
+      subroutine record_interface(self, row)
+         import :: recorder_type, wp, n_columns
+         class(recorder_type), intent(inout) :: self
+         real(wp), intent(in) :: row(n_columns)
+      end subroutine record_interface
+      subroutine snapshot_interface(self, t, u)
+         import :: recorder_type, wp
+         class(recorder_type), intent(inout) :: self
+         real(wp), intent(in) :: t
+         real(wp), intent(in) :: u(:)
+      end subroutine snapshot_interface
+   end interface
+
+contains
+
+   !> Default progress report: none.
+   subroutine progress(self, step, steps)
+      !> Recorder.
+      class(recorder_type), intent(inout) :: self
+      !> Steps done.
+      integer(ik), intent(in) :: step
+      !> Steps in the run.
+      integer(ik), intent(in) :: steps
+   end subroutine progress
+end module beamstops_recorder

@@ -1,0 +1,340 @@
+!> The HDF5 writer: chunked, extendable datasets written as the run goes,
+!> the scene and the results as root attributes, and a `status` attribute that
+!> says 'complete' only once the run has finished and every record is on disk.
+!>
+!>   /tip/t, /tip/u, /tip/v, /tip/reaction
+!>   /energy/t, /energy/E, /energy/work, /energy/dissipated
+!>   /snapshots/t, /snapshots/x, /snapshots/u   (u: snapshots x (J+1))
+module beamstops_recorder_hdf5
+   use, intrinsic :: iso_c_binding, only: c_loc
+   use hdf5
+   use beamstops_kinds, only: wp, ik
+   use beamstops_error, only: error_type, fatal_error
+   use beamstops_scene, only: scene_type, law_name, law_compliance
+   use beamstops_model, only: model_type
+   use beamstops_summary, only: run_summary, status_running
+   use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
+      & col_work, col_dissipated
+   use beamstops_version, only: version
+   implicit none
+   private
+   public :: hdf5_recorder
+
+   !> Rows buffered before a write.
+   integer, parameter :: buffer_rows = 4096
+   integer, parameter :: n_series = 8
+   character(len=*), parameter :: group_names(3) = [character(len=9) :: 'tip', 'energy', 'snapshots']
+   character(len=*), parameter :: series_path(n_series) = [character(len=18) :: '/tip/t', '/tip/u', '/tip/v', &
+      & '/tip/reaction', '/energy/t', '/energy/E', '/energy/work', '/energy/dissipated']
+   character(len=*), parameter :: series_units(n_series) = [character(len=4) :: 's', 'm', 'm/s', 'N', 's', &
+      & 'J', 'J', 'J']
+   integer, parameter :: series_column(n_series) = [col_t, col_u, col_v, col_reaction, col_t, col_energy, &
+      & col_work, col_dissipated]
+
+   !> Recorder writing an HDF5 file.
+   type, extends(recorder_type) :: hdf5_recorder
+      !> File name.
+      character(len=:), allocatable :: path
+      !> Message of the first failure.
+      character(len=:), allocatable :: message
+      integer(hid_t) :: file = -1
+      integer(hid_t) :: series(n_series) = -1
+      integer(hid_t) :: snap_t = -1, snap_u = -1
+      integer(hsize_t) :: written = 0, snaps_written = 0
+      integer :: fill = 0
+      integer :: nodes = 0
+      real(wp), allocatable :: buffer(:, :)
+      !> Print a progress line on stderr.
+      logical :: show_progress = .false.
+   contains
+      procedure :: open => open_file
+      procedure :: record
+      procedure :: snapshot
+      procedure :: progress
+      procedure :: finish
+   end type hdf5_recorder
+
+contains
+
+   !> Create the file, its datasets and the scene's attributes; status 'running'.
+   subroutine open_file(self, path, scene, model, error)
+      !> Recorder.
+      class(hdf5_recorder), intent(inout) :: self
+      !> File to create (replaced if it exists).
+      character(len=*), intent(in) :: path
+      !> Scene of the run.
+      type(scene_type), intent(in) :: scene
+      !> Its model.
+      type(model_type), intent(in) :: model
+      !> Set when the file cannot be created.
+      type(error_type), allocatable, intent(out) :: error
+      integer :: hdferr, i
+      integer(hid_t) :: group
+      self%path = path
+      self%nodes = size(model%x)
+      allocate (self%buffer(n_columns, buffer_rows))
+      call h5open_f(hdferr)
+      call h5eset_auto_f(0, hdferr)
+      call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%file, hdferr)
+      if (hdferr /= 0) then
+         call fatal_error(error, path//': cannot create the HDF5 file')
+         self%failed = .true.
+         return
+      end if
+      do i = 1, 3
+         call h5gcreate_f(self%file, trim(group_names(i)), group, hdferr)
+         call h5gclose_f(group, hdferr)
+      end do
+      do i = 1, n_series
+         call create_series(self, trim(series_path(i)), trim(series_units(i)), 1, self%series(i))
+      end do
+      if (scene%snapshot_every > 0) then
+         call create_series(self, '/snapshots/t', 's', 1, self%snap_t)
+         call create_series(self, '/snapshots/u', 'm', self%nodes, self%snap_u)
+      end if
+      call write_vector(self, '/snapshots/x', model%x)
+      call attribute_text(self, 'status', status_running)
+      call attribute_text(self, 'version', version)
+      call attribute_real(self, 'length', scene%length)
+      call attribute_real(self, 'k2', scene%k2)
+      call attribute_real(self, 'mass_per_length', scene%mass_per_length)
+      call attribute_real(self, 'amplitude', scene%amplitude)
+      call attribute_real(self, 'omega', scene%omega)
+      call attribute_real(self, 'lower', scene%lower)
+      call attribute_real(self, 'upper', scene%upper)
+      call attribute_text(self, 'law', law_name(scene%law))
+      if (scene%law == law_compliance) call attribute_real(self, 'stiffness_per_mass', scene%stiffness_per_mass)
+      call attribute_int(self, 'elements', int(scene%elements, ik))
+      call attribute_real(self, 'dt', scene%dt)
+      call attribute_real(self, 't_end', scene%t_end)
+      call attribute_real(self, 'beta', scene%beta)
+      call attribute_text(self, 'load_rule', merge('centered', 'paper   ', scene%centered_load))
+      call attribute_text(self, 'start', merge('taylor', 'euler ', scene%taylor_start))
+      call attribute_int(self, 'record_every', int(scene%record_every, ik))
+      call attribute_int(self, 'snapshot_every', int(scene%snapshot_every, ik))
+      call attribute_real(self, 'kappa_h', model%kappa_h)
+      call attribute_real(self, 'kappa_bound', model%kappa_bound)
+      call attribute_real(self, 'dt_limit_newmark', model%dt_newmark)
+      call attribute_real(self, 'dt_limit_paper', model%dt_paper_exact)
+      call attribute_real(self, 'dt_limit_paper_bound', model%dt_paper_bound)
+      if (self%failed) then
+         call fatal_error(error, self%message)
+         return
+      end if
+      call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, hdferr)
+   end subroutine open_file
+
+   !> Buffer one row; write the buffer when full.
+   subroutine record(self, row)
+      class(hdf5_recorder), intent(inout) :: self
+      real(wp), intent(in) :: row(n_columns)
+      self%fill = self%fill + 1
+      self%buffer(:, self%fill) = row
+      if (self%fill == buffer_rows) call write_buffer(self)
+   end subroutine record
+
+   !> Write one snapshot row.
+   subroutine snapshot(self, t, u)
+      class(hdf5_recorder), intent(inout) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: u(:)
+      call append(self, self%snap_t, 1, self%snaps_written, 1, [t])
+      call append(self, self%snap_u, self%nodes, self%snaps_written, 1, u)
+      self%snaps_written = self%snaps_written + 1
+   end subroutine snapshot
+
+   !> A progress line on stderr (only when asked, i.e. attached to a terminal).
+   subroutine progress(self, step, steps)
+      class(hdf5_recorder), intent(inout) :: self
+      integer(ik), intent(in) :: step
+      integer(ik), intent(in) :: steps
+      character(len=*), parameter :: cr = achar(13)
+      if (.not. self%show_progress) return
+      write (0, '(a,a,f6.2,a,i0,a,i0,a)', advance='no') cr, 'beamstops: ', 100.0_wp*step/steps, '% (', step, &
+         & ' of ', steps, ' steps)'
+      if (step == steps) write (0, '(a)') ''
+      flush (0)
+   end subroutine progress
+
+   !> Write what is buffered, the results as attributes and the final status; close the file.
+   subroutine finish(self, summary, error)
+      !> Recorder.
+      class(hdf5_recorder), intent(inout) :: self
+      !> Outcome of the run.
+      type(run_summary), intent(in) :: summary
+      !> Set when the file could not be completed.
+      type(error_type), allocatable, intent(out) :: error
+      integer :: hdferr
+      if (self%file < 0) return
+      if (self%fill > 0) call write_buffer(self)
+      call attribute_int(self, 'steps', summary%steps)
+      call attribute_real(self, 't_final', summary%t_final)
+      call attribute_real(self, 'cpu_seconds', summary%cpu_seconds)
+      call attribute_int(self, 'impacts', summary%impacts)
+      call attribute_real(self, 'max_violation', summary%max_violation)
+      if (allocated(summary%message)) call attribute_text(self, 'message', summary%message)
+      call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, hdferr)
+      if (.not. self%failed) call attribute_text(self, 'status', summary%status)
+      call h5fclose_f(self%file, hdferr)
+      self%file = -1
+      if (self%failed .or. hdferr /= 0) then
+         if (.not. allocated(self%message)) self%message = self%path//': cannot close the HDF5 file'
+         call fatal_error(error, self%message)
+      end if
+   end subroutine finish
+
+   subroutine write_buffer(self)
+      class(hdf5_recorder), intent(inout) :: self
+      integer :: i
+      do i = 1, n_series
+         call append(self, self%series(i), 1, self%written, self%fill, self%buffer(series_column(i), :self%fill))
+      end do
+      self%written = self%written + self%fill
+      self%fill = 0
+   end subroutine write_buffer
+
+   !> Append `rows` rows of `width` values (stored row after row in `values`) at row `offset`.
+   subroutine append(self, dset, width, offset, rows, values)
+      class(hdf5_recorder), intent(inout) :: self
+      integer(hid_t), intent(in) :: dset
+      integer, intent(in) :: width, rows
+      integer(hsize_t), intent(in) :: offset
+      real(wp), intent(in) :: values(*)
+      integer(hid_t) :: filespace, memspace
+      integer(hsize_t) :: dims(2), start(2), count(2)
+      integer :: hdferr, rank
+      if (self%failed) return
+      rank = merge(1, 2, width == 1)
+      if (rank == 1) then
+         dims(1) = offset + rows; start(1) = offset; count(1) = rows
+      else
+         dims = [int(width, hsize_t), offset + rows]; start = [0_hsize_t, offset]
+         count = [int(width, hsize_t), int(rows, hsize_t)]
+      end if
+      call h5dset_extent_f(dset, dims(:rank), hdferr)
+      call h5dget_space_f(dset, filespace, hdferr)
+      call h5sselect_hyperslab_f(filespace, H5S_SELECT_SET_F, start(:rank), count(:rank), hdferr)
+      call h5screate_simple_f(rank, count(:rank), memspace, hdferr)
+      call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, count(:rank), hdferr, memspace, filespace)
+      if (hdferr /= 0) call fail(self, 'cannot write to the HDF5 file (disk full?)')
+      call h5sclose_f(memspace, hdferr)
+      call h5sclose_f(filespace, hdferr)
+   end subroutine append
+
+   !> An extendable, chunked dataset of rows of `width` doubles.
+   subroutine create_series(self, path, units, width, dset)
+      class(hdf5_recorder), intent(inout) :: self
+      character(len=*), intent(in) :: path, units
+      integer, intent(in) :: width
+      integer(hid_t), intent(out) :: dset
+      integer(hid_t) :: space, plist
+      integer(hsize_t) :: dims(2), maxdims(2), chunk(2)
+      integer :: hdferr, rank
+      rank = merge(1, 2, width == 1)
+      if (rank == 1) then
+         dims(1) = 0; maxdims(1) = H5S_UNLIMITED_F; chunk(1) = buffer_rows
+      else
+         dims = [int(width, hsize_t), 0_hsize_t]; maxdims = [int(width, hsize_t), H5S_UNLIMITED_F]
+         chunk = [int(width, hsize_t), int(max(1, min(256, 65536/width)), hsize_t)]
+      end if
+      call h5screate_simple_f(rank, dims(:rank), space, hdferr, maxdims(:rank))
+      call h5pcreate_f(H5P_DATASET_CREATE_F, plist, hdferr)
+      call h5pset_chunk_f(plist, rank, chunk(:rank), hdferr)
+      call h5dcreate_f(self%file, path, H5T_NATIVE_DOUBLE, space, dset, hdferr, plist)
+      if (hdferr /= 0) call fail(self, 'cannot create dataset '//path)
+      call h5pclose_f(plist, hdferr)
+      call h5sclose_f(space, hdferr)
+      call dataset_units(dset, units)
+   end subroutine create_series
+
+   !> A fixed-size dataset.
+   subroutine write_vector(self, path, values)
+      class(hdf5_recorder), intent(inout) :: self
+      character(len=*), intent(in) :: path
+      real(wp), intent(in) :: values(:)
+      integer(hid_t) :: space, dset
+      integer(hsize_t) :: dims(1)
+      integer :: hdferr
+      dims = size(values)
+      call h5screate_simple_f(1, dims, space, hdferr)
+      call h5dcreate_f(self%file, path, H5T_NATIVE_DOUBLE, space, dset, hdferr)
+      call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, hdferr)
+      if (hdferr /= 0) call fail(self, 'cannot write dataset '//path)
+      call dataset_units(dset, 'm')
+      call h5dclose_f(dset, hdferr)
+      call h5sclose_f(space, hdferr)
+   end subroutine write_vector
+
+   subroutine dataset_units(dset, units)
+      integer(hid_t), intent(in) :: dset
+      character(len=*), intent(in) :: units
+      call text_attribute_on(dset, 'units', units)
+   end subroutine dataset_units
+
+   subroutine attribute_text(self, name, value)
+      class(hdf5_recorder), intent(inout) :: self
+      character(len=*), intent(in) :: name, value
+      if (self%failed) return
+      call text_attribute_on(self%file, name, value)
+   end subroutine attribute_text
+
+   !> Create or replace a scalar string attribute.
+   subroutine text_attribute_on(object, name, value)
+      integer(hid_t), intent(in) :: object
+      character(len=*), intent(in) :: name, value
+      integer(hid_t) :: space, atype, attr
+      integer(hsize_t) :: dims(1) = 1
+      integer :: hdferr
+      logical :: exists
+      call h5aexists_f(object, name, exists, hdferr)
+      if (exists) call h5adelete_f(object, name, hdferr)
+      call h5screate_f(H5S_SCALAR_F, space, hdferr)
+      call h5tcopy_f(H5T_C_S1, atype, hdferr)
+      call h5tset_size_f(atype, int(max(1, len(value)), size_t), hdferr)
+      call h5acreate_f(object, name, atype, space, attr, hdferr)
+      call h5awrite_f(attr, atype, value, dims, hdferr)
+      call h5aclose_f(attr, hdferr)
+      call h5tclose_f(atype, hdferr)
+      call h5sclose_f(space, hdferr)
+   end subroutine text_attribute_on
+
+   subroutine attribute_real(self, name, value)
+      class(hdf5_recorder), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      real(wp), intent(in) :: value
+      integer(hid_t) :: space, attr
+      integer(hsize_t) :: dims(1) = 1
+      integer :: hdferr
+      if (self%failed) return
+      call h5screate_f(H5S_SCALAR_F, space, hdferr)
+      call h5acreate_f(self%file, name, H5T_NATIVE_DOUBLE, space, attr, hdferr)
+      call h5awrite_f(attr, H5T_NATIVE_DOUBLE, value, dims, hdferr)
+      if (hdferr /= 0) call fail(self, 'cannot write attribute '//name)
+      call h5aclose_f(attr, hdferr)
+      call h5sclose_f(space, hdferr)
+   end subroutine attribute_real
+
+   subroutine attribute_int(self, name, value)
+      class(hdf5_recorder), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer(ik), intent(in) :: value
+      integer(ik), target :: buffer
+      integer(hid_t) :: space, attr
+      integer :: hdferr
+      if (self%failed) return
+      buffer = value
+      call h5screate_f(H5S_SCALAR_F, space, hdferr)
+      call h5acreate_f(self%file, name, H5T_STD_I64LE, space, attr, hdferr)
+      call h5awrite_f(attr, h5kind_to_type(ik, H5_INTEGER_KIND), c_loc(buffer), hdferr)
+      if (hdferr /= 0) call fail(self, 'cannot write attribute '//name)
+      call h5aclose_f(attr, hdferr)
+      call h5sclose_f(space, hdferr)
+   end subroutine attribute_int
+
+   subroutine fail(self, what)
+      class(hdf5_recorder), intent(inout) :: self
+      character(len=*), intent(in) :: what
+      if (.not. self%failed) self%message = self%path//': '//what
+      self%failed = .true.
+   end subroutine fail
+end module beamstops_recorder_hdf5

@@ -1,0 +1,196 @@
+!> The scene: every input of a run as plain data, with the paper's scene as
+!> default and one validation that names group, key and allowed range.
+module beamstops_scene
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use beamstops_kinds, only: wp, ik
+   use beamstops_error, only: error_type, fatal_error
+   implicit none
+   private
+   public :: scene_type, validate_scene, steps_of, tube_section, fmt_real, fmt_int
+   public :: law_none, law_signorini, law_compliance, law_name, law_code
+   public :: max_elements
+
+   !> Contact law codes.
+   integer, parameter :: law_none = 0, law_signorini = 1, law_compliance = 2
+   !> Largest mesh accepted (memory stays below a few GB).
+   integer, parameter :: max_elements = 10000000
+
+   !> Every input of a run. Defaults reproduce the paper's scene (Figure 2).
+   type :: scene_type
+      !> &beam: length L of the beam (m).
+      real(wp) :: length = 1.501_wp
+      !> &beam: k^2 = EI/(rho S) (m^4/s^2).
+      real(wp) :: k2 = 282.84_wp
+      !> &beam: mass per unit length rho S (kg/m); scales reactions and energies.
+      real(wp) :: mass_per_length = 0.11938_wp
+      !> &support: amplitude a of phi(t) = a sin(omega t) (m).
+      real(wp) :: amplitude = 0.2_wp
+      !> &support: angular frequency omega of the support (rad/s).
+      real(wp) :: omega = 10.0_wp
+      !> &stops: lower stop g1 < 0 (m).
+      real(wp) :: lower = -0.1_wp
+      !> &stops: upper stop g2 > 0 (m).
+      real(wp) :: upper = 0.1_wp
+      !> &stops: contact law (law_signorini, law_compliance or law_none).
+      integer :: law = law_signorini
+      !> &stops: normal-compliance stiffness per unit mass 1/epsilon (1/s^2).
+      real(wp) :: stiffness_per_mass = 0.0_wp
+      !> &mesh: number of elements J.
+      integer :: elements = 19
+      !> &time: time step (s).
+      real(wp) :: dt = 5.0e-5_wp
+      !> &time: final time (s).
+      real(wp) :: t_end = 2.0_wp
+      !> &time: Newmark beta in [0, 1/2].
+      real(wp) :: beta = 0.5_wp
+      !> &time: .true. for the centred load rule (second order), .false. for the paper's.
+      logical :: centered_load = .true.
+      !> &time: .true. for the second-order Taylor start, .false. for the Euler start.
+      logical :: taylor_start = .true.
+      !> &time: run even beyond the linear stability limit of beta < 1/4.
+      logical :: allow_unstable = .false.
+      !> &output: HDF5 file written by the program (not used by the in-memory path).
+      character(len=:), allocatable :: output_file
+      !> &output: record the tip and the energy every this many steps.
+      integer :: record_every = 1
+      !> &output: record the beam's shape every this many steps (0: never).
+      integer :: snapshot_every = 0
+   end type scene_type
+
+contains
+
+   !> Number of time steps N = nint(t_end/dt) of a scene.
+   pure function steps_of(scene) result(n)
+      !> The scene.
+      type(scene_type), intent(in) :: scene
+      integer(ik) :: n
+      n = max(1_ik, nint(scene%t_end/scene%dt, ik))
+   end function steps_of
+
+   !> Cross-section area and second moment of a tube.
+   pure subroutine tube_section(outer_diameter, wall_thickness, area, inertia)
+      !> Outer diameter (m).
+      real(wp), intent(in) :: outer_diameter
+      !> Wall thickness (m).
+      real(wp), intent(in) :: wall_thickness
+      !> Cross-section area (m^2).
+      real(wp), intent(out) :: area
+      !> Second moment of area (m^4).
+      real(wp), intent(out) :: inertia
+      real(wp), parameter :: pi = acos(-1.0_wp)
+      real(wp) :: d_in
+      d_in = outer_diameter - 2*wall_thickness
+      area = pi/4*(outer_diameter**2 - d_in**2)
+      inertia = pi/64*(outer_diameter**4 - d_in**4)
+   end subroutine tube_section
+
+   !> Name of a contact-law code, as written in a namelist.
+   pure function law_name(law) result(name)
+      !> Law code.
+      integer, intent(in) :: law
+      character(len=:), allocatable :: name
+      select case (law)
+      case (law_signorini); name = 'signorini'
+      case (law_compliance); name = 'compliance'
+      case default; name = 'none'
+      end select
+   end function law_name
+
+   !> Code of a contact-law name; -1 when unknown.
+   pure function law_code(name) result(law)
+      !> Law name (case-sensitive, lower case).
+      character(len=*), intent(in) :: name
+      integer :: law
+      select case (trim(adjustl(name)))
+      case ('signorini'); law = law_signorini
+      case ('compliance'); law = law_compliance
+      case ('none'); law = law_none
+      case default; law = -1
+      end select
+   end function law_code
+
+   !> Shortest round-trip text of a real.
+   function fmt_real(x) result(s)
+      !> Value.
+      real(wp), intent(in) :: x
+      character(len=:), allocatable :: s
+      character(len=40) :: buf
+      write (buf, '(g0.6)') x
+      s = trim(adjustl(buf))
+   end function fmt_real
+
+   !> Text of an integer.
+   pure function fmt_int(i) result(s)
+      !> Value.
+      integer(ik), intent(in) :: i
+      character(len=:), allocatable :: s
+      character(len=24) :: buf
+      write (buf, '(i0)') i
+      s = trim(buf)
+   end function fmt_int
+
+   !> Check every value of a scene; `source` (a file name or 'scene') starts the message.
+   subroutine validate_scene(scene, source, error)
+      !> Scene to check.
+      type(scene_type), intent(in) :: scene
+      !> Where the scene came from, for messages.
+      character(len=*), intent(in) :: source
+      !> Set on the first value out of range.
+      type(error_type), allocatable, intent(out) :: error
+
+      call within('beam', 'length', scene%length, 1.0e-6_wp, 1.0e6_wp); if (allocated(error)) return
+      call within('beam', 'k2', scene%k2, 1.0e-12_wp, 1.0e15_wp); if (allocated(error)) return
+      call within('beam', 'mass_per_length', scene%mass_per_length, 1.0e-12_wp, 1.0e9_wp)
+      if (allocated(error)) return
+      call within('support', 'amplitude', scene%amplitude, -1.0e3_wp, 1.0e3_wp); if (allocated(error)) return
+      call within('support', 'omega', scene%omega, 0.0_wp, 1.0e9_wp); if (allocated(error)) return
+      call within('stops', 'lower', scene%lower, -1.0e6_wp, 0.0_wp); if (allocated(error)) return
+      if (.not. scene%lower < 0) then
+         call say('stops', 'lower', fmt_real(scene%lower), 'lower < 0 (the beam starts at rest at 0)'); return
+      end if
+      call within('stops', 'upper', scene%upper, 0.0_wp, 1.0e6_wp); if (allocated(error)) return
+      if (.not. scene%upper > 0) then
+         call say('stops', 'upper', fmt_real(scene%upper), 'upper > 0 (the beam starts at rest at 0)'); return
+      end if
+      if (scene%law < law_none .or. scene%law > law_compliance) then
+         call say('stops', 'law', '?', "'signorini', 'compliance' or 'none'"); return
+      end if
+      if (scene%law == law_compliance) then
+         call within('stops', 'stiffness_per_mass', scene%stiffness_per_mass, 1.0e-12_wp, 1.0e20_wp)
+         if (allocated(error)) return
+      end if
+      if (scene%elements < 1 .or. scene%elements > max_elements) then
+         call say('mesh', 'elements', fmt_int(int(scene%elements, ik)), '1 <= elements <= '//fmt_int(int(max_elements, ik)))
+         return
+      end if
+      call within('time', 't_end', scene%t_end, 1.0e-300_wp, 1.0e9_wp); if (allocated(error)) return
+      call within('time', 'dt', scene%dt, 1.0e-300_wp, scene%t_end); if (allocated(error)) return
+      if (scene%t_end/scene%dt > 1.0e13_wp) then
+         call say('time', 'dt', fmt_real(scene%dt), 't_end/dt <= 1e13 steps'); return
+      end if
+      call within('time', 'beta', scene%beta, 0.0_wp, 0.5_wp); if (allocated(error)) return
+      if (scene%record_every < 1) then
+         call say('output', 'record_every', fmt_int(int(scene%record_every, ik)), 'record_every >= 1'); return
+      end if
+      if (scene%snapshot_every < 0) then
+         call say('output', 'snapshot_every', fmt_int(int(scene%snapshot_every, ik)), 'snapshot_every >= 0 (0: none)')
+         return
+      end if
+
+   contains
+
+      subroutine say(group, key, value, allowed)
+         character(len=*), intent(in) :: group, key, value, allowed
+         call fatal_error(error, source//': &'//group//' '//key//' = '//value// &
+            & ' is out of range; allowed: '//allowed)
+      end subroutine say
+
+      subroutine within(group, key, x, lo, hi)
+         character(len=*), intent(in) :: group, key
+         real(wp), intent(in) :: x, lo, hi
+         if (.not. ieee_is_finite(x) .or. x < lo .or. x > hi) &
+            & call say(group, key, fmt_real(x), fmt_real(lo)//' <= '//key//' <= '//fmt_real(hi))
+      end subroutine within
+
+   end subroutine validate_scene
+end module beamstops_scene

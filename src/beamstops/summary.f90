@@ -1,0 +1,31 @@
+!> What a run reports when it ends: status, counts, extremes and cost.
+module beamstops_summary
+   use beamstops_kinds, only: wp, ik
+   implicit none
+   private
+   public :: run_summary, status_complete, status_diverged, status_running, status_failed
+
+   !> Status texts written to the output's `status` attribute.
+   character(len=*), parameter :: status_complete = 'complete', status_diverged = 'diverged', &
+      & status_running = 'running', status_failed = 'failed'
+
+   !> Summary of a run.
+   type :: run_summary
+      !> 'complete', 'diverged', 'failed' or 'running' (interrupted).
+      character(len=:), allocatable :: status
+      !> Explanation when the status is not 'complete'.
+      character(len=:), allocatable :: message
+      !> Time steps done.
+      integer(ik) :: steps = 0
+      !> Time reached (s).
+      real(wp) :: t_final = 0
+      !> CPU time of the time loop (s).
+      real(wp) :: cpu_seconds = 0
+      !> Number of impacts (free-flight steps followed by a contact step).
+      integer(ik) :: impacts = 0
+      !> Largest violation of the stops max(u_tip - upper, lower - u_tip, 0) (m).
+      real(wp) :: max_violation = 0
+      !> Records and snapshots written.
+      integer(ik) :: records = 0, snapshots = 0
+   end type run_summary
+end module beamstops_summary
