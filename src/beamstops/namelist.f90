@@ -87,7 +87,7 @@ contains
          case (6); read (unit, nml=output, iostat=stat, iomsg=msg)
          end select
          if (stat /= 0) then
-            call fatal_error(error, path//': &'//trim(group_names(g))//': '//trim(explain(stat, msg))// &
+            call fatal_error(error, path//': &'//trim(group_names(g))//': '//trim(explain(stat, msg, groups_text(g)))// &
                & ' in `'//trim(groups_text(g))//'`; keys of &'//trim(group_names(g))//': '//trim(group_keys(g)))
             close (unit)
             return
@@ -210,11 +210,12 @@ contains
       character(len=text_len) :: line
       character(len=512) :: msg
       character(len=:), allocatable :: name
-      integer :: unit, stat, i, j, g, current, line_no
+      integer :: unit, stat, i, j, g, current, line_no, used(size(present))
       logical :: quoted
       character :: quote
       present = .false.
       texts = ''
+      used = 0
       open (newunit=unit, file=path, status='old', action='read', iostat=stat, iomsg=msg)
       if (stat /= 0) then
          call fatal_error(error, path//': cannot open: '//trim(msg))
@@ -247,7 +248,7 @@ contains
             else if (line(i:i) == '!') then
                exit
             else if (line(i:i) == '/' .and. current > 0) then
-               texts(current) = trim(texts(current))//' /'
+               call append_text(current, '/')
                current = 0
             else if (line(i:i) == '&' .or. line(i:i) == '$') then
                j = i + 1
@@ -274,33 +275,65 @@ contains
                end if
                present(g) = .true.
                current = g
-               texts(g) = '&'//name
+               texts(g) = ''
+               used(g) = 0
+               call append_text(g, '&'//name)
                i = j
                cycle
             end if
-            if (current > 0 .and. len_trim(texts(current)) < 200) &
-               & texts(current) = trim(texts(current))//line(i:i)
+            if (current > 0) call append_text(current, line(i:i))
             i = i + 1
          end do
          if (allocated(error)) exit
-         if (current > 0) texts(current) = trim(texts(current))//' '
+         if (current > 0) call append_text(current, ' ')
       end do
       close (unit)
+
+   contains
+
+      !> Append to a group's text (kept short for messages; runs of blanks folded).
+      subroutine append_text(g, piece)
+         integer, intent(in) :: g
+         character(len=*), intent(in) :: piece
+         if (used(g) + len(piece) > 200) return
+         if (piece == ' ' .and. used(g) > 0) then
+            if (texts(g)(used(g):used(g)) == ' ') return
+         end if
+         texts(g)(used(g) + 1:used(g) + len(piece)) = piece
+         used(g) = used(g) + len(piece)
+      end subroutine append_text
    end subroutine scan_groups
 
-   !> Clearer text for gfortran's namelist messages.
-   function explain(stat, msg) result(text)
+   !> Clearer text for gfortran's namelist messages: gfortran reports a malformed value
+   !> as an unknown object name, so a name not followed by '=' in the group is a bad value.
+   function explain(stat, msg, text) result(what)
       integer, intent(in) :: stat
-      character(len=*), intent(in) :: msg
-      character(len=:), allocatable :: text
+      character(len=*), intent(in) :: msg, text
+      character(len=:), allocatable :: what, name
       if (stat == iostat_end) then
-         text = 'a value is malformed or the group is not closed by /'
+         what = 'a value is malformed or the group is not closed by /'
       else if (index(msg, 'Cannot match namelist object name') > 0) then
-         text = 'unknown key '//trim(adjustl(msg(index(msg, 'name') + 4:)))
+         name = trim(adjustl(msg(index(msg, 'object name') + 11:)))
+         if (index(squeeze(lower(text)), squeeze(lower(name))//'=') > 0) then
+            what = 'unknown key '//name
+         else
+            what = "malformed value '"//name//"'"
+         end if
       else
-         text = 'malformed value ('//trim(msg)//')'
+         what = 'malformed value ('//trim(msg)//')'
       end if
    end function explain
+
+   !> A string without its blanks.
+   pure function squeeze(s) result(t)
+      character(len=*), intent(in) :: s
+      character(len=:), allocatable :: t
+      integer :: i
+      t = ''
+      do i = 1, len(s)
+         if (s(i:i) /= ' ') t = t//s(i:i)
+      end do
+   end function squeeze
 
    !> Index of a group name in group_names (0 when unknown).
    pure integer function group_index(name)

@@ -109,14 +109,53 @@ contains
       end select
    end function law_code
 
-   !> Shortest round-trip text of a real.
-   function fmt_real(x) result(s)
+   !> Shortest text that reads back as the same real (e.g. 2e-05, 0.25, 1.501, 2.6035e+10).
+   function fmt_real(x, digits) result(s)
       !> Value.
       real(wp), intent(in) :: x
+      !> At most this many significant digits (default: as many as needed to read back x).
+      integer, intent(in), optional :: digits
       character(len=:), allocatable :: s
-      character(len=40) :: buf
-      write (buf, '(g0.6)') x
-      s = trim(adjustl(buf))
+      character(len=40) :: buf, fmt
+      character(len=:), allocatable :: mantissa
+      real(wp) :: y
+      integer :: p, e, stat
+      if (.not. ieee_is_finite(x)) then
+         write (buf, '(g0)') x
+         s = trim(adjustl(buf))
+         return
+      end if
+      do p = 0, 16
+         write (fmt, '(a,i0,a)') '(es30.', p, 'e3)'
+         write (buf, fmt) x
+         read (buf, *, iostat=stat) y
+         if (stat == 0 .and. y == x) exit
+         if (present(digits)) then
+            if (p + 1 >= digits) exit
+         end if
+      end do
+      buf = adjustl(buf)
+      mantissa = buf(:index(buf, 'E') - 1)
+      read (buf(index(buf, 'E') + 1:), *) e
+      if (index(mantissa, '.') > 0) then
+         mantissa = mantissa(:verify(mantissa, '0', back=.true.))
+         if (mantissa(len(mantissa):) == '.') mantissa = mantissa(:len(mantissa) - 1)
+      end if
+      if (e >= -4 .and. e < 6) then
+         write (fmt, '(a,i0,a)') '(f0.', max(0, p - e), ')'
+         write (buf, fmt) x
+         s = trim(adjustl(buf))
+         if (index(s, '.') > 0) then
+            s = s(:verify(s, '0', back=.true.))
+            if (s(len(s):) == '.') s = s(:len(s) - 1)
+         end if
+         if (s(1:1) == '.') s = '0'//s
+         if (s(1:2) == '-.') s = '-0'//s(2:)
+         if (s == '' .or. s == '-') s = '0'
+      else
+         write (buf, '(sp,i3.2)') e
+         s = mantissa//'e'//trim(adjustl(buf))
+      end if
    end function fmt_real
 
    !> Text of an integer.
@@ -163,8 +202,10 @@ contains
          call say('mesh', 'elements', fmt_int(int(scene%elements, ik)), '1 <= elements <= '//fmt_int(int(max_elements, ik)))
          return
       end if
-      call within('time', 't_end', scene%t_end, 1.0e-300_wp, 1.0e9_wp); if (allocated(error)) return
-      call within('time', 'dt', scene%dt, 1.0e-300_wp, scene%t_end); if (allocated(error)) return
+      call within('time', 't_end', scene%t_end, tiny(1.0_wp), 1.0e9_wp, '0 < t_end <= 1e+09 s')
+      if (allocated(error)) return
+      call within('time', 'dt', scene%dt, tiny(1.0_wp), scene%t_end, '0 < dt <= t_end = '//fmt_real(scene%t_end)//' s')
+      if (allocated(error)) return
       if (scene%t_end/scene%dt > 1.0e13_wp) then
          call say('time', 'dt', fmt_real(scene%dt), 't_end/dt <= 1e13 steps'); return
       end if
@@ -185,11 +226,16 @@ contains
             & ' is out of range; allowed: '//allowed)
       end subroutine say
 
-      subroutine within(group, key, x, lo, hi)
+      subroutine within(group, key, x, lo, hi, allowed)
          character(len=*), intent(in) :: group, key
          real(wp), intent(in) :: x, lo, hi
-         if (.not. ieee_is_finite(x) .or. x < lo .or. x > hi) &
-            & call say(group, key, fmt_real(x), fmt_real(lo)//' <= '//key//' <= '//fmt_real(hi))
+         character(len=*), intent(in), optional :: allowed
+         if (ieee_is_finite(x) .and. x >= lo .and. x <= hi) return
+         if (present(allowed)) then
+            call say(group, key, fmt_real(x), allowed)
+         else
+            call say(group, key, fmt_real(x), fmt_real(lo)//' <= '//key//' <= '//fmt_real(hi))
+         end if
       end subroutine within
 
    end subroutine validate_scene

@@ -1,0 +1,138 @@
+"""The `beamstops` program: runs, `info`, exit statuses and messages on bad input."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+PROGRAM = os.environ.get("BEAMSTOPS_PROGRAM") or shutil.which("beamstops")
+INPUT = Path(__file__).resolve().parents[2] / "input"
+
+pytestmark = pytest.mark.skipif(PROGRAM is None, reason="the beamstops program is not on PATH")
+
+
+def beamstops(*args: str | Path, cwd: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([PROGRAM, *map(str, args)], cwd=cwd, capture_output=True, text=True, timeout=120)
+
+
+def write(tmp_path: Path, text: str, name: str = "scene.nml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+SHORT = "&time dt=5e-5, t_end=0.3 /\n"
+
+
+def test_run_writes_complete_file_with_contract_layout(tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT + "&output file='short.h5', snapshot_every=100 /\n")
+    done = beamstops("run", scene, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert "6000 steps" in done.stdout and "status complete" in done.stdout
+    with h5py.File(tmp_path / "short.h5") as f:
+        assert f.attrs["status"] == b"complete"
+        assert f.attrs["steps"] == 6000
+        for name in ["tip/t", "tip/u", "tip/v", "tip/reaction", "energy/t", "energy/E", "energy/work",
+                     "energy/dissipated"]:
+            assert f[name].shape == (6001,), name
+        assert f["snapshots/u"].shape == (61, 20)
+        assert f["snapshots/x"][-1] == pytest.approx(1.501)
+        # the physical displacement at the clamp is the support's motion
+        t = f["snapshots/t"][:]
+        np.testing.assert_allclose(f["snapshots/u"][:, 0], 0.2 * np.sin(10 * t), rtol=0, atol=1e-15)
+        # the tip never leaves [lower, upper] with the Signorini scheme
+        u = f["tip/u"][:]
+        assert u.max() <= 0.1 and u.min() >= -0.1
+        assert f.attrs["max_violation"] == 0.0
+        for key in ["kappa_h", "kappa_bound", "cpu_seconds", "impacts", "dt", "beta", "law", "version"]:
+            assert key in f.attrs, key
+
+
+def test_output_option_overrides_the_namelist(tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT)
+    done = beamstops("run", scene, "-o", tmp_path / "other.h5", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "other.h5").exists() and not (tmp_path / "scene.h5").exists()
+
+
+def test_info_prints_limits_without_running(tmp_path: Path) -> None:
+    scene = write(tmp_path, "&time dt=1e-6, beta=0.25 /\n")
+    done = beamstops("info", scene, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert "kappa_h" in done.stdout and "2000000" in done.stdout
+    assert not list(tmp_path.glob("*.h5"))
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in INPUT.glob("*.nml")))
+def test_shipped_inputs_are_valid(name: str, tmp_path: Path) -> None:
+    done = beamstops("info", INPUT / name, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+
+
+BAD = [
+    ("missing file", None, ["nowhere.nml", "cannot open"]),
+    ("unknown group", "&beams length=1 /\n", ["&beams", "unknown group"]),
+    ("unknown key", "&time dtt=1e-5 /\n", ["&time", "dtt"]),
+    ("malformed value", "&time dt=abc /\n", ["&time", "dt=abc"]),
+    ("repeated group", "&time dt=1e-5 /\n&time dt=2e-5 /\n", ["&time", "twice"]),
+    ("negative dt", "&time dt=-1e-5 /\n", ["&time", "dt", "allowed"]),
+    ("nan dt", "&time dt=nan /\n", ["&time", "dt", "allowed"]),
+    ("beta too large", "&time beta=0.7 /\n", ["&time", "beta", "0.5"]),
+    ("lower stop positive", "&stops lower=0.05 /\n", ["&stops", "lower", "allowed"]),
+    ("upper stop negative", "&stops upper=-0.05 /\n", ["&stops", "upper", "allowed"]),
+    ("no elements", "&mesh elements=0 /\n", ["&mesh", "elements", "allowed"]),
+    ("unknown law", "&stops law='glue' /\n", ["&stops", "law", "signorini"]),
+    ("compliance without stiffness", "&stops law='compliance' /\n", ["&stops", "stiffness"]),
+    ("unknown load rule", "&time load_rule='midpoint' /\n", ["&time", "load_rule", "centered"]),
+    ("record_every zero", "&output record_every=0 /\n", ["&output", "record_every", ">= 1"]),
+    ("half a material", "&beam youngs_modulus=2e11 /\n", ["&beam", "density"]),
+    ("unstable explicit", "&time dt=2e-5, beta=0 /\n", ["&time", "dt", "stability limit", "allow_unstable"]),
+    ("binary garbage", "&time dt=1e-5 /\n\x00\x01\x02\n", ["binary"]),
+]
+
+
+@pytest.mark.parametrize(("label", "text", "needles"), BAD, ids=[b[0] for b in BAD])
+def test_bad_input_gives_one_clear_message(label: str, text: str | None, needles: list[str],
+                                           tmp_path: Path) -> None:
+    scene = tmp_path / "nowhere.nml" if text is None else write(tmp_path, text)
+    done = beamstops("run", scene, cwd=tmp_path)
+    assert done.returncode == 1
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1, done.stderr
+    assert lines[0].startswith("beamstops: error: ") and scene.name in lines[0]
+    for needle in needles:
+        assert needle in lines[0], (needle, lines[0])
+    assert "Traceback" not in done.stderr and "Backtrace" not in done.stderr
+    assert not list(tmp_path.glob("*.h5"))
+
+
+def test_usage_errors_exit_2(tmp_path: Path) -> None:
+    assert beamstops(cwd=tmp_path).returncode == 2
+    assert beamstops("fly", "x.nml", cwd=tmp_path).returncode == 2
+    assert beamstops("run", cwd=tmp_path).returncode == 2
+    assert beamstops("--help", cwd=tmp_path).returncode == 0
+
+
+def test_unstable_run_is_marked_diverged_not_complete(tmp_path: Path) -> None:
+    scene = write(tmp_path, "&time dt=2e-5, beta=0, t_end=0.5, allow_unstable=.true. /\n"
+                            "&output file='bad.h5', record_every=100 /\n")
+    done = beamstops("run", scene, cwd=tmp_path)
+    assert done.returncode == 3
+    assert "diverged" in done.stderr
+    with h5py.File(tmp_path / "bad.h5") as f:
+        assert f.attrs["status"] == b"diverged"
+        assert f.attrs["steps"] < 25000
+        assert np.all(np.isfinite(f["tip/u"][:]))
+
+
+def test_unwritable_output_exits_4(tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT)
+    done = beamstops("run", scene, "-o", tmp_path / "no" / "such" / "dir.h5", cwd=tmp_path)
+    assert done.returncode == 4
+    assert "dir.h5" in done.stderr
