@@ -6,7 +6,7 @@
 !>   /energy/t, /energy/E, /energy/work, /energy/dissipated
 !>   /snapshots/t, /snapshots/x, /snapshots/u   (u: snapshots x (J+1))
 module beamstops_recorder_hdf5
-   use, intrinsic :: iso_c_binding, only: c_loc
+   use, intrinsic :: iso_c_binding, only: c_loc, c_ptr
    use hdf5
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
@@ -302,16 +302,9 @@ contains
       class(hdf5_recorder), intent(inout) :: self
       character(len=*), intent(in) :: name
       real(wp), intent(in) :: value
-      integer(hid_t) :: space, attr
-      integer(hsize_t) :: dims(1) = 1
-      integer :: hdferr
-      if (self%failed) return
-      call h5screate_f(H5S_SCALAR_F, space, hdferr)
-      call h5acreate_f(self%file, name, H5T_NATIVE_DOUBLE, space, attr, hdferr)
-      call h5awrite_f(attr, H5T_NATIVE_DOUBLE, value, dims, hdferr)
-      if (hdferr /= 0) call fail(self, 'cannot write attribute '//name)
-      call h5aclose_f(attr, hdferr)
-      call h5sclose_f(space, hdferr)
+      real(wp), target :: buffer
+      buffer = value
+      call attribute_scalar(self, name, H5T_NATIVE_DOUBLE, h5kind_to_type(wp, H5_REAL_KIND), c_loc(buffer))
    end subroutine attribute_real
 
    subroutine attribute_int(self, name, value)
@@ -319,17 +312,29 @@ contains
       character(len=*), intent(in) :: name
       integer(ik), intent(in) :: value
       integer(ik), target :: buffer
+      buffer = value
+      call attribute_scalar(self, name, H5T_STD_I64LE, h5kind_to_type(ik, H5_INTEGER_KIND), c_loc(buffer))
+   end subroutine attribute_int
+
+   !> Create or replace a scalar numeric root attribute of file type `file_type` from memory at `value`.
+   subroutine attribute_scalar(self, name, file_type, memory_type, value)
+      class(hdf5_recorder), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer(hid_t), intent(in) :: file_type, memory_type
+      type(c_ptr), intent(in) :: value
       integer(hid_t) :: space, attr
       integer :: hdferr
+      logical :: exists
       if (self%failed) return
-      buffer = value
+      call h5aexists_f(self%file, name, exists, hdferr)
+      if (exists) call h5adelete_f(self%file, name, hdferr)
       call h5screate_f(H5S_SCALAR_F, space, hdferr)
-      call h5acreate_f(self%file, name, H5T_STD_I64LE, space, attr, hdferr)
-      call h5awrite_f(attr, h5kind_to_type(ik, H5_INTEGER_KIND), c_loc(buffer), hdferr)
+      call h5acreate_f(self%file, name, file_type, space, attr, hdferr)
+      call h5awrite_f(attr, memory_type, value, hdferr)
       if (hdferr /= 0) call fail(self, 'cannot write attribute '//name)
       call h5aclose_f(attr, hdferr)
       call h5sclose_f(space, hdferr)
-   end subroutine attribute_int
+   end subroutine attribute_scalar
 
    subroutine fail(self, what)
       class(hdf5_recorder), intent(inout) :: self
