@@ -3,7 +3,8 @@
 module beamstops
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
-   use beamstops_scene, only: scene_type, validate_scene, steps_of, law_none, law_signorini, law_compliance, &
+   use beamstops_scene, only: scene_type, validate_scene, steps_of, record_count, snapshot_count, output_bytes, &
+      & law_none, law_signorini, law_compliance, &
       & law_name, law_code
    use beamstops_namelist, only: read_scene
    use beamstops_model, only: model_type, build_model, check_stability
@@ -12,7 +13,7 @@ module beamstops
    use beamstops_recorder_array, only: array_recorder
    use beamstops_recorder_hdf5, only: hdf5_recorder
    use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed
-   use beamstops_run, only: prepare_run, simulate, record_count, snapshot_count
+   use beamstops_run, only: prepare_run, simulate
    use beamstops_version, only: version
    implicit none
    private
@@ -22,5 +23,5 @@ module beamstops
    public :: state_type, start_state, run_scheme
    public :: recorder_type, n_columns, array_recorder, hdf5_recorder
    public :: run_summary, status_complete, status_diverged, status_failed
-   public :: prepare_run, simulate, record_count, snapshot_count, version
+   public :: prepare_run, simulate, record_count, snapshot_count, output_bytes, version
 end module beamstops

@@ -147,7 +147,6 @@ contains
    subroutine print_info(scene, model)
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
-      integer(ik) :: bytes
       character(len=*), parameter :: f = '(a,t24,es13.6,1x,a)', fi = '(a,t24,i0,1x,a)', fa = '(a,t24,a)'
       write (output_unit, fa) 'file', path
       write (output_unit, f) '&beam length', scene%length, 'm'
@@ -177,7 +176,6 @@ contains
       write (output_unit, fi) 'steps', steps_of(scene), ''
       write (output_unit, fi) 'records', record_count(scene), ''
       write (output_unit, fi) 'snapshots', snapshot_count(scene), ''
-      bytes = 8*(8*record_count(scene) + snapshot_count(scene)*(scene%elements + 2))
-      write (output_unit, f) 'output size', real(bytes, wp)/1.0e6_wp, 'MB'
+      write (output_unit, f) 'output size', output_bytes(scene)/1.0e6_wp, 'MB'
    end subroutine print_info
 end program beamstops_main

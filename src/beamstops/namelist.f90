@@ -16,7 +16,7 @@ module beamstops_namelist
    character(len=*), parameter :: group_keys(6) = [character(len=140) :: &
       & 'length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness', &
       & 'amplitude, omega', 'lower, upper, law, stiffness, stiffness_per_mass', 'elements', &
-      & 'dt, t_end, beta, load_rule, start, allow_unstable', 'file, record_every, snapshot_every']
+      & 'dt, t_end, beta, load_rule, start, allow_unstable', 'file, record_every, snapshot_every, max_output_gb']
    real(wp), parameter :: unset = -huge(1.0_wp)
    integer, parameter :: text_len = 4096
 
@@ -47,12 +47,13 @@ contains
       ! &output
       character(len=text_len) :: file
       integer :: record_every, snapshot_every
+      real(wp) :: max_output_gb
       namelist /beam/ length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness
       namelist /support/ amplitude, omega
       namelist /stops/ lower, upper, law, stiffness, stiffness_per_mass
       namelist /mesh/ elements
       namelist /time/ dt, t_end, beta, load_rule, start, allow_unstable
-      namelist /output/ file, record_every, snapshot_every
+      namelist /output/ file, record_every, snapshot_every, max_output_gb
       character(len=text_len) :: groups_text(size(group_names))
       logical :: present(size(group_names))
       character(len=512) :: msg
@@ -69,6 +70,7 @@ contains
       dt = scene%dt; t_end = scene%t_end; beta = scene%beta; load_rule = 'centered'; start = 'taylor'
       allow_unstable = .false.
       file = default_output(path); record_every = scene%record_every; snapshot_every = scene%snapshot_every
+      max_output_gb = scene%max_output_gb
 
       open (newunit=unit, file=path, status='old', action='read', iostat=stat, iomsg=msg)
       if (stat /= 0) then
@@ -153,6 +155,7 @@ contains
       scene%output_file = trim(file)
       scene%record_every = record_every
       scene%snapshot_every = snapshot_every
+      scene%max_output_gb = max_output_gb
       call validate_scene(scene, path, error)
    end subroutine read_scene
 

@@ -2,16 +2,15 @@
 !> Shared by the program (HDF5 recorder) and the Python wrapper (array recorder),
 !> so both give the same numbers by construction.
 module beamstops_run
-   use beamstops_kinds, only: ik
    use beamstops_error, only: error_type
-   use beamstops_scene, only: scene_type, steps_of
+   use beamstops_scene, only: scene_type
    use beamstops_model, only: model_type, build_model, check_stability
    use beamstops_scheme, only: state_type, start_state, run_scheme
    use beamstops_recorder, only: recorder_type
    use beamstops_summary, only: run_summary
    implicit none
    private
-   public :: prepare_run, simulate, record_count, snapshot_count
+   public :: prepare_run, simulate
 
 contains
 
@@ -47,21 +46,4 @@ contains
       if (allocated(error)) return
       call run_scheme(scene, model, state, recorder, summary)
    end subroutine simulate
-
-   !> Records a complete run writes (t = 0 included).
-   pure function record_count(scene) result(n)
-      !> Scene.
-      type(scene_type), intent(in) :: scene
-      integer(ik) :: n
-      n = steps_of(scene)/scene%record_every + 1
-   end function record_count
-
-   !> Snapshots a complete run writes (t = 0 included; 0 when snapshot_every = 0).
-   pure function snapshot_count(scene) result(n)
-      !> Scene.
-      type(scene_type), intent(in) :: scene
-      integer(ik) :: n
-      n = 0
-      if (scene%snapshot_every > 0) n = steps_of(scene)/scene%snapshot_every + 1
-   end function snapshot_count
 end module beamstops_run

@@ -6,14 +6,15 @@ module beamstops_scene
    use beamstops_error, only: error_type, fatal_error
    implicit none
    private
-   public :: scene_type, validate_scene, steps_of, tube_section, fmt_real, fmt_int
+   public :: scene_type, validate_scene, steps_of, record_count, snapshot_count, output_bytes
+   public :: tube_section, fmt_real, fmt_int
    public :: law_none, law_signorini, law_compliance, law_name, law_code
    public :: max_elements
 
    !> Contact law codes.
    integer, parameter :: law_none = 0, law_signorini = 1, law_compliance = 2
    !> Largest mesh accepted (memory stays below a few GB).
-   integer, parameter :: max_elements = 10000000
+   integer, parameter :: max_elements = 1000000
 
    !> Every input of a run. Defaults reproduce the paper's scene (Figure 2).
    type :: scene_type
@@ -51,6 +52,8 @@ module beamstops_scene
       logical :: allow_unstable = .false.
       !> &output: HDF5 file written by the program (not used by the in-memory path).
       character(len=:), allocatable :: output_file
+      !> &output: refuse a run whose output would exceed this many gigabytes (1e9 bytes).
+      real(wp) :: max_output_gb = 4.0_wp
       !> &output: record the tip and the energy every this many steps.
       integer :: record_every = 1
       !> &output: record the beam's shape every this many steps (0: never).
@@ -66,6 +69,31 @@ contains
       integer(ik) :: n
       n = max(1_ik, nint(scene%t_end/scene%dt, ik))
    end function steps_of
+
+   !> Records a complete run writes (t = 0 included).
+   pure function record_count(scene) result(n)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      integer(ik) :: n
+      n = steps_of(scene)/scene%record_every + 1
+   end function record_count
+
+   !> Snapshots a complete run writes (t = 0 included; 0 when snapshot_every = 0).
+   pure function snapshot_count(scene) result(n)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      integer(ik) :: n
+      n = 0
+      if (scene%snapshot_every > 0) n = steps_of(scene)/scene%snapshot_every + 1
+   end function snapshot_count
+
+   !> Bytes of recorded data of a complete run: 8 series of records and the snapshots.
+   pure function output_bytes(scene) result(bytes)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      real(wp) :: bytes
+      bytes = 64*real(record_count(scene), wp) + 8*real(snapshot_count(scene), wp)*(scene%elements + 2)
+   end function output_bytes
 
    !> Cross-section area and second moment of a tube.
    pure subroutine tube_section(outer_diameter, wall_thickness, area, inertia)
@@ -217,8 +245,33 @@ contains
          call say('output', 'snapshot_every', fmt_int(int(scene%snapshot_every, ik)), 'snapshot_every >= 0 (0: none)')
          return
       end if
+      call within('output', 'max_output_gb', scene%max_output_gb, 0.0_wp, 1.0e6_wp); if (allocated(error)) return
+      call output_fits(); if (allocated(error)) return
 
    contains
+
+      !> Refuse an output larger than max_output_gb, saying which record_every (or snapshot_every) fits.
+      subroutine output_fits()
+         real(wp) :: limit, snaps, per_record
+         real(wp) :: fits
+         limit = scene%max_output_gb*1.0e9_wp
+         if (output_bytes(scene) <= limit) return
+         snaps = 8*real(snapshot_count(scene), wp)*(scene%elements + 2)
+         per_record = 64*real(steps_of(scene), wp)
+         if (snaps < limit - 64) then
+            fits = per_record/(limit - snaps - 64)
+            call fatal_error(error, source//': &output record_every = '//fmt_int(int(scene%record_every, ik))// &
+               & ' gives '//fmt_real(output_bytes(scene)/1.0e9_wp, 3)//' GB of output, more than max_output_gb = '// &
+               & fmt_real(scene%max_output_gb)//'; allowed: record_every >= '//fmt_int(ceiling(fits, ik))// &
+               & ' (or raise max_output_gb)')
+         else
+            fits = 8*real(steps_of(scene), wp)*(scene%elements + 2)/(limit/2)
+            call fatal_error(error, source//': &output snapshot_every = '//fmt_int(int(scene%snapshot_every, ik))// &
+               & ' gives '//fmt_real(output_bytes(scene)/1.0e9_wp, 3)//' GB of output, more than max_output_gb = '// &
+               & fmt_real(scene%max_output_gb)//'; allowed: snapshot_every >= '//fmt_int(ceiling(fits, ik))// &
+               & ' (or raise max_output_gb)')
+         end if
+      end subroutine output_fits
 
       subroutine say(group, key, value, allowed)
          character(len=*), intent(in) :: group, key, value, allowed

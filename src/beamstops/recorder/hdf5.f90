@@ -44,6 +44,9 @@ module beamstops_recorder_hdf5
       integer :: fill = 0
       integer :: nodes = 0
       real(wp), allocatable :: buffer(:, :)
+      !> Buffered snapshots: times and shapes (nodes, snapshot_rows).
+      real(wp), allocatable :: snap_t_buffer(:), snap_u_buffer(:, :)
+      integer :: snap_fill = 0, snapshot_rows = 0
       !> Print a progress line on stderr.
       logical :: show_progress = .false.
    contains
@@ -91,6 +94,8 @@ contains
       if (scene%snapshot_every > 0) then
          call create_series(self, '/snapshots/t', 's', 1, self%snap_t)
          call create_series(self, '/snapshots/u', 'm', self%nodes, self%snap_u)
+         self%snapshot_rows = max(1, min(buffer_rows, 2**20/self%nodes))
+         allocate (self%snap_t_buffer(self%snapshot_rows), self%snap_u_buffer(self%nodes, self%snapshot_rows))
       end if
       call write_vector(self, '/snapshots/x', model%x)
       call attribute_text(self, 'status', status_running)
@@ -133,14 +138,15 @@ contains
       if (self%fill == buffer_rows) call write_buffer(self)
    end subroutine record
 
-   !> Write one snapshot row.
+   !> Buffer one snapshot; write the buffer when full.
    subroutine snapshot(self, t, u)
       class(hdf5_recorder), intent(inout) :: self
       real(wp), intent(in) :: t
       real(wp), intent(in) :: u(:)
-      call append(self, self%snap_t, 1, self%snaps_written, 1, [t])
-      call append(self, self%snap_u, self%nodes, self%snaps_written, 1, u)
-      self%snaps_written = self%snaps_written + 1
+      self%snap_fill = self%snap_fill + 1
+      self%snap_t_buffer(self%snap_fill) = t
+      self%snap_u_buffer(:, self%snap_fill) = u
+      if (self%snap_fill == self%snapshot_rows) call write_buffer(self)
    end subroutine snapshot
 
    !> A progress line on stderr (only when asked, i.e. attached to a terminal).
@@ -166,7 +172,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: hdferr
       if (self%file < 0) return
-      if (self%fill > 0) call write_buffer(self)
+      call write_buffer(self)
       call attribute_int(self, 'steps', summary%steps)
       call attribute_real(self, 't_final', summary%t_final)
       call attribute_real(self, 'cpu_seconds', summary%cpu_seconds)
@@ -183,6 +189,7 @@ contains
       end if
    end subroutine finish
 
+   !> Write the buffered records and snapshots.
    subroutine write_buffer(self)
       class(hdf5_recorder), intent(inout) :: self
       integer :: i
@@ -191,6 +198,12 @@ contains
       end do
       self%written = self%written + self%fill
       self%fill = 0
+      if (self%snap_fill > 0) then
+         call append(self, self%snap_t, 1, self%snaps_written, self%snap_fill, self%snap_t_buffer)
+         call append(self, self%snap_u, self%nodes, self%snaps_written, self%snap_fill, self%snap_u_buffer)
+         self%snaps_written = self%snaps_written + self%snap_fill
+         self%snap_fill = 0
+      end if
    end subroutine write_buffer
 
    !> Append `rows` rows of `width` values (stored row after row in `values`) at row `offset`.
@@ -203,7 +216,7 @@ contains
       integer(hid_t) :: filespace, memspace
       integer(hsize_t) :: dims(2), start(2), count(2)
       integer :: hdferr, rank
-      if (self%failed) return
+      if (self%failed .or. rows == 0) return
       rank = merge(1, 2, width == 1)
       if (rank == 1) then
          dims(1) = offset + rows; start(1) = offset; count(1) = rows
