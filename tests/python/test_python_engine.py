@@ -1,0 +1,171 @@
+"""beamstops.run, beamstops.load and beamstops.stability: the engine from Python."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+import beamstops
+from beamstops import IncompleteRunError, Scene
+from beamstops.result import ARRAYS
+
+SHORT = Scene(t_end=0.3, dt=5e-5)
+
+SCENES = {
+    "signorini": SHORT.replace(snapshot_every=7, record_every=3),
+    "compliance": SHORT.replace(law="compliance", stiffness_per_mass=1e8, beta=0.25, dt=5e-6, t_end=0.15,
+                                load_rule="paper", start="euler", snapshot_every=500),
+    "none": SHORT.replace(law="none", beta=0.1, dt=5e-6, t_end=0.1, record_every=7),
+    "material": SHORT.replace(youngs_modulus=2e11, density=8e3, outer_diameter=0.01, wall_thickness=5e-4,
+                              elements=8, snapshot_every=1),
+}
+
+
+def same_bits(a: np.ndarray, b: np.ndarray) -> bool:
+    return a.dtype == b.dtype == np.float64 and a.shape == b.shape and np.array_equal(
+        np.ascontiguousarray(a).view(np.uint64), np.ascontiguousarray(b).view(np.uint64))
+
+
+@pytest.mark.parametrize("name", sorted(SCENES))
+def test_run_and_load_agree_bit_for_bit(name: str, program: str, tmp_path: Path) -> None:
+    scene = SCENES[name].replace(file="out.h5")
+    scene.to_namelist(tmp_path / "scene.nml")
+    done = subprocess.run([program, "run", "scene.nml"], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    loaded = beamstops.load(tmp_path / "out.h5")
+    ran = beamstops.run(Scene.from_namelist(tmp_path / "scene.nml"))
+    for array in ARRAYS:
+        assert same_bits(getattr(loaded, array), getattr(ran, array)), array
+    assert ran.t.size == beamstops.engine.sizes(scene)[0] and ran.t.size > 1
+    assert ran.snapshot_u.shape == (ran.snapshot_t.size, scene.elements + 1)
+    with h5py.File(tmp_path / "out.h5") as f:  # the same arrays as the raw file, names included
+        assert same_bits(f["energy/t"][()], ran.t) and same_bits(f["energy/E"][()], ran.energy)
+    cpu = [r.attrs.pop("cpu_seconds") for r in (loaded, ran)]
+    assert all(c >= 0 for c in cpu)
+    assert loaded.attrs == ran.attrs
+    assert ran.attrs["status"] == "complete" and ran.attrs["version"] == beamstops.version()
+
+
+def test_result_arrays_hold_what_the_scheme_promises() -> None:
+    result = beamstops.run(SCENES["signorini"])
+    assert result.t[0] == 0 and result.t[-1] == pytest.approx(0.3)
+    assert result.tip_u.max() <= 0.1 and result.tip_u.min() >= -0.1
+    assert result.attrs["max_violation"] == 0 and result.attrs["impacts"] > 0
+    # the physical displacement at the clamp follows the support
+    np.testing.assert_allclose(result.snapshot_u[:, 0], 0.2 * np.sin(10 * result.snapshot_t), rtol=0, atol=1e-15)
+    assert result.scene() == SCENES["signorini"]
+
+
+def test_stability_gives_the_papers_numbers() -> None:
+    limits = beamstops.stability(Scene(beta=0.25, dt=1e-6))
+    # SPEC §2 and §6, J = 19
+    assert limits.kappa_h == pytest.approx(2.6035e10, rel=1e-4)
+    assert limits.kappa_bound == pytest.approx(7.1416e11, rel=1e-4)
+    assert limits.dt_limit_paper_bound == pytest.approx(3.3469e-6, rel=1e-4)
+    assert limits.dt_limit_paper == pytest.approx(1.7529e-5, rel=1e-4)
+    assert limits.dt_limit_newmark == np.inf and limits.runnable
+    explicit = beamstops.stability(Scene(beta=0.0, dt=2e-5))
+    assert explicit.dt_limit_newmark == pytest.approx(1.2395e-5, rel=1e-4)
+    assert not explicit.runnable and "allow_unstable" in explicit.refusal
+    # the attributes of a run carry the same numbers
+    run = beamstops.run(Scene(beta=0.25, dt=1e-6, t_end=1e-4))
+    assert run.attrs["kappa_h"] == limits.kappa_h and run.attrs["dt_limit_paper_bound"] == limits.dt_limit_paper_bound
+
+
+BAD = [
+    ("negative dt", dict(dt=-1e-5), "scene: &time dt = -1e-05 is out of range"),
+    ("nan dt", dict(dt=float("nan")), "scene: &time dt = NaN"),
+    ("dt beyond t_end", dict(dt=3.0), "scene: &time dt = 3"),
+    ("beta", dict(beta=0.7), "scene: &time beta = 0.7"),
+    ("lower stop", dict(lower=0.05), "scene: &stops lower"),
+    ("upper stop", dict(upper=-0.05), "scene: &stops upper"),
+    ("no elements", dict(elements=0), "scene: &mesh elements = 0"),
+    ("huge elements", dict(elements=2**40), "scene: &mesh elements = 1099511627776"),
+    ("huger elements", dict(elements=2**80), "scene: &mesh elements"),
+    ("compliance without stiffness", dict(law="compliance"), "scene: &stops stiffness_per_mass = 0"),
+    ("record_every", dict(record_every=0), "scene: &output record_every = 0"),
+    ("snapshot_every", dict(snapshot_every=-1), "scene: &output snapshot_every = -1"),
+    ("output too large", dict(dt=1e-9, t_end=100.0), "max_output_gb"),
+    ("infinite length", dict(length=float("inf")), "scene: &beam length = Inf"),
+    ("unstable explicit", dict(beta=0.0, dt=2e-5), "stability limit"),
+]
+
+
+@pytest.mark.parametrize(("label", "changes", "needle"), BAD, ids=[b[0] for b in BAD])
+def test_bad_scenes_raise_value_error_with_the_engines_message(label: str, changes: dict, needle: str) -> None:
+    scene = SHORT.replace(**changes)
+    with pytest.raises(ValueError) as caught:
+        beamstops.run(scene)
+    assert needle in str(caught.value)
+    assert "allowed" in str(caught.value)
+
+
+def test_bad_scenes_never_crash_the_interpreter() -> None:
+    # In a child process, so that a crash would show as a failed test, not a dead test run.
+    code = "\n".join([
+        "import beamstops, math",
+        "from beamstops import Scene",
+        "bad = [dict(dt=-1.0), dict(dt=math.nan), dict(dt=math.inf), dict(elements=0), dict(elements=-5),",
+        "       dict(elements=2**31), dict(elements=2**63 - 1), dict(record_every=-(2**62)), dict(beta=-0.1),",
+        "       dict(k2=0.0), dict(mass_per_length=-1.0), dict(t_end=1e300), dict(omega=math.nan),",
+        "       dict(lower=-math.inf), dict(law='compliance', stiffness_per_mass=math.inf), dict(max_output_gb=-1.0)]",
+        "n = 0",
+        "for changes in bad:",
+        "    for call in (beamstops.run, beamstops.stability, lambda s: s.validate()):",
+        "        try:",
+        "            call(Scene(t_end=0.01).replace(**changes))",
+        "        except ValueError:",
+        "            n += 1",
+        "print(n)",
+    ])
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert int(done.stdout) == 16 * 3
+
+
+def test_a_diverged_run_is_an_incomplete_run_error_holding_the_partial_result() -> None:
+    scene = Scene(beta=0.0, dt=2e-5, t_end=0.5, allow_unstable=True, record_every=100)
+    with pytest.raises(IncompleteRunError) as caught:
+        beamstops.run(scene)
+    assert "diverged" in str(caught.value)
+    partial = caught.value.result
+    assert partial.status == "diverged" and partial.attrs["steps"] < 25000
+    assert partial.t.size == partial.attrs["steps"] // 100 + 1 and np.all(np.isfinite(partial.tip_u))
+    allowed = beamstops.run(scene, allow_incomplete=True)
+    assert allowed.status == "diverged" and "blew up" in allowed.attrs["message"]
+
+
+def test_load_refuses_an_incomplete_file_unless_asked(program: str, tmp_path: Path) -> None:
+    scene = Scene(beta=0.0, dt=2e-5, t_end=0.5, allow_unstable=True, record_every=100, file="bad.h5")
+    scene.to_namelist(tmp_path / "bad.nml")
+    done = subprocess.run([program, "run", "bad.nml"], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 3
+    with pytest.raises(IncompleteRunError, match="diverged"):
+        beamstops.load(tmp_path / "bad.h5")
+    loaded = beamstops.load(tmp_path / "bad.h5", allow_incomplete=True)
+    ran = beamstops.run(scene, allow_incomplete=True)
+    assert loaded.status == ran.status == "diverged"
+    assert all(same_bits(getattr(loaded, a), getattr(ran, a)) for a in ARRAYS)
+    with pytest.raises(FileNotFoundError):
+        beamstops.load(tmp_path / "nowhere.h5")
+    (tmp_path / "text.h5").write_text("not HDF5")
+    with pytest.raises(OSError, match="text.h5"):
+        beamstops.load(tmp_path / "text.h5")
+
+
+def test_runs_in_threads_release_the_interpreter_and_agree() -> None:
+    scene = SCENES["compliance"]
+    results: list[beamstops.Result] = []
+    threads = [threading.Thread(target=lambda: results.append(beamstops.run(scene))) for _ in range(3)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert len(results) == 3
+    assert all(same_bits(r.tip_u, results[0].tip_u) for r in results)

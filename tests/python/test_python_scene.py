@@ -1,0 +1,183 @@
+"""beamstops.Scene: namelist <-> Scene round trips, agreement with the program's own reader."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import pytest
+
+import beamstops
+from beamstops import Scene, engine
+
+from conftest import INPUT, ROOT
+
+
+def test_the_package_is_the_installed_one() -> None:
+    here = Path(beamstops.__file__).resolve()
+    assert ROOT / "wrap" not in here.parents, f"tests import the source tree's package: {here}"
+    assert beamstops._engine.__file__  # the compiled extension is there
+
+
+def write(tmp_path: Path, text: str, name: str = "scene.nml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_empty_namelist_gives_the_paper_scene_as_the_engine_does(tmp_path: Path) -> None:
+    path = write(tmp_path, "! nothing but a comment\n")
+    scene = Scene.from_namelist(path)
+    assert scene == Scene(file="scene.h5")
+    assert scene == engine.read_namelist(path)
+
+
+SCENES = [
+    Scene(),
+    Scene(file="out.h5", t_end=0.3, dt=1 / 30000, beta=0.25, snapshot_every=7, record_every=3),
+    Scene(law="compliance", stiffness_per_mass=1e8, beta=0.25, dt=5e-6, load_rule="paper", start="euler",
+          file="c.h5"),
+    Scene(law="none", length=0.1 + 0.2, k2=1 / 3, mass_per_length=2.0 ** -30, amplitude=-1e-300, omega=0.0,
+          lower=-1e-9, upper=123456.789, elements=1, allow_unstable=True, file="n.h5", max_output_gb=0.5),
+]
+
+
+@pytest.mark.parametrize("scene", SCENES, ids=range(len(SCENES)))
+def test_scene_namelist_scene_round_trip_is_exact(scene: Scene, tmp_path: Path) -> None:
+    path = tmp_path / "scene.nml"
+    scene.to_namelist(path)
+    back = Scene.from_namelist(path)
+    expected = scene if scene.file is not None else scene.replace(file="scene.h5")
+    assert back == expected, back.differences(expected)
+    # and the program reads the very same values
+    assert engine.read_namelist(path) == expected
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in INPUT.glob("*.nml")))
+def test_shipped_inputs_read_as_the_program_reads_them(name: str, tmp_path: Path) -> None:
+    scene = Scene.from_namelist(INPUT / name)
+    assert scene.differences(engine.read_namelist(INPUT / name)) == ""
+    # namelist -> Scene -> namelist -> Scene
+    scene.to_namelist(tmp_path / name)
+    assert Scene.from_namelist(tmp_path / name) == scene
+
+
+# Namelist texts the program accepts, written in every way its reader allows.
+ACCEPTED = [
+    "&time dt=1e-5 /",
+    "&TIME DT=1E-5, T_END=1 /",
+    "&time dt= /",
+    "&time dt=1d-5 /",
+    "&time dt=.5e-4, beta=.25 /",
+    "&time t_end=1 dt=1e-5 /",
+    "&time dt = 1e-5 ! a comment / not the end\n beta=0.3 /",
+    "&time dt=1e-5,, /",
+    "&time dt=1e-5; beta=0.3 /",
+    "&time dt=1e-5 /\n&end\n&beam length=2 /",
+    "&time\n dt=1e-5\n&end\n&beam length=2 /",
+    "&time\n dt=1e-5\n $END ! old style\n&beam length=2 /",
+    "$time dt=1e-5 $end",
+    "&time dt=1 &end",
+    "&mesh elements=+19 /",
+    "&time allow_unstable=T, beta=0.1, dt=1e-5 /",
+    "&time allow_unstable=.t. /",
+    "&stops law=' signorini' /",
+    "&stops law='signorini ', lower=-0.05 /",
+    "&stops law='signorini' law='none' /",
+    '&time load_rule="paper", start="euler" /',
+    "&stops law='compliance', stiffness=1e7 /",
+    "&stops law='compliance', stiffness_per_mass=1e8 /",
+    "&stops law='signorini', stiffness=1e7 /",
+    "&beam youngs_modulus=2e11, density=8e3, outer_diameter=0.01, wall_thickness=5e-4 /\n"
+    "&stops law='compliance', stiffness=1e8 /",
+    "&beam length=2, k2=300 /",
+    "&output file='x y.h5', record_every=10, snapshot_every=100, max_output_gb=0.1 /",
+    "&beam length=2 /\n&support amplitude=0.1 omega=20 /\n&mesh elements=7 /\n",
+]
+
+
+@pytest.mark.parametrize("text", ACCEPTED)
+def test_from_namelist_accepts_what_the_program_accepts_with_the_same_values(text: str, tmp_path: Path) -> None:
+    path = write(tmp_path, text + "\n")
+    reference = engine.read_namelist(path)
+    scene = Scene.from_namelist(path)
+    assert scene.differences(reference) == ""
+
+
+# Texts the program refuses: the Python reader refuses them with the program's own message.
+REFUSED = [
+    ("&beams length=1 /", ["&beams", "unknown group"]),
+    ("&time dtt=1e-5 /", ["&time", "dtt"]),
+    ("&time dt=abc /", ["&time", "abc"]),
+    ("&time dt=1.0_8 /", ["&time", "_8"]),
+    ("&time dt=1e-5, 2e-5 /", ["&time", "2e-5"]),
+    ("&time dt=1e-5 /\n&time dt=2e-5 /", ["&time", "twice"]),
+    ("&mesh elements=19.0 /", ["&mesh"]),
+    ("&mesh elements=2147483648 /", ["&mesh", "overflow"]),
+    ("&time dt=-1e-5 /", ["&time dt = -1e-05", "allowed"]),
+    ("&time dt=nan /", ["&time dt", "allowed"]),
+    ("&time beta=0.7 /", ["&time beta", "0.5"]),
+    ("&stops lower=0.05 /", ["&stops lower", "allowed"]),
+    ("&stops law='glue' /", ["&stops law", "signorini"]),
+    ("&stops law='compliance' /", ["&stops", "stiffness"]),
+    ("&stops law='compliance', stiffness=-1 /", ["&stops stiffness", "> 0"]),
+    ("&time load_rule=' paper' /", ["&time load_rule"]),
+    ("&beam youngs_modulus=2e11 /", ["&beam", "density"]),
+    ("&beam k2=1, youngs_modulus=2e11, density=8e3, outer_diameter=0.01, wall_thickness=5e-4 /", ["&beam", "k2"]),
+    ("&beam youngs_modulus=2e11, density=8e3, outer_diameter=0.01, wall_thickness=0.006 /",
+     ["&beam wall_thickness"]),
+    ("&output file='' /", ["&output file"]),
+    ("&output record_every=0 /", ["&output record_every", ">= 1"]),
+    ("&time dt=1e-9 /", ["max_output_gb"]),
+    ("&time dt=1e-5 /\n\x00\x01\n", ["binary"]),
+]
+
+
+@pytest.mark.parametrize(("text", "needles"), REFUSED, ids=[r[0][:40] for r in REFUSED])
+def test_from_namelist_refuses_what_the_program_refuses(text: str, needles: list[str], tmp_path: Path) -> None:
+    path = write(tmp_path, text + "\n")
+    with pytest.raises(ValueError) as program:
+        engine.read_namelist(path)
+    with pytest.raises(ValueError) as python:
+        Scene.from_namelist(path)
+    assert str(python.value) == str(program.value)
+    assert str(path) in str(python.value)
+    for needle in needles:
+        assert needle in str(python.value), (needle, str(python.value))
+
+
+def test_missing_file_is_an_os_error(tmp_path: Path) -> None:
+    with pytest.raises(FileNotFoundError):
+        Scene.from_namelist(tmp_path / "nowhere.nml")
+
+
+def test_material_and_stiffness_routes_match_the_programs(tmp_path: Path) -> None:
+    material = dict(youngs_modulus=2e11, density=8e3, outer_diameter=0.01, wall_thickness=5e-4)
+    path = write(tmp_path, "&beam " + ", ".join(f"{k}={v!r}" for k, v in material.items()) + " /\n"
+                 "&stops law='compliance', stiffness=1e8 /\n")
+    scene = Scene().replace(law="compliance", stiffness=1e8, file="scene.h5", **material)
+    assert scene == Scene.from_namelist(path) == engine.read_namelist(path)
+    # SPEC §2: rho S = 0.11938 kg/m, k2 = 282.84 m^4/s^2 for the paper's pipe
+    assert scene.mass_per_length == pytest.approx(0.11938, rel=1e-4)
+    assert scene.k2 == pytest.approx(282.84, rel=2e-4)
+    assert scene.stiffness_per_mass == 1e8 / scene.mass_per_length
+
+
+def test_replace_and_keyword_checks() -> None:
+    scene = Scene().replace(dt=1e-6, beta=0.25)
+    assert (scene.dt, scene.beta, Scene().dt) == (1e-6, 0.25, 5e-5)
+    with pytest.raises(TypeError, match="unknown scene key"):
+        Scene().replace(timestep=1e-6)
+    with pytest.raises(TypeError, match="elements"):
+        Scene(elements=19.5)
+    with pytest.raises(TypeError, match="dt"):
+        Scene(dt="1e-5")
+    with pytest.raises(TypeError, match="allow_unstable"):
+        Scene(allow_unstable=1)
+    with pytest.raises(ValueError, match="&stops law = 'glue'"):
+        Scene(law="glue")
+    with pytest.raises(ValueError, match="&beam density is missing"):
+        Scene().replace(youngs_modulus=2e11)
+    with pytest.raises(ValueError, match="exactly one"):
+        Scene().replace(stiffness=1e8, stiffness_per_mass=1e8)
+    assert dataclasses.is_dataclass(scene) and hash(scene) == hash(Scene().replace(dt=1e-6, beta=0.25))

@@ -1,0 +1,21 @@
+"""beamstops: an elastic cantilever beam on a vibrating support between rigid stops.
+
+The Fortran engine (the Dumont–Paoli scheme) from Python::
+
+    import beamstops
+    scene = beamstops.Scene.from_namelist("input/paper_fig2.nml").replace(t_end=0.5)
+    result = beamstops.run(scene)            # in memory, through the extension
+    same = beamstops.load("paper_fig2.h5")   # the program's HDF5 output
+    limits = beamstops.stability(scene)      # kappa_h, the paper's kappa bound, dt limits
+
+Plots live in :mod:`beamstops.plots`; ``python -m beamstops plot OUT.h5`` draws them.
+"""
+
+from .engine import Stability, run, stability, version
+from .result import IncompleteRunError, Result, load
+from .scene import Scene
+
+__version__ = version()
+
+__all__ = ["Scene", "Result", "Stability", "IncompleteRunError", "run", "load", "stability", "version",
+           "__version__"]

@@ -1,0 +1,66 @@
+"""``python -m beamstops``: subcommands over the package.
+
+Each subcommand is a function ``register(subparsers)`` that adds its parser and sets
+``handler`` (a function of the parsed arguments returning an exit status). To add one,
+write such a function (here or in a module of its own) and list it in :data:`COMMANDS`.
+Errors a user can fix end in one line ``beamstops: error: ...`` and exit status 1.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Callable, Optional, Sequence
+
+
+def _plot(args: argparse.Namespace) -> int:
+    from . import plots
+    from .result import load
+
+    result = load(args.file, allow_incomplete=args.allow_incomplete)
+    out = args.output or Path(args.file).with_name(f"{Path(args.file).stem}_{args.kind}.png")
+    plots.save(result, out, kind=args.kind, dpi=args.dpi)
+    print(out)
+    return 0
+
+
+def register_plot(subparsers: argparse._SubParsersAction) -> None:
+    """``plot OUT.h5 [-o PNG] [--kind KIND]``: draw a run written by ``beamstops run``."""
+    from .plots import KINDS
+
+    parser = subparsers.add_parser("plot", help="plot the HDF5 output of `beamstops run`",
+                                   description="Plot the HDF5 output of `beamstops run` (no display needed).")
+    parser.add_argument("file", type=Path, help="HDF5 file written by `beamstops run`")
+    parser.add_argument("-o", "--output", type=Path, help="image to write (default: FILE_KIND.png next to FILE)")
+    parser.add_argument("--kind", choices=KINDS, default="tip",
+                        help="tip displacement, space-time shape, energy, phase portrait, reaction, or all (default: tip)")
+    parser.add_argument("--dpi", type=int, default=120, help="resolution of raster images (default: 120)")
+    parser.add_argument("--allow-incomplete", action="store_true",
+                        help="plot a run that diverged or was interrupted")
+    parser.set_defaults(handler=_plot)
+
+
+#: Subcommand registrars, in the order `--help` lists them.
+COMMANDS: list[Callable[[argparse._SubParsersAction], None]] = [register_plot]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from . import version
+
+    parser = argparse.ArgumentParser(prog="python -m beamstops",
+                                     description="beamstops: a beam on a vibrating support between rigid stops.")
+    parser.add_argument("-V", "--version", action="version", version=f"beamstops {version()}")
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for register in COMMANDS:
+        register(subparsers)
+    return parser
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.handler(args))
+    except (OSError, ValueError) as exc:
+        print(f"beamstops: error: {exc}", file=sys.stderr)
+        return 1

@@ -1,0 +1,149 @@
+"""The result of a run: the arrays of the program's HDF5 layout and the run's attributes.
+
+=================  =====================  =========================================
+Result             HDF5 (program output)  meaning
+=================  =====================  =========================================
+t                  /tip/t (= /energy/t)   record times (s)
+tip_u              /tip/u                 tip displacement u(L, t) (m)
+tip_v              /tip/v                 tip velocity (m/s)
+reaction           /tip/reaction          contact reaction (N)
+energy             /energy/E              discrete energy E^{n+1/2} (J)
+work               /energy/work           work of the load (J)
+dissipated         /energy/dissipated     energy taken by the stops (J)
+snapshot_t         /snapshots/t           snapshot times (s)
+snapshot_x         /snapshots/x           node abscissae x_0..x_J (m)
+snapshot_u         /snapshots/u           physical displacement ũ(x, t), (snapshots, J+1) (m)
+attrs              root attributes        scene, κ_h, limits, status, steps, cpu_seconds, …
+=================  =====================  =========================================
+
+:func:`load` reads a file written by ``beamstops run``; :func:`beamstops.run` gives the
+same object from memory.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from typing import Any, Optional
+
+import numpy as np
+
+__all__ = ["Result", "IncompleteRunError", "load", "ARRAYS"]
+
+#: Result arrays and the HDF5 datasets they come from.
+ARRAYS: dict[str, str] = {
+    "t": "tip/t",
+    "tip_u": "tip/u",
+    "tip_v": "tip/v",
+    "reaction": "tip/reaction",
+    "energy": "energy/E",
+    "work": "energy/work",
+    "dissipated": "energy/dissipated",
+    "snapshot_t": "snapshots/t",
+    "snapshot_x": "snapshots/x",
+    "snapshot_u": "snapshots/u",
+}
+
+
+class IncompleteRunError(ValueError):
+    """A run that did not complete (diverged, failed or interrupted); ``result`` holds what was recorded."""
+
+    def __init__(self, message: str, result: Optional[Result] = None) -> None:
+        super().__init__(message)
+        self.result = result
+
+
+@dataclass(eq=False)
+class Result:
+    """Arrays and attributes of one run (see the module's table)."""
+
+    t: np.ndarray
+    tip_u: np.ndarray
+    tip_v: np.ndarray
+    reaction: np.ndarray
+    energy: np.ndarray
+    work: np.ndarray
+    dissipated: np.ndarray
+    snapshot_t: np.ndarray
+    snapshot_x: np.ndarray
+    snapshot_u: np.ndarray
+    attrs: dict[str, Any] = field(default_factory=dict)
+    source: str = "memory"
+    """'memory' for :func:`beamstops.run`, the file name for :func:`load`."""
+
+    @property
+    def status(self) -> str:
+        """'complete', 'diverged', 'failed' or 'running' (an interrupted program)."""
+        return str(self.attrs.get("status", "unknown"))
+
+    @property
+    def snapshots(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(snapshot_t, snapshot_x, snapshot_u)."""
+        return self.snapshot_t, self.snapshot_x, self.snapshot_u
+
+    def scene(self) -> Any:
+        """The :class:`beamstops.Scene` of the run, from its attributes."""
+        from .scene import Scene
+
+        keys = {f: self.attrs[f] for f in ("length", "k2", "mass_per_length", "amplitude", "omega", "lower", "upper",
+                                           "law", "elements", "dt", "t_end", "beta", "load_rule", "start",
+                                           "record_every", "snapshot_every") if f in self.attrs}
+        if "stiffness_per_mass" in self.attrs:
+            keys["stiffness_per_mass"] = self.attrs["stiffness_per_mass"]
+        return Scene(**keys)
+
+    def __repr__(self) -> str:
+        a = self.attrs
+        return (f"Result({self.source!r}, status={self.status!r}, law={a.get('law')!r}, dt={a.get('dt')!r}, "
+                f"records={self.t.size}, snapshots={self.snapshot_t.size}, steps={a.get('steps')!r}, "
+                f"cpu_seconds={a.get('cpu_seconds')!r})")
+
+
+def _attribute(value: Any) -> Any:
+    """An HDF5 attribute as a plain Python value."""
+    if isinstance(value, (bytes, np.bytes_)):
+        return bytes(value).decode("utf-8", errors="replace").rstrip(" \x00")
+    if isinstance(value, np.ndarray) and value.shape == ():
+        value = value[()]
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating):
+        return float(value)
+    return value
+
+
+def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result:
+    """Read the HDF5 output of ``beamstops run``.
+
+    A file whose ``status`` is not 'complete' (a run that diverged, failed or is still
+    being written) raises :class:`IncompleteRunError` (a ValueError, holding what the
+    file has) unless ``allow_incomplete``.
+    """
+    import h5py
+
+    path = os.fspath(path)
+    if not os.path.isfile(path):
+        raise FileNotFoundError(f"{path}: no such file")
+    try:
+        file = h5py.File(path, "r")
+    except OSError as exc:
+        raise OSError(f"{path}: cannot read as HDF5 ({exc})") from None
+    with file as f:
+        attrs = {name: _attribute(value) for name, value in f.attrs.items()}
+        if "status" not in attrs:
+            raise ValueError(f"{path}: not a beamstops output (no status attribute)")
+        arrays: dict[str, np.ndarray] = {}
+        for name, dataset in ARRAYS.items():
+            if dataset in f:
+                arrays[name] = np.asarray(f[dataset][()], dtype=np.float64)
+    nodes = arrays["snapshot_x"].size if "snapshot_x" in arrays else 0
+    arrays.setdefault("snapshot_t", np.empty(0))
+    arrays.setdefault("snapshot_x", np.empty(0))
+    arrays.setdefault("snapshot_u", np.empty((0, nodes)))
+    for name in ARRAYS:
+        arrays.setdefault(name, np.empty(0))
+    result = Result(**arrays, attrs=attrs, source=path)
+    if result.status != "complete" and not allow_incomplete:
+        raise IncompleteRunError(f"{path}: run {result.status}: {attrs.get('message', 'not complete')}; "
+                                 "pass allow_incomplete=True to read what it holds", result)
+    return result
