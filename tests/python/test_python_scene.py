@@ -181,3 +181,12 @@ def test_replace_and_keyword_checks() -> None:
     with pytest.raises(ValueError, match="exactly one"):
         Scene().replace(stiffness=1e8, stiffness_per_mass=1e8)
     assert dataclasses.is_dataclass(scene) and hash(scene) == hash(Scene().replace(dt=1e-6, beta=0.25))
+
+
+def test_any_file_name_goes_through(tmp_path: Path) -> None:
+    folder = tmp_path / "dossier é ü"
+    folder.mkdir()
+    path = write(folder, "&time dt=1e-5 /\n", name="scène.nml")
+    assert Scene.from_namelist(path) == engine.read_namelist(path) == Scene(dt=1e-5, file="scène.h5")
+    with pytest.raises(ValueError, match="scène.nml: &time dt = -1"):
+        Scene(dt=-1.0).validate(str(path))

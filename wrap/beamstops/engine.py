@@ -28,7 +28,8 @@ _INT64 = 2**63
 
 
 def _text(value: Any) -> str:
-    """f2py returns fixed-length character outputs as bytes, blank-padded."""
+    """f2py returns fixed-length character outputs as bytes, blank-padded (character inputs
+    are passed as bytes too, file-system encoded, so that any path goes through)."""
     if isinstance(value, (bytes, np.bytes_)):
         value = bytes(value).decode("utf-8", errors="replace")
     return str(value).rstrip(" \x00")
@@ -61,7 +62,7 @@ def version() -> str:
 
 def validate(scene: Scene, source: str = "scene") -> None:
     """Check a scene with the engine's ``validate_scene``; ValueError names group, key and range."""
-    _check(*_engine.bs_validate(*_flat(scene), source))
+    _check(*_engine.bs_validate(*_flat(scene), os.fsencode(source)))
 
 
 def sizes(scene: Scene) -> tuple[int, int, int]:
@@ -163,7 +164,7 @@ def read_namelist(path: PathLike) -> Scene:
     """The scene the program itself (the engine's namelist reader) reads from a file."""
     (length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, elements, dt, t_end,
      beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, max_output_gb, file,
-     status, message) = _engine.bs_read_scene(os.fspath(path))
+     status, message) = _engine.bs_read_scene(os.fsencode(path))
     _check(status, message)
     return Scene(length=length, k2=k2, mass_per_length=mass_per_length, amplitude=amplitude, omega=omega,
                  lower=lower, upper=upper, law=_LAW_NAMES[int(law)], stiffness_per_mass=stiffness_per_mass,
