@@ -1,0 +1,298 @@
+!> read_scene on namelist files written by the test into a temporary directory:
+!> values of a valid file (the material route included) and one message per bad input,
+!> naming the file, the group and the key.
+module test_namelist
+   use testing
+   use beamstops, only: scene_type, read_scene, law_signorini, law_compliance
+   implicit none
+   private
+   public :: collect_namelist
+
+   !> Length of a line of a test file.
+   integer, parameter :: ll = 120
+
+contains
+
+   !> Tests of the suite.
+   subroutine collect_namelist(tests)
+      !> The suite's tests.
+      type(unittest_type), allocatable, intent(out) :: tests(:)
+      tests = [ &
+         & new_unittest('valid file: every value, material route', test_valid), &
+         & new_unittest('groups left out keep the paper''s values', test_defaults), &
+         & new_unittest('missing file', test_missing_file), &
+         & new_unittest('unknown group', test_unknown_group), &
+         & new_unittest('unknown key', test_unknown_key), &
+         & new_unittest('malformed value dt=abc', test_malformed), &
+         & new_unittest('repeated group', test_repeated), &
+         & new_unittest('dt = -1 out of range', test_dt), &
+         & new_unittest('beta = 0.7 out of range', test_beta), &
+         & new_unittest('lower = 0.1 out of range', test_lower), &
+         & new_unittest('upper = -0.1 out of range', test_upper), &
+         & new_unittest('elements = 0 out of range', test_elements), &
+         & new_unittest('law = ''glue'' unknown', test_law), &
+         & new_unittest('compliance without stiffness', test_compliance_stiffness), &
+         & new_unittest('record_every = 0 out of range', test_record_every) &
+         & ]
+   end subroutine collect_namelist
+
+   ! ---------------------------------------------------------------- helpers
+
+   !> A directory of this process under $TMPDIR (or /tmp), created if needed.
+   function temp_dir() result(dir)
+      character(len=:), allocatable :: dir
+      character(len=4096) :: base
+      character(len=16) :: pid
+      integer :: length, stat
+      call get_environment_variable('TMPDIR', base, length, stat)
+      if (stat /= 0 .or. length == 0) base = '/tmp'
+      write (pid, '(i0)') getpid()
+      dir = trim(base)//'/beamstops-fortran-tests-'//trim(pid)
+      call execute_command_line('mkdir -p "'//dir//'"', exitstat=stat)
+   end function temp_dir
+
+   !> Write `lines` to a file `name` in the temporary directory; its path.
+   function write_file(name, lines) result(path)
+      character(len=*), intent(in) :: name
+      character(len=*), intent(in) :: lines(:)
+      character(len=:), allocatable :: path
+      integer :: unit, i
+      path = temp_dir()//'/'//name
+      open (newunit=unit, file=path, status='replace', action='write')
+      do i = 1, size(lines)
+         write (unit, '(a)') trim(lines(i))
+      end do
+      close (unit)
+   end function write_file
+
+   !> Delete a test file and, once empty, the temporary directory.
+   subroutine remove(path)
+      character(len=*), intent(in) :: path
+      integer :: unit, stat
+      logical :: exists
+      inquire (file=path, exist=exists)
+      if (exists) then
+         open (newunit=unit, file=path, status='old', iostat=stat)
+         if (stat == 0) close (unit, status='delete')
+      end if
+      call execute_command_line('rmdir "'//path(:index(path, '/', back=.true.) - 1)//'" 2>/dev/null', exitstat=stat)
+   end subroutine remove
+
+   !> Whether `word` occurs in `text` not preceded or followed by a name character.
+   pure logical function has_word(text, word)
+      character(len=*), intent(in) :: text, word
+      character(len=*), parameter :: name_chars = 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_'
+      integer :: start, at
+      logical :: before, after
+      has_word = .false.
+      start = 1
+      do
+         at = index(text(start:), word)
+         if (at == 0) return
+         at = at + start - 1
+         before = .true.
+         if (at > 1) before = index(name_chars, text(at - 1:at - 1)) == 0
+         after = .true.
+         if (at + len(word) <= len(text)) after = index(name_chars, text(at + len(word):at + len(word))) == 0
+         if (before .and. after) then
+            has_word = .true.
+            return
+         end if
+         start = at + 1
+      end do
+   end function has_word
+
+   !> read_scene on a file must fail with a message holding the path and each of `needles`.
+   subroutine expect_error(name, lines, needles, error)
+      character(len=*), intent(in) :: name
+      character(len=*), intent(in) :: lines(:)
+      character(len=*), intent(in) :: needles(:)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: path
+      path = write_file(name, lines)
+      call expect_error_at(path, needles, error)
+      call remove(path)
+   end subroutine expect_error
+
+   !> read_scene on `path` must fail with a message holding the path and each of `needles`.
+   subroutine expect_error_at(path, needles, error)
+      character(len=*), intent(in) :: path
+      character(len=*), intent(in) :: needles(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(error_type), allocatable :: read_error
+      integer :: i
+      call read_scene(path, scene, read_error)
+      if (.not. allocated(read_error)) then
+         call test_failed(error, 'read_scene accepted '//path)
+         return
+      end if
+      call note('message: '//read_error%message)
+      call check(error, index(read_error%message, path) > 0, 'the message names the file '//path//': '// &
+         & read_error%message)
+      if (allocated(error)) return
+      do i = 1, size(needles)
+         call check(error, has_word(read_error%message, trim(needles(i))), 'the message names '//trim(needles(i))// &
+            & ': '//read_error%message)
+         if (allocated(error)) return
+      end do
+   end subroutine expect_error_at
+
+   ! ---------------------------------------------------------------- tests
+
+   subroutine test_valid(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), parameter :: pi = acos(-1.0_wp), e = 2e11_wp, rho = 8e3_wp, d_out = 0.01_wp, wall = 5e-4_wp
+      type(scene_type) :: scene
+      character(len=:), allocatable :: path
+      real(wp) :: d_in, area, inertia
+      path = write_file('valid.nml', [character(len=ll) :: &
+         & '! a scene with every group', &
+         & '&beam length = 1.2, youngs_modulus = 2e11, density = 8e3,', &
+         & '      outer_diameter = 0.01, wall_thickness = 5e-4 /', &
+         & '&support amplitude = 0.15, omega = 12.5 /', &
+         & '&stops lower = -0.05, upper = 0.08, law = ''compliance'', stiffness = 2.0e7 /', &
+         & '&mesh elements = 23 /', &
+         & '&time dt = 1e-5, t_end = 0.75, beta = 0.25, load_rule = ''paper'', start = ''euler'',', &
+         & '      allow_unstable = .true. /', &
+         & '&output record_every = 10, snapshot_every = 100 /'])
+      call read_scene(path, scene, error)
+      call remove(path)
+      if (allocated(error)) return
+      ! thin-walled tube: S = pi/4 (D^2 - d^2), I = pi/64 (D^4 - d^4), k2 = E I/(rho S)
+      d_in = d_out - 2*wall
+      area = pi/4*(d_out**2 - d_in**2)
+      inertia = pi/64*(d_out**4 - d_in**4)
+      call note('material route: k2 = '//real_text(scene%k2)//', mass_per_length = '//real_text(scene%mass_per_length))
+      call check(error, scene%k2, 282.8_wp, 'k2 (SPEC 2: 282.84)', thr=1e-3_wp, rel=.true.); if (allocated(error)) return
+      call check(error, scene%k2, e*(d_out**2 + d_in**2)/(16*rho), 'k2 = E (D^2 + d^2)/(16 rho)', thr=1e-12_wp, rel=.true.)
+      if (allocated(error)) return
+      call check(error, scene%mass_per_length, 0.11938_wp, 'mass_per_length (SPEC 2)', thr=1e-4_wp, rel=.true.)
+      if (allocated(error)) return
+      call check(error, scene%mass_per_length, rho*area, 'mass_per_length = rho S', thr=1e-12_wp, rel=.true.)
+      if (allocated(error)) return
+      call check(error, scene%length, 1.2_wp, 'length'); if (allocated(error)) return
+      call check(error, scene%amplitude, 0.15_wp, 'amplitude'); if (allocated(error)) return
+      call check(error, scene%omega, 12.5_wp, 'omega'); if (allocated(error)) return
+      call check(error, scene%lower, -0.05_wp, 'lower'); if (allocated(error)) return
+      call check(error, scene%upper, 0.08_wp, 'upper'); if (allocated(error)) return
+      call check(error, scene%law, law_compliance, 'law'); if (allocated(error)) return
+      call check(error, scene%stiffness_per_mass, 2.0e7_wp/(rho*area), 'stiffness_per_mass = stiffness/(rho S)', &
+         & thr=1e-12_wp, rel=.true.); if (allocated(error)) return
+      call check(error, scene%elements, 23, 'elements'); if (allocated(error)) return
+      call check(error, scene%dt, 1e-5_wp, 'dt'); if (allocated(error)) return
+      call check(error, scene%t_end, 0.75_wp, 't_end'); if (allocated(error)) return
+      call check(error, scene%beta, 0.25_wp, 'beta'); if (allocated(error)) return
+      call check(error, scene%centered_load, .false., 'centered_load (load_rule = ''paper'')'); if (allocated(error)) return
+      call check(error, scene%taylor_start, .false., 'taylor_start (start = ''euler'')'); if (allocated(error)) return
+      call check(error, scene%allow_unstable, .true., 'allow_unstable'); if (allocated(error)) return
+      call check(error, scene%record_every, 10, 'record_every'); if (allocated(error)) return
+      call check(error, scene%snapshot_every, 100, 'snapshot_every'); if (allocated(error)) return
+      call check(error, allocated(scene%output_file), 'an output file name is set'); if (allocated(error)) return
+      call check(error, scene%output_file == 'valid.h5', 'default output file valid.h5, got '//scene%output_file)
+   end subroutine test_valid
+
+   subroutine test_defaults(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene, paper
+      character(len=:), allocatable :: path
+      path = write_file('mesh_only.nml', [character(len=ll) :: '&mesh elements = 7 /', '&output file = ''x.h5'' /'])
+      call read_scene(path, scene, error)
+      call remove(path)
+      if (allocated(error)) return
+      call check(error, scene%elements, 7, 'elements'); if (allocated(error)) return
+      call check(error, scene%output_file == 'x.h5', 'output file x.h5, got '//scene%output_file); if (allocated(error)) return
+      call check(error, scene%length, paper%length, 'length'); if (allocated(error)) return
+      call check(error, scene%k2, paper%k2, 'k2'); if (allocated(error)) return
+      call check(error, scene%mass_per_length, paper%mass_per_length, 'mass_per_length'); if (allocated(error)) return
+      call check(error, scene%amplitude, paper%amplitude, 'amplitude'); if (allocated(error)) return
+      call check(error, scene%omega, paper%omega, 'omega'); if (allocated(error)) return
+      call check(error, scene%lower, paper%lower, 'lower'); if (allocated(error)) return
+      call check(error, scene%upper, paper%upper, 'upper'); if (allocated(error)) return
+      call check(error, scene%law, law_signorini, 'law'); if (allocated(error)) return
+      call check(error, scene%dt, paper%dt, 'dt'); if (allocated(error)) return
+      call check(error, scene%t_end, paper%t_end, 't_end'); if (allocated(error)) return
+      call check(error, scene%beta, paper%beta, 'beta'); if (allocated(error)) return
+      call check(error, scene%centered_load, paper%centered_load, 'centered_load'); if (allocated(error)) return
+      call check(error, scene%taylor_start, paper%taylor_start, 'taylor_start'); if (allocated(error)) return
+      call check(error, scene%record_every, paper%record_every, 'record_every')
+   end subroutine test_defaults
+
+   subroutine test_missing_file(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: path
+      path = temp_dir()//'/no_such_file.nml'
+      call expect_error_at(path, [character(len=8) :: 'cannot'], error)
+      call remove(path)
+   end subroutine test_missing_file
+
+   subroutine test_unknown_group(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('unknown_group.nml', [character(len=ll) :: '&mesh elements = 7 /', '&velocity v = 1 /'], &
+         & [character(len=16) :: '&velocity'], error)
+   end subroutine test_unknown_group
+
+   subroutine test_unknown_key(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('unknown_key.nml', [character(len=ll) :: '&time dtt = 1e-5 /'], &
+         & [character(len=16) :: '&time', 'dtt'], error)
+   end subroutine test_unknown_key
+
+   subroutine test_malformed(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('malformed.nml', [character(len=ll) :: '&time dt=abc /'], &
+         & [character(len=16) :: '&time', 'dt', 'abc'], error)
+   end subroutine test_malformed
+
+   subroutine test_repeated(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('repeated.nml', [character(len=ll) :: '&time dt = 1e-5 /', '&mesh elements = 3 /', &
+         & '&time beta = 0.25 /'], [character(len=16) :: '&time'], error)
+   end subroutine test_repeated
+
+   subroutine test_dt(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('dt.nml', [character(len=ll) :: '&time dt = -1 /'], [character(len=16) :: '&time', 'dt'], error)
+   end subroutine test_dt
+
+   subroutine test_beta(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('beta.nml', [character(len=ll) :: '&time beta = 0.7 /'], [character(len=16) :: '&time', 'beta'], error)
+   end subroutine test_beta
+
+   subroutine test_lower(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('lower.nml', [character(len=ll) :: '&stops lower = 0.1 /'], &
+         & [character(len=16) :: '&stops', 'lower'], error)
+   end subroutine test_lower
+
+   subroutine test_upper(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('upper.nml', [character(len=ll) :: '&stops upper = -0.1 /'], &
+         & [character(len=16) :: '&stops', 'upper'], error)
+   end subroutine test_upper
+
+   subroutine test_elements(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('elements.nml', [character(len=ll) :: '&mesh elements = 0 /'], &
+         & [character(len=16) :: '&mesh', 'elements'], error)
+   end subroutine test_elements
+
+   subroutine test_law(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('law.nml', [character(len=ll) :: '&stops law = ''glue'' /'], &
+         & [character(len=16) :: '&stops', 'law', 'glue'], error)
+   end subroutine test_law
+
+   subroutine test_compliance_stiffness(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('compliance.nml', [character(len=ll) :: '&stops law = ''compliance'' /'], &
+         & [character(len=24) :: '&stops', 'stiffness', 'stiffness_per_mass'], error)
+   end subroutine test_compliance_stiffness
+
+   subroutine test_record_every(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('record_every.nml', [character(len=ll) :: '&output record_every = 0 /'], &
+         & [character(len=16) :: '&output', 'record_every'], error)
+   end subroutine test_record_every
+end module test_namelist
