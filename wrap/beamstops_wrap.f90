@@ -268,13 +268,9 @@ end subroutine bs_read_scene
 
 !> k2 = E I/(rho S) and the mass per length rho S of a tube, as the namelist reader derives them.
 subroutine bs_tube(youngs_modulus, density, outer_diameter, wall_thickness, k2, mass_per_length)
-   use beamstops, only: wp
-   use beamstops_scene, only: tube_section
+   use beamstops_scene, only: tube_beam
    implicit none
    real(8), intent(in) :: youngs_modulus, density, outer_diameter, wall_thickness
    real(8), intent(out) :: k2, mass_per_length
-   real(wp) :: area, inertia
-   call tube_section(outer_diameter, wall_thickness, area, inertia)
-   k2 = youngs_modulus*inertia/(density*area)
-   mass_per_length = density*area
+   call tube_beam(youngs_modulus, density, outer_diameter, wall_thickness, k2, mass_per_length)
 end subroutine bs_tube

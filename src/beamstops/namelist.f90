@@ -5,7 +5,7 @@ module beamstops_namelist
    use, intrinsic :: iso_fortran_env, only: iostat_end
    use beamstops_kinds, only: wp
    use beamstops_error, only: error_type, fatal_error
-   use beamstops_scene, only: scene_type, validate_scene, tube_section, law_code, law_compliance, fmt_real
+   use beamstops_scene, only: scene_type, validate_scene, tube_beam, law_code, law_compliance, fmt_real
    implicit none
    private
    public :: read_scene, group_names
@@ -57,9 +57,10 @@ contains
       character(len=text_len) :: groups_text(size(group_names))
       logical :: present(size(group_names))
       character(len=512) :: msg
-      integer :: unit, stat, g
+      character(len=:), allocatable :: text
+      integer :: stat, g
 
-      call scan_groups(path, present, groups_text, error)
+      call scan_groups(path, present, groups_text, text, error)
       if (allocated(error)) return
 
       length = scene%length; k2 = unset; mass_per_length = unset
@@ -72,30 +73,22 @@ contains
       file = default_output(path); record_every = scene%record_every; snapshot_every = scene%snapshot_every
       max_output_gb = scene%max_output_gb
 
-      open (newunit=unit, file=path, status='old', action='read', iostat=stat, iomsg=msg)
-      if (stat /= 0) then
-         call fatal_error(error, path//': cannot open: '//trim(msg))
-         return
-      end if
       do g = 1, size(group_names)
          if (.not. present(g)) cycle
-         rewind (unit)
          select case (g)
-         case (1); read (unit, nml=beam, iostat=stat, iomsg=msg)
-         case (2); read (unit, nml=support, iostat=stat, iomsg=msg)
-         case (3); read (unit, nml=stops, iostat=stat, iomsg=msg)
-         case (4); read (unit, nml=mesh, iostat=stat, iomsg=msg)
-         case (5); read (unit, nml=time, iostat=stat, iomsg=msg)
-         case (6); read (unit, nml=output, iostat=stat, iomsg=msg)
+         case (1); read (text, nml=beam, iostat=stat, iomsg=msg)
+         case (2); read (text, nml=support, iostat=stat, iomsg=msg)
+         case (3); read (text, nml=stops, iostat=stat, iomsg=msg)
+         case (4); read (text, nml=mesh, iostat=stat, iomsg=msg)
+         case (5); read (text, nml=time, iostat=stat, iomsg=msg)
+         case (6); read (text, nml=output, iostat=stat, iomsg=msg)
          end select
          if (stat /= 0) then
             call fatal_error(error, path//': &'//trim(group_names(g))//': '//trim(explain(stat, msg, groups_text(g)))// &
                & ' in `'//trim(groups_text(g))//'`; keys of &'//trim(group_names(g))//': '//trim(group_keys(g)))
-            close (unit)
             return
          end if
       end do
-      close (unit)
 
       call derive_beam(path, length, k2, mass_per_length, youngs_modulus, density, outer_diameter, &
          & wall_thickness, scene, error)
@@ -166,7 +159,7 @@ contains
       real(wp), intent(in) :: length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness
       type(scene_type), intent(inout) :: scene
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: material(4), area, inertia
+      real(wp) :: material(4)
       character(len=*), parameter :: names(4) = ['youngs_modulus', 'density       ', 'outer_diameter', &
          & 'wall_thickness']
       integer :: i
@@ -199,16 +192,17 @@ contains
             & ' is out of range; allowed: 0 < wall_thickness <= outer_diameter/2 = '//fmt_real(outer_diameter/2))
          return
       end if
-      call tube_section(outer_diameter, wall_thickness, area, inertia)
-      scene%k2 = youngs_modulus*inertia/(density*area)
-      scene%mass_per_length = density*area
+      call tube_beam(youngs_modulus, density, outer_diameter, wall_thickness, scene%k2, scene%mass_per_length)
    end subroutine derive_beam
 
    !> Which groups the file holds (and their text, for messages); unknown or repeated groups are errors.
-   subroutine scan_groups(path, present, texts, error)
+   !> `cleaned` is the whole file without comments, its lines joined: gfortran reads namelists
+   !> from it whatever the file's last line ends with.
+   subroutine scan_groups(path, present, texts, cleaned, error)
       character(len=*), intent(in) :: path
       logical, intent(out) :: present(:)
       character(len=*), intent(out) :: texts(:)
+      character(len=:), allocatable, intent(out) :: cleaned
       type(error_type), allocatable, intent(out) :: error
       character(len=text_len) :: line
       character(len=512) :: msg
@@ -219,6 +213,7 @@ contains
       present = .false.
       texts = ''
       used = 0
+      cleaned = ''
       open (newunit=unit, file=path, status='old', action='read', iostat=stat, iomsg=msg)
       if (stat /= 0) then
          call fatal_error(error, path//': cannot open: '//trim(msg))
@@ -249,6 +244,7 @@ contains
                quoted = .true.
                quote = line(i:i)
             else if (line(i:i) == '!') then
+               cleaned = cleaned//line(:i - 1)//' '
                exit
             else if (line(i:i) == '/' .and. current > 0) then
                call append_text(current, '/')
@@ -288,6 +284,7 @@ contains
             i = i + 1
          end do
          if (allocated(error)) exit
+         if (i > len_trim(line)) cleaned = cleaned//trim(line)//' '
          if (current > 0) call append_text(current, ' ')
       end do
       close (unit)

@@ -7,7 +7,7 @@ module beamstops_scene
    implicit none
    private
    public :: scene_type, validate_scene, steps_of, record_count, snapshot_count, output_bytes
-   public :: tube_section, fmt_real, fmt_int
+   public :: tube_section, tube_beam, fmt_real, fmt_int
    public :: law_none, law_signorini, law_compliance, law_name, law_code
    public :: max_elements
 
@@ -112,6 +112,26 @@ contains
       inertia = pi/64*(outer_diameter**4 - d_in**4)
    end subroutine tube_section
 
+   !> k^2 = E I/(rho S) and the mass per length rho S of a tube.
+   pure subroutine tube_beam(youngs_modulus, density, outer_diameter, wall_thickness, k2, mass_per_length)
+      !> Young's modulus E (Pa).
+      real(wp), intent(in) :: youngs_modulus
+      !> Density rho (kg/m^3).
+      real(wp), intent(in) :: density
+      !> Outer diameter (m).
+      real(wp), intent(in) :: outer_diameter
+      !> Wall thickness (m).
+      real(wp), intent(in) :: wall_thickness
+      !> k^2 (m^4/s^2).
+      real(wp), intent(out) :: k2
+      !> rho S (kg/m).
+      real(wp), intent(out) :: mass_per_length
+      real(wp) :: area, inertia
+      call tube_section(outer_diameter, wall_thickness, area, inertia)
+      k2 = youngs_modulus*inertia/(density*area)
+      mass_per_length = density*area
+   end subroutine tube_beam
+
    !> Name of a contact-law code, as written in a namelist.
    pure function law_name(law) result(name)
       !> Law code.
@@ -211,13 +231,11 @@ contains
       if (allocated(error)) return
       call within('support', 'amplitude', scene%amplitude, -1.0e3_wp, 1.0e3_wp); if (allocated(error)) return
       call within('support', 'omega', scene%omega, 0.0_wp, 1.0e9_wp); if (allocated(error)) return
-      call within('stops', 'lower', scene%lower, -1.0e6_wp, 0.0_wp); if (allocated(error)) return
-      if (.not. scene%lower < 0) then
-         call say('stops', 'lower', fmt_real(scene%lower), 'lower < 0 (the beam starts at rest at 0)'); return
+      if (.not. (scene%lower >= -1.0e6_wp .and. scene%lower < 0)) then
+         call say('stops', 'lower', fmt_real(scene%lower), '-1e+06 <= lower < 0 (the beam starts at rest at 0)'); return
       end if
-      call within('stops', 'upper', scene%upper, 0.0_wp, 1.0e6_wp); if (allocated(error)) return
-      if (.not. scene%upper > 0) then
-         call say('stops', 'upper', fmt_real(scene%upper), 'upper > 0 (the beam starts at rest at 0)'); return
+      if (.not. (scene%upper > 0 .and. scene%upper <= 1.0e6_wp)) then
+         call say('stops', 'upper', fmt_real(scene%upper), '0 < upper <= 1e+06 (the beam starts at rest at 0)'); return
       end if
       if (scene%law < law_none .or. scene%law > law_compliance) then
          call say('stops', 'law', '?', "'signorini', 'compliance' or 'none'"); return

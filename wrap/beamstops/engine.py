@@ -139,7 +139,8 @@ def run(scene: Scene, *, allow_incomplete: bool = False) -> Result:
     attrs.update({
         "elements": scene.elements, "dt": scene.dt, "t_end": scene.t_end, "beta": scene.beta,
         "load_rule": scene.load_rule, "start": scene.start, "record_every": scene.record_every,
-        "snapshot_every": scene.snapshot_every,
+        "snapshot_every": scene.snapshot_every, "allow_unstable": int(scene.allow_unstable),
+        "max_output_gb": scene.max_output_gb,
         "kappa_h": float(kappa_h), "kappa_bound": float(kappa_bound), "dt_limit_newmark": float(dt_newmark),
         "dt_limit_paper": float(dt_paper), "dt_limit_paper_bound": float(dt_paper_bound),
         "steps": int(steps), "t_final": float(t_final), "cpu_seconds": float(cpu_seconds),

@@ -87,7 +87,9 @@ class Result:
 
         keys = {f: self.attrs[f] for f in ("length", "k2", "mass_per_length", "amplitude", "omega", "lower", "upper",
                                            "law", "elements", "dt", "t_end", "beta", "load_rule", "start",
-                                           "record_every", "snapshot_every") if f in self.attrs}
+                                           "record_every", "snapshot_every", "max_output_gb") if f in self.attrs}
+        if "allow_unstable" in self.attrs:
+            keys["allow_unstable"] = bool(self.attrs["allow_unstable"])
         if "stiffness_per_mass" in self.attrs:
             keys["stiffness_per_mass"] = self.attrs["stiffness_per_mass"]
         return Scene(**keys)

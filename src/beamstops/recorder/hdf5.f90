@@ -117,6 +117,8 @@ contains
       call attribute_text(self, 'start', merge('taylor', 'euler ', scene%taylor_start))
       call attribute_int(self, 'record_every', int(scene%record_every, ik))
       call attribute_int(self, 'snapshot_every', int(scene%snapshot_every, ik))
+      call attribute_int(self, 'allow_unstable', merge(1_ik, 0_ik, scene%allow_unstable))
+      call attribute_real(self, 'max_output_gb', scene%max_output_gb)
       call attribute_real(self, 'kappa_h', model%kappa_h)
       call attribute_real(self, 'kappa_bound', model%kappa_bound)
       call attribute_real(self, 'dt_limit_newmark', model%dt_newmark)
