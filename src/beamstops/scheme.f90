@@ -9,6 +9,9 @@ module beamstops_scheme
    use beamstops_model, only: model_type
    use beamstops_error, only: error_type
    use beamstops_band, only: band_matvec, cholesky_factor, cholesky_solve
+   use beamstops_band, only: kd
+   use beamstops_band_solve, only: band_solver, prepare_solver, forward_substitution, back_substitution_edge, &
+      & band_diagonals, prepare_diagonals, diagonal_matvec
    use beamstops_forcing, only: load_average, support_position
    use beamstops_contact_tip_projection, only: project_tip
    use beamstops_contact_compliance, only: spring_force, solve_spring_tip
@@ -50,6 +53,12 @@ module beamstops_scheme
       integer(ik) :: impacts = 0
       !> Largest violation of the stops so far (m).
       real(wp) :: max_violation = 0
+      !> The factor of A in the form of the fused substitutions (from model%factor).
+      type(band_solver) :: solver
+      !> S and M by diagonals (for the vectorized products of the loop).
+      type(band_diagonals) :: stiffness, mass
+      !> Solve with LAPACK's dpbtrs and separate updates: the reference path of the tests.
+      logical :: lapack_solve = .false.
    end type state_type
 
 contains
@@ -103,8 +112,10 @@ contains
          state%p_now = spring_force(state%u(tip), scene%lower, scene%upper, scene%stiffness_per_mass)
       end if
       if (scene%law /= law_none) state%max_violation = violation(state%u(tip), scene)
-      state%energy0 = energy(model, state%u, state%d, state%su, state%scratch, &
-         & dot_product(model%u0, matmul_band(model, model%u0)))
+      call prepare_operators(model, state)
+      call band_matvec(model%mass, state%d, state%scratch)
+      state%energy0 = energy(model, dot_product(state%d, state%scratch), dot_product(state%u, state%su), &
+         & dot_product(state%d, state%su), dot_product(model%u0, matmul_band(model, model%u0)))
       r = 0
       r(col_u) = model%u0(tip)
       r(col_v) = model%v0(tip)
@@ -179,6 +190,8 @@ contains
    end function real_text
 
    !> Advance from state%step through step `last` (computing u^{last+1}), recording on the way.
+   !> The fused path (default) or, with state%lapack_solve, the reference path; both compute
+   !> the same step, to round-off.
    subroutine advance(scene, model, state, recorder, last)
       !> Scene.
       type(scene_type), intent(in) :: scene
@@ -190,97 +203,362 @@ contains
       class(recorder_type), intent(inout) :: recorder
       !> Last step to do.
       integer(ik), intent(in) :: last
-      integer(ik) :: step
-      integer :: tip
-      real(wp) :: dt2, beta, sigma_next, weight, c, tip_value, r_step, gd, d_tip_prev, u_tip_prev
-      real(wp) :: u_old_su, p_next, row(n_columns)
-      logical :: contact
-
-      tip = model%tip
-      dt2 = model%dt2
-      beta = model%beta
-      do step = state%step, last
-         sigma_next = load_average(step + 1, model%dt, scene%omega, scene%centered_load)
-         weight = beta*sigma_next + (1 - 2*beta)*state%sigma_now + beta*state%sigma_prev
-         state%rhs = dt2*(weight*model%load - state%su)
-         if (scene%law == law_compliance) state%rhs(tip) = state%rhs(tip) + &
-            & dt2*((1 - 2*beta)*state%p_now + beta*state%p_prev)
-         call cholesky_solve(model%factor, state%rhs)
-         d_tip_prev = state%d(tip)
-         u_tip_prev = state%u(tip)
-         state%d = state%d + state%rhs
-         select case (scene%law)
-         case (law_signorini)
-            call project_tip(u_tip_prev + state%d(tip), scene%lower, scene%upper, model%z(tip), c, tip_value)
-            contact = c /= 0
-            if (contact) state%d = state%d + c*model%z
-            r_step = c/dt2
-            state%u = state%u + state%d
-            if (contact) state%u(tip) = tip_value
-         case (law_compliance)
-            tip_value = solve_spring_tip(u_tip_prev + state%d(tip), scene%lower, scene%upper, &
-               & scene%stiffness_per_mass, dt2*beta*model%z(tip))
-            p_next = spring_force(tip_value, scene%lower, scene%upper, scene%stiffness_per_mass)
-            c = dt2*beta*p_next
-            if (c /= 0) state%d = state%d + c*model%z
-            r_step = beta*p_next + (1 - 2*beta)*state%p_now + beta*state%p_prev
-            state%p_prev = state%p_now
-            state%p_now = p_next
-            contact = r_step /= 0
-            state%u = state%u + state%d
-            state%max_violation = max(state%max_violation, violation(state%u(tip), scene))
-         case default
-            r_step = 0
-            contact = .false.
-            state%u = state%u + state%d
-         end select
-         if (contact .and. .not. state%in_contact) state%impacts = state%impacts + 1
-         state%in_contact = contact
-
-         gd = dot_product(model%load, state%d)
-         state%work = state%work + 0.5_wp*weight*(gd + state%gd_prev)
-         state%dissipated = state%dissipated - 0.5_wp*r_step*(state%d(tip) + d_tip_prev)
-         state%gd_prev = gd
-         state%sigma_prev = state%sigma_now
-         state%sigma_now = sigma_next
-
-         if (mod(step, int(scene%record_every, ik)) == 0) then
-            u_old_su = dot_product(state%u, state%su) - dot_product(state%d, state%su)
-            call band_matvec(model%stiffness, state%u, state%su)
-            row(col_t) = real(step, wp)*model%dt
-            row(col_u) = u_tip_prev
-            row(col_v) = (state%d(tip) + d_tip_prev)/(2*model%dt)
-            row(col_reaction) = scene%mass_per_length*r_step
-            row(col_energy) = scene%mass_per_length*energy(model, state%u, state%d, state%su, state%scratch, u_old_su)
-            row(col_work) = scene%mass_per_length*state%work
-            row(col_dissipated) = scene%mass_per_length*state%dissipated
-            call recorder%record(row)
-         else
-            call band_matvec(model%stiffness, state%u, state%su)
-         end if
-         if (scene%snapshot_every > 0) then
-            if (mod(step, int(scene%snapshot_every, ik)) == 0) then
-               state%scratch = state%u - state%d
-               call physical_shape(model, state%scratch, real(step, wp)*model%dt, scene, state%shape)
-               call recorder%snapshot(real(step, wp)*model%dt, state%shape)
-            end if
-         end if
-      end do
+      if (state%solver%n /= model%n) call prepare_operators(model, state)
+      if (state%lapack_solve) then
+         call advance_reference(scene, model, state, recorder, last)
+      else
+         call advance_fused(scene, model, state, recorder, last)
+      end if
       state%step = last + 1
    end subroutine advance
 
-   !> Discrete energy E^{n+1/2} per unit mass from u^{n+1}, d^n = u^{n+1} - u^n, S u^{n+1}
-   !> and u^n.S u^n (SPEC 6); `scratch` receives M d.
-   function energy(model, u, d, su, scratch, u_old_s_u_old) result(e)
+   !> The step as SPEC 4 writes it, one operation after the other: rhs = dt^2 (G^n - S u^n),
+   !> LAPACK's dpbtrs, the contact law, d^n = d^{n-1} + A^{-1} rhs + c z, u^{n+1} = u^n + d^n,
+   !> S u^{n+1}, the record. The reference of the tests and of scripts/bench.py.
+   subroutine advance_reference(scene, model, state, recorder, last)
+      type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
-      real(wp), intent(in) :: u(:), d(:), su(:), u_old_s_u_old
-      real(wp), intent(inout) :: scratch(:)
-      real(wp) :: e, usu, u_old_su
-      call band_matvec(model%mass, d, scratch)
-      usu = dot_product(u, su)
-      u_old_su = usu - dot_product(d, su)
-      e = 0.5_wp*dot_product(d, scratch)/model%dt2 + 0.5_wp*(model%beta*usu + model%beta*u_old_s_u_old &
-         & + (1 - 2*model%beta)*u_old_su)
+      type(state_type), intent(inout) :: state
+      class(recorder_type), intent(inout) :: recorder
+      integer(ik), intent(in) :: last
+      integer(ik) :: step, next_record, next_snapshot
+      integer :: tip
+      real(wp) :: sigma_next, weight, c, tip_value, trial, r_step, gd, d_tip_prev, u_tip_prev, u_old_su, dmd
+      real(wp) :: row(n_columns)
+      logical :: contact
+
+      tip = model%tip
+      call first_events(scene, state%step, next_record, next_snapshot)
+      do step = state%step, last
+         sigma_next = load_average(step + 1, model%dt, scene%omega, scene%centered_load)
+         weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
+         state%rhs = model%dt2*(weight*model%load - state%su)
+         state%rhs(tip) = state%rhs(tip) + spring_term(scene, model, state)
+         call cholesky_solve(model%factor, state%rhs)
+         d_tip_prev = state%d(tip)
+         u_tip_prev = state%u(tip)
+         trial = u_tip_prev + (d_tip_prev + state%rhs(tip))
+         call contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
+         state%d = state%d + state%rhs + c*model%z
+         state%u = state%u + state%d
+         gd = dot_product(model%load, state%d)
+         call close_step(scene, model, state, contact, tip_value, gd, weight, r_step, d_tip_prev, sigma_next)
+         if (step == next_record) u_old_su = dot_product(state%u, state%su) - dot_product(state%d, state%su)
+         call band_matvec(model%stiffness, state%u, state%su)
+         if (step == next_record) then
+            next_record = next_record + scene%record_every
+            call band_matvec(model%mass, state%d, state%scratch)
+            dmd = dot_product(state%d, state%scratch)
+            call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_step, row)
+            row(col_energy) = scene%mass_per_length*energy(model, dmd, dot_product(state%u, state%su), &
+               & dot_product(state%d, state%su), u_old_su)
+            call recorder%record(row)
+         end if
+         if (step == next_snapshot) then
+            next_snapshot = next_snapshot + scene%snapshot_every
+            call take_snapshot(scene, model, state, step, recorder)
+         end if
+      end do
+   end subroutine advance_reference
+
+   !> The same step arranged around the dependency chain of the two triangular solves
+   !> (2n multiply-adds in a row, the bound of a step). Two passes over the unknowns:
+   !>  - forward (forward_pass): S u^n as a vectorized product, then row by row the
+   !>    right-hand side dt^2 (G^n - S u^n), the forward substitution and the dot products
+   !>    the energy needs;
+   !>  - back: the first kd rows of the back substitution give the trial tip value, the
+   !>    contact law gives c, then back_substitution_update finishes the substitution and
+   !>    updates d and u row by row.
+   !> The work besides the substitutions runs in the shadow of their chain. The energy of a
+   !> recorded step needs S u^{n+1}, which the next forward pass computes: its record is
+   !> handed to the recorder one step later (at the end of the call for the last step).
+   subroutine advance_fused(scene, model, state, recorder, last)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      class(recorder_type), intent(inout) :: recorder
+      integer(ik), intent(in) :: last
+      integer(ik) :: step, next_record, next_snapshot
+      integer :: tip
+      real(wp) :: sigma_next, sigma_after, weight, c, tip_value, trial, r_step, gd, d_tip_prev, u_tip_prev
+      real(wp) :: usu, dsu, u_old_su, dmd, row(n_columns)
+      logical :: contact, pending
+
+      tip = model%tip
+      call first_events(scene, state%step, next_record, next_snapshot)
+      pending = .false.
+      u_old_su = 0
+      dmd = 0
+      sigma_after = load_average(state%step + 1, model%dt, scene%omega, scene%centered_load)
+      do step = state%step, last
+         ! The load average is computed a step ahead: its sine is then off the chain.
+         sigma_next = sigma_after
+         sigma_after = load_average(step + 2, model%dt, scene%omega, scene%centered_load)
+         weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
+         call forward_pass(state%stiffness, state%solver, model%load, state%u, state%d, model%dt2*weight, &
+            & model%dt2, spring_term(scene, model, state), state%su, state%rhs, usu, dsu)
+         if (pending) then
+            ! usu = u^n.S u^n and dsu = d^{n-1}.S u^n complete the energy of step n-1.
+            row(col_energy) = scene%mass_per_length*energy(model, dmd, usu, dsu, u_old_su)
+            call recorder%record(row)
+            pending = .false.
+         end if
+         u_old_su = usu
+         call back_substitution_edge(state%solver, state%rhs)
+         d_tip_prev = state%d(tip)
+         u_tip_prev = state%u(tip)
+         trial = u_tip_prev + (d_tip_prev + state%rhs(tip))
+         call contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
+         call back_substitution_update(state%solver, state%rhs, c, model%z, model%load, state%d, state%u, gd)
+         call close_step(scene, model, state, contact, tip_value, gd, weight, r_step, d_tip_prev, sigma_next)
+         if (step == next_record) then
+            next_record = next_record + scene%record_every
+            call diagonal_matvec(state%mass, state%d, state%scratch)
+            dmd = dot_product(state%d, state%scratch)
+            call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_step, row)
+            pending = .true.
+         end if
+         if (step == next_snapshot) then
+            next_snapshot = next_snapshot + scene%snapshot_every
+            call take_snapshot(scene, model, state, step, recorder)
+         end if
+      end do
+      ! The state carries S u^{last+1}; it also completes a waiting record.
+      call diagonal_matvec(state%stiffness, state%u, state%su)
+      if (pending) then
+         row(col_energy) = scene%mass_per_length*energy(model, dmd, dot_product(state%u, state%su), &
+            & dot_product(state%d, state%su), u_old_su)
+         call recorder%record(row)
+      end if
+   end subroutine advance_fused
+
+   !> Forward pass of a step: su = S u (a vectorized product); rhs = a g - b su, plus `spring`
+   !> in the tip row (n-1), replaced by w, the forward substitution (I + N)^T w = rhs; with
+   !> usu = u.su and dsu = d.su. The right-hand side and the dot products are off the chain
+   !> of the substitution (one multiply-add per row, the nearest row subtracted last).
+   pure subroutine forward_pass(stiffness, solver, g, u, d, a, b, spring, su, rhs, usu, dsu)
+      !> S by diagonals.
+      type(band_diagonals), intent(in) :: stiffness
+      !> Factor of A.
+      type(band_solver), intent(in) :: solver
+      !> Load vector, u^n and d^{n-1} (n).
+      real(wp), intent(in), contiguous :: g(:), u(:), d(:)
+      !> Coefficients of rhs = a g - b S u, and the force added in the tip row.
+      real(wp), intent(in) :: a, b, spring
+      !> S u^n (n).
+      real(wp), intent(out), contiguous :: su(:)
+      !> w (n).
+      real(wp), intent(out), contiguous :: rhs(:)
+      !> u.S u and d.S u.
+      real(wp), intent(out) :: usu, dsu
+      real(wp) :: x, x1, x2, x3
+      integer :: j, n
+      n = solver%n
+      call diagonal_matvec(stiffness, u, su)
+      if (n <= kd + 1) then
+         ! The tip row is among the first kd rows.
+         rhs = a*g - b*su
+         rhs(n - 1) = rhs(n - 1) + spring
+         call forward_substitution(solver, rhs)
+         usu = dot_product(u, su)
+         dsu = dot_product(d, su)
+         return
+      end if
+      associate (off => solver%off)
+         x3 = a*g(1) - b*su(1)
+         x2 = (a*g(2) - b*su(2)) - off(3, 2)*x3
+         x1 = (a*g(3) - b*su(3)) - off(2, 3)*x3 - off(3, 3)*x2
+         rhs(1) = x3
+         rhs(2) = x2
+         rhs(3) = x1
+         usu = u(1)*su(1) + u(2)*su(2) + u(3)*su(3)
+         dsu = d(1)*su(1) + d(2)*su(2) + d(3)*su(3)
+         do j = kd + 1, n
+            x = a*g(j) - b*su(j)
+            if (j == n - 1) x = x + spring
+            x = x - off(1, j)*x3 - off(2, j)*x2 - off(3, j)*x1
+            rhs(j) = x
+            usu = usu + u(j)*su(j)
+            dsu = dsu + d(j)*su(j)
+            x3 = x2
+            x2 = x1
+            x1 = x
+         end do
+      end associate
+   end subroutine forward_pass
+
+   !> The back substitution after its first kd rows (back_substitution_edge), fused with the
+   !> update of the step: row by row from the last, x_i = w_i/d_i^2 - N(i, i+1..i+kd) x,
+   !> d_i = d_i + x_i + c z_i, u_i = u_i + d_i, and gd = g.d. The updates run in the shadow
+   !> of the substitution's chain.
+   pure subroutine back_substitution_update(solver, b, c, z, g, d, u, gd)
+      !> Factor of A.
+      type(band_solver), intent(in) :: solver
+      !> w with its last kd rows solved (n); the solution x on return.
+      real(wp), intent(inout), contiguous :: b(:)
+      !> Multiple of z to add (contact).
+      real(wp), intent(in) :: c
+      !> z = A^{-1} e_tip and the load vector g (n).
+      real(wp), intent(in), contiguous :: z(:), g(:)
+      !> d^{n-1} and u^n on entry, d^n and u^{n+1} on return (n).
+      real(wp), intent(inout), contiguous :: d(:), u(:)
+      !> g.d^n.
+      real(wp), intent(out) :: gd
+      real(wp) :: x, x1, x2, x3
+      integer :: i, n
+      n = solver%n
+      gd = 0
+      do i = n, max(n - kd + 1, 1), -1
+         d(i) = d(i) + b(i) + c*z(i)
+         u(i) = u(i) + d(i)
+         gd = gd + g(i)*d(i)
+      end do
+      if (n <= kd) return
+      x3 = b(n)
+      x2 = b(n - 1)
+      x1 = b(n - 2)
+      associate (off => solver%off, inv_d2 => solver%inv_d2)
+         do i = n - kd, 1, -1
+            x = b(i)*inv_d2(i) - off(1, i + 3)*x3 - off(2, i + 2)*x2 - off(3, i + 1)*x1
+            b(i) = x
+            d(i) = d(i) + x + c*z(i)
+            u(i) = u(i) + d(i)
+            gd = gd + g(i)*d(i)
+            x3 = x2
+            x2 = x1
+            x1 = x
+         end do
+      end associate
+   end subroutine back_substitution_update
+
+   !> dt^2 times the explicit part of the Newmark-weighted spring force, added to the tip row of
+   !> the right-hand side (normal compliance; zero otherwise).
+   pure function spring_term(scene, model, state) result(f)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(state_type), intent(in) :: state
+      real(wp) :: f
+      f = 0
+      if (scene%law == law_compliance) f = model%dt2*((1 - 2*model%beta)*state%p_now + model%beta*state%p_prev)
+   end function spring_term
+
+   !> The contact law at the tip: from the trial tip value u^n_tip + (A^{-1} rhs + d^{n-1})_tip,
+   !> the multiple c of z to add, the tip value, the reaction per unit mass of the step and
+   !> whether the tip is in contact (SPEC 4, 5).
+   subroutine contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      real(wp), intent(in) :: trial
+      real(wp), intent(out) :: c, tip_value, r_step
+      logical, intent(out) :: contact
+      real(wp) :: p_next
+      select case (scene%law)
+      case (law_signorini)
+         call project_tip(trial, scene%lower, scene%upper, model%z(model%tip), c, tip_value)
+         contact = c /= 0
+         r_step = c/model%dt2
+      case (law_compliance)
+         tip_value = solve_spring_tip(trial, scene%lower, scene%upper, scene%stiffness_per_mass, &
+            & model%dt2*model%beta*model%z(model%tip))
+         p_next = spring_force(tip_value, scene%lower, scene%upper, scene%stiffness_per_mass)
+         c = model%dt2*model%beta*p_next
+         r_step = model%beta*p_next + (1 - 2*model%beta)*state%p_now + model%beta*state%p_prev
+         state%p_prev = state%p_now
+         state%p_now = p_next
+         contact = r_step /= 0
+      case default
+         c = 0
+         tip_value = trial
+         r_step = 0
+         contact = .false.
+      end select
+   end subroutine contact_law
+
+   !> After the update: the exact tip value (Signorini), the violation (compliance), impacts,
+   !> the work of the load and the energy taken by the stops, the load averages moved on.
+   subroutine close_step(scene, model, state, contact, tip_value, gd, weight, r_step, d_tip_prev, sigma_next)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      logical, intent(in) :: contact
+      real(wp), intent(in) :: tip_value, gd, weight, r_step, d_tip_prev, sigma_next
+      integer :: tip
+      tip = model%tip
+      if (scene%law == law_signorini .and. contact) state%u(tip) = tip_value
+      if (scene%law == law_compliance) state%max_violation = max(state%max_violation, violation(state%u(tip), scene))
+      if (contact .and. .not. state%in_contact) state%impacts = state%impacts + 1
+      state%in_contact = contact
+      state%work = state%work + 0.5_wp*weight*(gd + state%gd_prev)
+      state%dissipated = state%dissipated - 0.5_wp*r_step*(state%d(tip) + d_tip_prev)
+      state%gd_prev = gd
+      state%sigma_prev = state%sigma_now
+      state%sigma_now = sigma_next
+   end subroutine close_step
+
+   !> A record row of step n, the energy column left for the caller.
+   subroutine fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_step, row)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(state_type), intent(in) :: state
+      integer(ik), intent(in) :: step
+      real(wp), intent(in) :: u_tip_prev, d_tip_prev, r_step
+      real(wp), intent(out) :: row(n_columns)
+      row(col_t) = real(step, wp)*model%dt
+      row(col_u) = u_tip_prev
+      row(col_v) = (state%d(model%tip) + d_tip_prev)/(2*model%dt)
+      row(col_reaction) = scene%mass_per_length*r_step
+      row(col_energy) = 0
+      row(col_work) = scene%mass_per_length*state%work
+      row(col_dissipated) = scene%mass_per_length*state%dissipated
+   end subroutine fill_row
+
+   !> Snapshot of u^n (= u^{n+1} - d^n) at t_n.
+   subroutine take_snapshot(scene, model, state, step, recorder)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      integer(ik), intent(in) :: step
+      class(recorder_type), intent(inout) :: recorder
+      state%scratch = state%u - state%d
+      call physical_shape(model, state%scratch, real(step, wp)*model%dt, scene, state%shape)
+      call recorder%snapshot(real(step, wp)*model%dt, state%shape)
+   end subroutine take_snapshot
+
+   !> The first recorded step and the first snapshot step at or after `step`.
+   pure subroutine first_events(scene, step, next_record, next_snapshot)
+      type(scene_type), intent(in) :: scene
+      integer(ik), intent(in) :: step
+      integer(ik), intent(out) :: next_record, next_snapshot
+      next_record = next_multiple(step, int(scene%record_every, ik))
+      next_snapshot = huge(step)
+      if (scene%snapshot_every > 0) next_snapshot = next_multiple(step, int(scene%snapshot_every, ik))
+   end subroutine first_events
+
+   !> The first multiple of `every` at or after `step`.
+   pure function next_multiple(step, every) result(m)
+      integer(ik), intent(in) :: step, every
+      integer(ik) :: m
+      m = ((step + every - 1)/every)*every
+   end function next_multiple
+
+   !> The factor of A, S and M in the layouts of the fused loop.
+   subroutine prepare_operators(model, state)
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      call prepare_solver(model%factor, state%solver)
+      call prepare_diagonals(model%stiffness, state%stiffness)
+      call prepare_diagonals(model%mass, state%mass)
+   end subroutine prepare_operators
+
+   !> Discrete energy E^{n+1/2} per unit mass (SPEC 6) from d.M d, u.S u and d.S u (u = u^{n+1},
+   !> d = d^n = u^{n+1} - u^n) and u^n.S u^n.
+   pure function energy(model, dmd, usu, dsu, u_old_s_u_old) result(e)
+      type(model_type), intent(in) :: model
+      real(wp), intent(in) :: dmd, usu, dsu, u_old_s_u_old
+      real(wp) :: e
+      e = 0.5_wp*dmd/model%dt2 + 0.5_wp*(model%beta*usu + model%beta*u_old_s_u_old &
+         & + (1 - 2*model%beta)*(usu - dsu))
    end function energy
 
    !> Violation of the stops by a tip value (m).

@@ -11,13 +11,14 @@ program tester
    use test_order, only: collect_order
    use test_namelist, only: collect_namelist
    use test_scheme, only: collect_scheme
+   use test_box_qp, only: collect_box_qp
    implicit none
    character(len=64) :: suite
    type(unittest_type), allocatable :: tests(:)
    integer :: failures
 
    if (command_argument_count() /= 1) then
-      write (error_unit, '(a)') 'usage: tester SUITE (harness, hermite, eigen, projection, energy, order, scheme, namelist)'
+      write (error_unit, '(a)') 'usage: tester SUITE (harness, hermite, eigen, projection, energy, order, scheme, namelist, box_qp)'
       error stop 2
    end if
    call get_command_argument(1, suite)
@@ -30,6 +31,7 @@ program tester
    case ('order'); call collect_order(tests)
    case ('scheme'); call collect_scheme(tests)
    case ('namelist'); call collect_namelist(tests)
+   case ('box_qp'); call collect_box_qp(tests)
    case default
       write (error_unit, '(a)') 'tester: unknown suite '''//trim(suite)//''''
       error stop 2

@@ -1,0 +1,319 @@
+!> A recorder that keeps nothing (but touches what it is given), so that a timed
+!> step loop measures the engine and not the output.
+module bench_null_recorder
+   use beamstops_kinds, only: wp
+   use beamstops_recorder, only: recorder_type, n_columns
+   implicit none
+   private
+   public :: null_recorder
+
+   type, extends(recorder_type) :: null_recorder
+      real(wp) :: sink = 0
+   contains
+      procedure :: record
+      procedure :: snapshot
+   end type null_recorder
+
+contains
+
+   subroutine record(self, row)
+      class(null_recorder), intent(inout) :: self
+      real(wp), intent(in) :: row(n_columns)
+      self%sink = self%sink + row(2)
+   end subroutine record
+
+   subroutine snapshot(self, t, u)
+      class(null_recorder), intent(inout) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: u(:)
+      self%sink = self%sink + u(1)
+   end subroutine snapshot
+end module bench_null_recorder
+
+!> Microbenchmarks of the hot loop; prints `key value` lines (times in ns, medians of repeats).
+!>
+!>   bench_kernels fma [repeats]                    latency of one dependent multiply-add
+!>   bench_kernels solve J [repeats]                one solve with A = M + dt^2 beta S (dt = 1e-6,
+!>                                                  beta = 1/2): LAPACK dpbtrs against the fused
+!>                                                  substitutions, each solve feeding the next
+!>   bench_kernels step J LAW EVERY STEPS [repeats [both|fused|lapack]]
+!>                                                  engine steps (start_state + advance) with a
+!>                                                  recorder that keeps nothing, fused and LAPACK
+!>                                                  paths; LAW signorini|compliance|none; EVERY
+!>                                                  = record_every (0: never)
+!>   bench_kernels triad MB [repeats]               memory bandwidth, a = b + s c over 3 arrays
+!>                                                  of MB megabytes each (GB/s, 24 bytes/element)
+!>
+!> Timings are wall-clock (system_clock) of the code under test only; the repeats of the
+!> variants that are compared are interleaved, so that a slow moment of a shared machine
+!> hits both.
+program bench_kernels
+   use, intrinsic :: iso_fortran_env, only: int64, error_unit
+   use beamstops_kinds, only: wp, ik
+   use beamstops_error, only: error_type
+   use beamstops_scene, only: scene_type, law_code, law_none, law_signorini, law_compliance, steps_of
+   use beamstops_model, only: model_type, build_model
+   use beamstops_band, only: cholesky_solve
+   use beamstops_band_solve, only: band_solver, prepare_solver, fused_solve
+   use beamstops_scheme, only: state_type, start_state, advance
+   use bench_null_recorder, only: null_recorder
+   implicit none
+
+   character(len=64) :: what
+   integer :: repeats
+
+   what = argument(1, 'fma')
+   select case (trim(what))
+   case ('fma')
+      repeats = int_argument(2, 7)
+      call put('fma_latency_ns', median_of(fma_latency, repeats))
+   case ('solve')
+      call bench_solve(int_argument(2, 19), int_argument(3, 7))
+   case ('step')
+      call bench_step(int_argument(2, 19), argument(3, 'signorini'), int_argument(4, 1), &
+         & int_argument(5, 200000), int_argument(6, 5), argument(7, 'both'))
+   case ('triad')
+      call bench_triad(int_argument(2, 256), int_argument(3, 5))
+   case default
+      write (error_unit, '(a)') 'usage: bench_kernels fma|solve|step|triad ...'
+      error stop 2
+   end select
+
+contains
+
+   !> Nanoseconds per dependent multiply-add x = b - a x (the operation that links one row
+   !> of a substitution to the next).
+   function fma_latency() result(ns)
+      real(wp) :: ns
+      integer, parameter :: count = 20000000
+      real(wp) :: a, b, x
+      integer(int64) :: t0, t1, rate
+      integer :: k
+      a = 0.999_wp
+      b = 1.0e-3_wp
+      x = runtime_one()
+      call system_clock(t0, rate)
+      do k = 1, count
+         x = b - a*x
+      end do
+      call system_clock(t1)
+      ns = 1.0e9_wp*real(t1 - t0, wp)/real(rate, wp)/count
+      if (x == 12345) print *, x
+   end function fma_latency
+
+   !> One solve of the Figure 4 matrix, LAPACK against fused.
+   subroutine bench_solve(elements, repeats)
+      integer, intent(in) :: elements, repeats
+      type(scene_type) :: scene
+      type(model_type) :: model
+      type(band_solver) :: solver
+      type(error_type), allocatable :: error
+      real(wp), allocatable :: r(:), b(:)
+      real(wp) :: t_lapack(repeats), t_fused(repeats), t_fma(repeats), zero
+      integer(int64) :: t0, t1, rate
+      integer :: rep, k, count
+      call paper_scene(scene, elements, 1.0e-6_wp, 0.5_wp, law_signorini)
+      call build_model(scene, model, error)
+      if (allocated(error)) call fail(error%message)
+      call prepare_solver(model%factor, solver)
+      allocate (r(model%n), b(model%n))
+      call random_number(r)
+      zero = runtime_one() - 1
+      count = max(10, int(4.0e7_wp/model%n))
+      do rep = 1, repeats
+         t_fma(rep) = fma_latency()
+         b = r
+         call system_clock(t0, rate)
+         do k = 1, count
+            call cholesky_solve(model%factor, b)
+            b = r + zero*b
+         end do
+         call system_clock(t1)
+         t_lapack(rep) = 1.0e9_wp*real(t1 - t0, wp)/real(rate, wp)/count
+         b = r
+         call system_clock(t0, rate)
+         do k = 1, count
+            call fused_solve(solver, b)
+            b = r + zero*b
+         end do
+         call system_clock(t1)
+         t_fused(rep) = 1.0e9_wp*real(t1 - t0, wp)/real(rate, wp)/count
+      end do
+      call put('n', real(model%n, wp))
+      call put('fma_latency_ns', median(t_fma))
+      call put('solve_lapack_ns', median(t_lapack))
+      call put('solve_fused_ns', median(t_fused))
+      call put('solve_lapack_fmas', median(t_lapack/t_fma))
+      call put('solve_fused_fmas', median(t_fused/t_fma))
+   end subroutine bench_solve
+
+   !> Engine steps with a recorder that keeps nothing: the fused path and the LAPACK path.
+   subroutine bench_step(elements, law_text, every, steps, repeats, paths)
+      integer, intent(in) :: elements, every, steps, repeats
+      character(len=*), intent(in) :: law_text, paths
+      type(scene_type) :: scene
+      type(model_type) :: model
+      type(error_type), allocatable :: error
+      real(wp) :: t_fused(repeats), t_lapack(repeats), t_fma(repeats), beta
+      integer :: rep, law
+      law = law_code(law_text)
+      if (law < 0) call fail('unknown law '//trim(law_text))
+      beta = merge(0.25_wp, 0.5_wp, law == law_compliance)
+      call paper_scene(scene, elements, 1.0e-6_wp, beta, law)
+      scene%t_end = 1.0e-6_wp*(steps + 1)
+      scene%record_every = huge(1)
+      if (every > 0) scene%record_every = every
+      call build_model(scene, model, error)
+      if (allocated(error)) call fail(error%message)
+      do rep = 1, repeats
+         t_fma(rep) = fma_latency()
+         t_fused(rep) = 0
+         t_lapack(rep) = 0
+         if (paths /= 'lapack') t_fused(rep) = time_steps(scene, model, steps, .false.)
+         if (paths /= 'fused') t_lapack(rep) = time_steps(scene, model, steps, .true.)
+      end do
+      call put('n', real(model%n, wp))
+      call put('fma_latency_ns', median(t_fma))
+      call put('step_fused_ns', median(t_fused))
+      call put('step_lapack_ns', median(t_lapack))
+      call put('step_fused_min_ns', minval(t_fused))
+      call put('step_lapack_min_ns', minval(t_lapack))
+      call put('step_fused_fmas', median(t_fused/t_fma))
+      call put('step_lapack_fmas', median(t_lapack/t_fma))
+   end subroutine bench_step
+
+   !> Nanoseconds per step of `steps` steps from the start, on the fused or the LAPACK path.
+   function time_steps(scene, model, steps, lapack) result(ns)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      integer, intent(in) :: steps
+      logical, intent(in) :: lapack
+      real(wp) :: ns
+      type(state_type) :: state
+      type(null_recorder) :: recorder
+      type(error_type), allocatable :: error
+      integer(int64) :: t0, t1, rate
+      call start_state(scene, model, state, recorder, error)
+      if (allocated(error)) call fail(error%message)
+      state%lapack_solve = lapack
+      call system_clock(t0, rate)
+      call advance(scene, model, state, recorder, int(steps, ik))
+      call system_clock(t1)
+      ns = 1.0e9_wp*real(t1 - t0, wp)/real(rate, wp)/steps
+      if (recorder%sink == 12345) print *, recorder%sink
+   end function time_steps
+
+   !> Memory bandwidth of a = b + s c (GB/s, 24 bytes per element as STREAM counts them).
+   subroutine bench_triad(megabytes, repeats)
+      integer, intent(in) :: megabytes, repeats
+      real(wp), allocatable :: a(:), b(:), c(:)
+      real(wp) :: s, rates(repeats)
+      integer(int64) :: t0, t1, rate
+      integer :: n, rep, k
+      integer, parameter :: passes = 10
+      n = int(int(megabytes, int64)*1000000_int64/8)
+      allocate (a(n), b(n), c(n))
+      a = 0
+      b = 1
+      c = 2
+      s = runtime_one()
+      do rep = 1, repeats
+         call system_clock(t0, rate)
+         do k = 1, passes
+            a = b + s*c
+            b(1) = a(n)
+         end do
+         call system_clock(t1)
+         rates(rep) = 24.0_wp*n*passes/(real(t1 - t0, wp)/real(rate, wp))/1.0e9_wp
+      end do
+      call put('triad_GBps', median(rates))
+      if (a(1) == 12345) print *, a(1)
+   end subroutine bench_triad
+
+   !> The paper's scene (defaults of scene_type) with J elements, dt, beta and a contact law;
+   !> the compliance stiffness is the paper's 1/epsilon = 1e8 per unit mass.
+   subroutine paper_scene(scene, elements, dt, beta, law)
+      type(scene_type), intent(out) :: scene
+      integer, intent(in) :: elements, law
+      real(wp), intent(in) :: dt, beta
+      scene%elements = elements
+      scene%dt = dt
+      scene%beta = beta
+      scene%law = law
+      if (law == law_compliance) scene%stiffness_per_mass = 1.0e8_wp
+      scene%output_file = 'unused.h5'
+   end subroutine paper_scene
+
+   !> 1, but not known to the compiler.
+   function runtime_one() result(one)
+      real(wp) :: one
+      character(len=8) :: text
+      call get_environment_variable('BEAMSTOPS_BENCH_NEVER_SET', text)
+      one = merge(2.0_wp, 1.0_wp, text == 'two')
+   end function runtime_one
+
+   function median_of(f, repeats) result(m)
+      interface
+         function f() result(y)
+            import :: wp
+            real(wp) :: y
+         end function f
+      end interface
+      integer, intent(in) :: repeats
+      real(wp) :: m, t(repeats)
+      integer :: k
+      do k = 1, repeats
+         t(k) = f()
+      end do
+      m = median(t)
+   end function median_of
+
+   function median(t) result(m)
+      real(wp), intent(in) :: t(:)
+      real(wp) :: m, s(size(t)), v
+      integer :: i, j
+      s = t
+      do i = 2, size(s)
+         v = s(i)
+         j = i - 1
+         do while (j >= 1)
+            if (s(j) <= v) exit
+            s(j + 1) = s(j)
+            j = j - 1
+         end do
+         s(j + 1) = v
+      end do
+      m = 0.5_wp*(s((size(s) + 1)/2) + s(size(s)/2 + 1))
+   end function median
+
+   subroutine put(key, value)
+      character(len=*), intent(in) :: key
+      real(wp), intent(in) :: value
+      print '(a, 1x, es16.9)', key, value
+   end subroutine put
+
+   function argument(i, default) result(text)
+      integer, intent(in) :: i
+      character(len=*), intent(in) :: default
+      character(len=64) :: text
+      text = default
+      if (command_argument_count() >= i) call get_command_argument(i, text)
+   end function argument
+
+   function int_argument(i, default) result(value)
+      integer, intent(in) :: i, default
+      integer :: value, status
+      character(len=64) :: text
+      value = default
+      if (command_argument_count() < i) return
+      call get_command_argument(i, text)
+      read (text, *, iostat=status) value
+      if (status /= 0) call fail('not an integer: '//trim(text))
+   end function int_argument
+
+   subroutine fail(message)
+      character(len=*), intent(in) :: message
+      write (error_unit, '(a)') 'bench_kernels: '//message
+      error stop 1
+   end subroutine fail
+end program bench_kernels
