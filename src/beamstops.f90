@@ -15,6 +15,7 @@ module beamstops
    use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed
    use beamstops_run, only: prepare_run, simulate
    use beamstops_version, only: version
+   use beamstops_three_level, only: run_three_level
    implicit none
    private
    public :: wp, ik, error_type, fatal_error
@@ -24,4 +25,5 @@ module beamstops
    public :: recorder_type, n_columns, array_recorder, hdf5_recorder
    public :: run_summary, status_complete, status_diverged, status_failed
    public :: prepare_run, simulate, record_count, snapshot_count, output_bytes, version
+   public :: run_three_level
 end module beamstops

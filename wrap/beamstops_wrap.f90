@@ -274,3 +274,125 @@ subroutine bs_tube(youngs_modulus, density, outer_diameter, wall_thickness, k2, 
    real(8), intent(out) :: k2, mass_per_length
    call tube_beam(youngs_modulus, density, outer_diameter, wall_thickness, k2, mass_per_length)
 end subroutine bs_tube
+
+!> Studies: a scene without stops run in the paper's three-level form (module
+!> beamstops_three_level), recording the tip every record_every steps; `records` from bs_sizes.
+!> Only to measure the round-off floor that the engine's increment form removes (SPEC 4).
+subroutine bs_run_three_level(length, k2, mass_per_length, amplitude, omega, lower, upper, law, &
+   & stiffness_per_mass, elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, &
+   & snapshot_every, max_output_gb, records, t, tip_u, cpu_seconds, status, message)
+   use beamstops, only: error_type, fatal_error, scene_type, validate_scene, record_count, model_type, &
+      & prepare_run, run_three_level
+   use beamstops_wrap_support, only: make_scene, report
+   implicit none
+   !f2py threadsafe
+   real(8), intent(in) :: length, k2, mass_per_length, amplitude, omega, lower, upper, stiffness_per_mass
+   real(8), intent(in) :: dt, t_end, beta, max_output_gb
+   integer(8), intent(in) :: law, elements, centered_load, taylor_start, allow_unstable, record_every, snapshot_every
+   integer(8), intent(in) :: records
+   real(8), intent(out) :: t(records), tip_u(records), cpu_seconds
+   integer, intent(out) :: status
+   character(len=1024), intent(out) :: message
+   type(scene_type) :: scene
+   type(model_type) :: model
+   type(error_type), allocatable :: error
+   real(8), allocatable :: tt(:), uu(:)
+   t = 0; tip_u = 0; cpu_seconds = 0
+   call make_scene(length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, &
+      & elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, &
+      & max_output_gb, 'scene', scene, error)
+   if (.not. allocated(error)) call validate_scene(scene, 'scene', error)
+   if (.not. allocated(error)) then
+      if (records /= record_count(scene)) call fatal_error(error, 'scene: the arrays given to '// &
+         & 'bs_run_three_level do not have the size bs_sizes returns for this scene')
+   end if
+   if (.not. allocated(error)) call prepare_run(scene, 'scene', model, error)
+   if (.not. allocated(error)) call run_three_level(scene, model, tt, uu, cpu_seconds, error)
+   if (.not. allocated(error)) then
+      t = tt
+      tip_u = uu
+   end if
+   call report(error, status, message)
+end subroutine bs_run_three_level
+
+!> Studies: the full state of the engine's own loop (start_state, advance) at chosen steps,
+!> u^n (the homogeneous unknown, 2J values and slopes) and v^n = (u^{n+1} - u^{n-1})/(2 dt),
+!> with M and S (band storage, per unit mass). Rationale: the energy norm of an error,
+!> 1/2 e'.M e' + 1/2 e.S e, needs slopes and velocities, which the records (tip) and the
+!> snapshots (nodal values) do not hold. `steps` ascending in 0..steps_of(scene); n = 2J.
+subroutine bs_states(length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, &
+   & elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, &
+   & max_output_gb, count, steps, n, u, v, mass, stiffness, cpu_seconds, status, message)
+   use beamstops, only: error_type, fatal_error, scene_type, validate_scene, steps_of, model_type, prepare_run, &
+      & state_type, start_state, array_recorder
+   use beamstops_scheme, only: advance
+   use beamstops_wrap_support, only: make_scene, report
+   implicit none
+   !f2py threadsafe
+   real(8), intent(in) :: length, k2, mass_per_length, amplitude, omega, lower, upper, stiffness_per_mass
+   real(8), intent(in) :: dt, t_end, beta, max_output_gb
+   integer(8), intent(in) :: law, elements, centered_load, taylor_start, allow_unstable, record_every, snapshot_every
+   integer(8), intent(in) :: count, n
+   integer(8), intent(in) :: steps(count)
+   real(8), intent(out) :: u(n, count), v(n, count), mass(4, n), stiffness(4, n), cpu_seconds
+   integer, intent(out) :: status
+   character(len=1024), intent(out) :: message
+   type(scene_type) :: scene
+   type(model_type) :: model
+   type(state_type) :: state
+   type(array_recorder) :: recorder
+   type(error_type), allocatable :: error
+   real(8), allocatable :: d_prev(:)
+   real(8) :: t0, t1
+   integer(8) :: k, step
+   u = 0; v = 0; mass = 0; stiffness = 0; cpu_seconds = 0
+   call make_scene(length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, &
+      & elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, &
+      & max_output_gb, 'scene', scene, error)
+   if (.not. allocated(error)) call validate_scene(scene, 'scene', error)
+   if (.not. allocated(error)) then
+      if (n /= 2*scene%elements) call fatal_error(error, 'scene: bs_states needs n = 2*elements')
+   end if
+   if (.not. allocated(error)) then
+      do k = 1, count
+         if (steps(k) < 0 .or. steps(k) > steps_of(scene) .or. (k > 1 .and. steps(max(k - 1, 1_8)) >= steps(k))) &
+            & call fatal_error(error, 'scene: bs_states needs ascending steps in 0..steps of the scene')
+         if (allocated(error)) exit
+      end do
+   end if
+   if (allocated(error)) then
+      call report(error, status, message)
+      return
+   end if
+   ! Records are not wanted here: one row (t = 0), no snapshots.
+   scene%record_every = huge(scene%record_every)
+   scene%snapshot_every = 0
+   call prepare_run(scene, 'scene', model, error)
+   if (.not. allocated(error)) then
+      call recorder%reserve(2_8, 0_8, scene%elements + 1)
+      call start_state(scene, model, state, recorder, error)
+   end if
+   if (allocated(error)) then
+      call report(error, status, message)
+      return
+   end if
+   mass = model%mass
+   stiffness = model%stiffness
+   call cpu_time(t0)
+   do k = 1, count
+      step = steps(k)
+      if (step == 0) then
+         u(:, k) = model%u0
+         v(:, k) = model%v0
+         cycle
+      end if
+      if (state%step <= step - 1) call advance(scene, model, state, recorder, step - 1)
+      d_prev = state%d
+      call advance(scene, model, state, recorder, step)
+      u(:, k) = state%u - state%d
+      v(:, k) = (state%d + d_prev)/(2*dt)
+   end do
+   call cpu_time(t1)
+   cpu_seconds = t1 - t0
+   call report(error, status, message)
+end subroutine bs_states

@@ -44,6 +44,10 @@ def register_plot(subparsers: argparse._SubParsersAction) -> None:
 #: Subcommand registrars, in the order `--help` lists them.
 COMMANDS: list[Callable[[argparse._SubParsersAction], None]] = [register_plot]
 
+from .studies.cli import STUDIES  # noqa: E402  (issue 6: converge, work-precision, stability-map, compliance)
+
+COMMANDS += STUDIES
+
 
 def build_parser() -> argparse.ArgumentParser:
     from . import version

@@ -1,0 +1,14 @@
+"""Work-precision chart (PNG, markdown, CSV) into out/work_precision.
+
+Runs the installed package's study (beamstops.studies.workprecision); options: --quick (seconds),
+-o DIR, --quiet; see --help. Same as `python -m beamstops work-precision`.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from beamstops.studies.workprecision import main
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,37 @@
+"""Stability map (issue 6): classification of small cases against the known limits."""
+
+from __future__ import annotations
+
+import beamstops
+from beamstops import Scene
+from beamstops.studies import stability_map
+
+BASE = Scene(elements=8, t_end=0.05)
+
+
+def _verdict(scene: Scene) -> str:
+    scale = stability_map.energy_scale(scene)
+    return stability_map._run_point(scene, scale, 10.0)[0]
+
+
+def test_explicit_scheme_around_its_linear_limit() -> None:
+    scene = BASE.replace(beta=0.0)
+    limit = beamstops.stability(scene).dt_limit_newmark
+    assert beamstops.stability(scene.replace(dt=1.5 * limit)).refusal is not None
+    assert _verdict(scene.replace(dt=0.5 * limit)) == "stable"
+    assert _verdict(scene.replace(dt=1.5 * limit)) == "unstable"
+
+
+def test_projected_scheme_beyond_the_paper_condition() -> None:
+    scene = BASE.replace(beta=0.25)
+    limit = beamstops.stability(scene).dt_limit_paper
+    assert _verdict(scene.replace(dt=10 * limit)) == "stable"
+
+
+def test_map_and_answer() -> None:
+    table = stability_map.beta_map(BASE, (0.0, 0.25), (1e-5, 2e-4), quiet=True)
+    verdicts = {(row[0], row[2]): row[3] for row in table.rows}
+    assert verdicts == {(0.0, 1e-5): "stable", (0.0, 2e-4): "unstable", (0.25, 1e-5): "stable",
+                        (0.25, 2e-4): "stable"}
+    text = stability_map.answer(table)
+    assert "1 runs, 0 unstable" in text and "beyond the linear Newmark limit: 1 runs, 1 unstable" in text

@@ -1,0 +1,8 @@
+"""Studies of speed against accuracy (issue 6): convergence tables, work-precision charts,
+stability maps, normal compliance. Each module has a ``study`` function writing PNGs,
+markdown and CSV into out/<study>, a ``register`` for ``python -m beamstops`` and a ``main``
+for scripts/. Every run and every CPU time comes from the engine; these modules compare,
+classify and draw.
+"""
+
+__all__ = ["common", "convergence", "workprecision", "stability_map", "compliance", "cli"]

@@ -1,0 +1,129 @@
+"""Work-precision: error against the engine's CPU time, one curve per method.
+
+Methods: the Signorini scheme with β = 0, 1/4, 1/2 (centred load rule), the same with the
+paper's load rule, and normal compliance (β = 1/4) with 1/ε from 1e6 to 1e10 per unit mass.
+Each is run at a sequence of Δt; its error is the max (and L²) of the tip displacement
+against one fine reference run of the Signorini scheme (β = 1/2, centred) over [0, window]
+(default the first contact period, [0, 0.2] s, where runs of different Δt agree); the cost
+is the engine's ``cpu_seconds`` (the time loop's CPU time). Read the chart horizontally:
+at a given error, the leftmost curve is the fastest method.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+
+from ..scene import Scene
+from .common import Table, out_dir, progress, run_tip, tip_error
+
+__all__ = ["Method", "methods", "study", "draw", "main", "register"]
+
+
+@dataclass(frozen=True)
+class Method:
+    """A method: its label, the scene changes that select it and its time steps."""
+
+    label: str
+    changes: dict[str, object]
+    dts: tuple[float, ...]
+
+
+def methods(quick: bool = False) -> list[Method]:
+    """The methods of the chart, each with Δt = grid/2^k (β = 0 below its stability limit)."""
+    k = 3 if quick else 7
+    coarse = tuple(4e-5 / 2**i for i in range(k))
+    explicit = tuple(1e-5 / 2**i for i in range(k - 2 if not quick else 2))
+    out = [Method("Signorini β=0", {"beta": 0.0}, explicit),
+           Method("Signorini β=1/4", {"beta": 0.25}, coarse),
+           Method("Signorini β=1/2", {"beta": 0.5}, coarse),
+           Method("Signorini β=1/4, paper's load", {"beta": 0.25, "load_rule": "paper"}, coarse),
+           Method("Signorini β=1/2, paper's load", {"beta": 0.5, "load_rule": "paper"}, coarse)]
+    for stiffness in ((1e6, 1e8, 1e10) if quick else (1e6, 1e7, 1e8, 1e9, 1e10)):
+        out.append(Method(f"compliance 1/ε={stiffness:.0e}", {"beta": 0.25, "law": "compliance",
+                                                             "stiffness_per_mass": stiffness}, coarse))
+    return out
+
+
+def study(folder: Optional[Path] = None, *, quick: bool = False, window: float = 0.2,
+          quiet: bool = False) -> Table:
+    """Run every method at every Δt, write work_precision.{md,csv,png}; return the table."""
+    folder = out_dir(folder, "work_precision")
+    grid = 4e-5
+    base = Scene(t_end=window if not quick else min(window, 0.05))
+    window = base.t_end
+    finest = min(min(m.dts) for m in methods(quick))
+    ref = run_tip(base.replace(beta=0.5, dt=finest / 8), grid)
+    runs = [(m, dt) for m in methods(quick) for dt in m.dts]
+    rows: list[list[object]] = []
+    for m, dt in progress(runs, "work-precision", quiet=quiet):
+        result = run_tip(base.replace(dt=dt, **m.changes), grid)  # type: ignore[arg-type]
+        e = tip_error(result, ref, window)
+        rows.append([m.label, dt, result.attrs["cpu_seconds"], e.max, e.l2, result.attrs["max_violation"],
+                     result.status])
+    table = Table(f"Work-precision on [0, {window:g}] s", ["method", "Δt (s)", "CPU (s)", "max err (m)",
+                                                           "L2 err (m s^1/2)", "max violation (m)", "status"], rows)
+    table.note = (f"paper's scene (J = {base.elements}), T = {window:g} s; reference: Signorini β = 1/2, centred load, "
+                  f"Δt = {finest / 8:g} s; CPU: the engine's time-loop CPU time of each run.")
+    table.write(folder, "work_precision")
+    draw(table, folder / "work_precision.png")
+    return table
+
+
+def draw(table: Table, path: Path) -> Path:
+    """Error against CPU time, log-log, one curve per method."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(8.5, 5.5), layout="constrained")
+    ax = fig.add_subplot()
+    labels = list(dict.fromkeys(table.column("method")))
+    cmap = {"Signorini": "tab:blue", "compliance": "tab:red"}
+    styles = ["o-", "s-", "^-", "v--", "D--", "x:", "+:", "*:", "p:", "h:"]
+    for i, label in enumerate(labels):
+        rows = [r for r in table.rows if r[0] == label]
+        cpu = np.array([max(float(r[2]), 1e-6) for r in rows])  # type: ignore[arg-type]
+        err = np.array([float(r[3]) for r in rows])  # type: ignore[arg-type]
+        keep = np.isfinite(err) & (err > 0)
+        colour = None if not label.startswith("compliance") else None
+        ax.loglog(cpu[keep], err[keep], styles[i % len(styles)], label=label, color=colour, markersize=4)
+    ax.set_xlabel("engine CPU time of the run (s)")
+    ax.set_ylabel("max |u(L,t) − u_ref(L,t)| (m)")
+    ax.set_title(table.title + " — lower left is better")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    del cmap
+    fig.savefig(path, dpi=120)
+    return path
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """``work-precision [-o DIR] [--quick] [--window T]``."""
+    parser = subparsers.add_parser("work-precision", help="error against CPU time for every method (PNG, md, CSV)",
+                                   description="Work-precision chart: tip error against the engine's CPU time.")
+    _arguments(parser)
+    parser.set_defaults(handler=_handler)
+
+
+def _arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("-o", "--output", type=Path, help="output folder (default out/work_precision)")
+    parser.add_argument("--quick", action="store_true", help="small sizes (seconds), for tests and CI")
+    parser.add_argument("--window", type=float, default=0.2, help="compare on [0, WINDOW] s (default 0.2)")
+    parser.add_argument("--quiet", action="store_true", help="no progress bars")
+
+
+def _handler(args: argparse.Namespace) -> int:
+    folder = out_dir(args.output, "work_precision")
+    study(folder, quick=args.quick, window=args.window, quiet=args.quiet)
+    print(folder / "work_precision.png")
+    return 0
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    parser = argparse.ArgumentParser(prog="study_workprecision", description=__doc__.splitlines()[0])
+    _arguments(parser)
+    return _handler(parser.parse_args(argv))
