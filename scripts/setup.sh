@@ -23,6 +23,14 @@ if command -v "$python" >/dev/null; then
   inc=$("$python" -c 'import sysconfig; print(sysconfig.get_paths()["include"])')
   [ -f "$inc/Python.h" ] || missing+=(python3-dev)
 fi
+# MPI, for sweeps on several ranks (python -m mpi4py.futures -m beamstops sweep): optional;
+# installed when root, otherwise named below (the MPI tests then skip).
+optional=()
+command -v mpiexec >/dev/null || optional+=(openmpi-bin libopenmpi-dev)
+if [ "$(id -u)" -eq 0 ] && [ ${#optional[@]} -gt 0 ]; then
+  missing+=("${optional[@]}")
+  optional=()
+fi
 if [ ${#missing[@]} -gt 0 ]; then
   if [ "$(id -u)" -eq 0 ]; then
     echo "setup: installing Debian packages: ${missing[*]}" >&2
@@ -35,6 +43,9 @@ if [ ${#missing[@]} -gt 0 ]; then
     exit 1
   fi
 fi
+if [ ${#optional[@]} -gt 0 ]; then
+  echo "setup: optional, for MPI sweeps: sudo apt-get install -y ${optional[*]}" >&2
+fi
 
 if [ ! -x .venv/bin/python ]; then
   "$python" -m venv .venv
@@ -43,4 +54,8 @@ fi
 # Build tools for the Fortran tests (meson test), then the package itself.
 .venv/bin/python -m pip install -q 'meson>=1.1' ninja meson-python numpy pytest
 .venv/bin/python -m pip install -q --no-build-isolation '.[test]'
+# mpi4py (PyPI) over the system's MPI, for sweeps on MPI ranks.
+if command -v mpiexec >/dev/null; then
+  .venv/bin/python -m pip install -q mpi4py
+fi
 echo "setup: ready: $(.venv/bin/beamstops --version) in .venv (program .venv/bin/beamstops)" >&2

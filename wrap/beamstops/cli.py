@@ -44,6 +44,11 @@ def register_plot(subparsers: argparse._SubParsersAction) -> None:
 #: Subcommand registrars, in the order `--help` lists them.
 COMMANDS: list[Callable[[argparse._SubParsersAction], None]] = [register_plot]
 
+# Parameter sweeps (issue 7): `sweep SPEC -o DIR`.
+from .sweep.cli import register_sweep  # noqa: E402
+
+COMMANDS.append(register_sweep)
+
 from .studies.cli import STUDIES  # noqa: E402  (issue 6: converge, work-precision, stability-map, compliance)
 
 COMMANDS += STUDIES

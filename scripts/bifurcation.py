@@ -1,0 +1,124 @@
+#!/usr/bin/env python3
+"""Bifurcation diagram: the tip's stroboscopic displacement against the forcing frequency ω.
+
+Runs the sweep input/sweeps/bifurcation.toml (``python -m beamstops sweep``'s machinery,
+resumable: a second call only draws) and draws from its summary table:
+
+- top: u(L, kT), T = 2π/ω, for every k after the transient (one dot per sample), with
+  the stops; a point whose samples repeat with a period p (``strobe_period``) is drawn
+  in colour, the others in black;
+- bottom: the energy the stops take per forcing period over the whole run, and the
+  number of impacts per period.
+
+Usage::
+
+    python scripts/bifurcation.py                      # 300 points, out/bifurcation/bifurcation.png
+    python scripts/bifurcation.py --quick              # 12 short points (a test), out/bifurcation-quick/
+    python scripts/bifurcation.py -j 8 -o DIR --png FILE
+    mpiexec -n 9 python -m mpi4py.futures scripts/bifurcation.py   # on MPI ranks
+
+Every number comes from the engine's HDF5 outputs (the program's runs); this script only
+samples and draws them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import shlex
+import sys
+from pathlib import Path
+from typing import Any, Optional, Sequence
+
+import numpy as np
+from matplotlib import rc_context
+from matplotlib.figure import Figure
+
+from beamstops import sweep
+
+ROOT = Path(__file__).resolve().parents[1]
+SPEC = ROOT / "input" / "sweeps" / "bifurcation.toml"
+#: --quick: a dozen short runs, for tests and a first look (a different hash, so another folder).
+QUICK = ("axes.omega.num=12", "periods.t_end=16", "reductions.strobe.transient_periods=8",
+         "reductions.u_max.after_periods=8")
+
+
+def draw(rows: list[dict[str, Any]], path: Path, title: str = "", stops: Sequence[float] = ()) -> Path:
+    """The diagram of a sweep's summary rows (an axis omega, a strobe reduction named 'strobe')."""
+    done = [r for r in rows if r.get("status") == "complete" and r.get("strobe")]
+    bad = [r for r in rows if r.get("status") not in ("complete", "pending")]
+    with rc_context({"font.size": 9}):
+        fig = Figure(figsize=(8.0, 6.4), constrained_layout=True)
+        top, bottom = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.3]})
+        for periodic in (False, True):
+            chosen = [r for r in done if bool(r.get("strobe_period")) == periodic]
+            x = np.concatenate([np.full(len(r["strobe"]), r["omega"]) for r in chosen]) if chosen else np.empty(0)
+            y = np.concatenate([np.asarray(r["strobe"], dtype=float) for r in chosen]) if chosen else np.empty(0)
+            if x.size:
+                top.scatter(x, y, s=1.5, linewidths=0, color="tab:blue" if periodic else "k",
+                            label="period-p motion (strobe_period > 0)" if periodic else "no period ≤ max_period")
+        if bad:
+            top.scatter([r["omega"] for r in bad], np.zeros(len(bad)), marker="x", color="tab:red", s=12,
+                        label=f"failed or diverged ({len(bad)})")
+        for g in stops:
+            top.axhline(g, color="tab:red", linewidth=0.8, linestyle="--")
+        top.set_ylabel("tip displacement u(L, kT) (m)")
+        top.set_title(title or "Stroboscopic tip displacement, T = 2π/ω")
+        if len(top.get_legend_handles_labels()[0]):
+            top.legend(loc="upper right", fontsize=7, markerscale=4)
+        omega = np.array([r["omega"] for r in done])
+        if omega.size:
+            periods = np.array([r["t_end"] * r["omega"] / (2 * math.pi) for r in done])
+            energy = np.array([(r.get("dissipated") or 0.0) for r in done]) / periods
+            impacts = np.array([(r.get("impacts") or 0) for r in done]) / periods
+            bottom.plot(omega, energy, color="k", linewidth=0.8, label="energy taken by the stops per period (J)")
+            bottom.set_ylabel("J per period")
+            twin = bottom.twinx()
+            twin.plot(omega, impacts, color="tab:orange", linewidth=0.8, label="impacts per period")
+            twin.set_ylabel("impacts per period", color="tab:orange")
+            bottom.legend(loc="upper left", fontsize=7)
+        bottom.set_xlabel("forcing frequency ω (rad/s)")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fig.savefig(path, dpi=150)
+    return path
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--spec", type=Path, default=SPEC, help=f"sweep specification (default: {SPEC.relative_to(ROOT)})")
+    parser.add_argument("-o", "--output", type=Path, help="sweep folder (default: out/bifurcation, "
+                                                          "out/bifurcation-quick with --quick)")
+    parser.add_argument("--png", type=Path, help="image (default: OUTPUT/bifurcation.png)")
+    parser.add_argument("--quick", action="store_true", help="12 short points (tests)")
+    parser.add_argument("-j", "--jobs", type=int, help="local worker processes (default: every core)")
+    parser.add_argument("--executor", choices=sweep.EXECUTORS, default="auto")
+    parser.add_argument("--set", action="append", default=[], metavar="TABLE.KEY=VALUE",
+                        help="change the specification (see python -m beamstops sweep --help)")
+    parser.add_argument("-q", "--quiet", action="store_true", help="no progress")
+    args = parser.parse_args(argv)
+
+    overrides = (list(QUICK) if args.quick else []) + list(args.set)
+    out = args.output or ROOT / "out" / ("bifurcation-quick" if args.quick else "bifurcation")
+    png = args.png or out / "bifurcation.png"
+    try:
+        spec = sweep.load_spec(args.spec, overrides=overrides)
+        outcome = sweep.run_sweep(spec, out, executor=args.executor, jobs=args.jobs,
+                                  stream=None if args.quiet else sys.stderr)
+        rows = sweep.read_summary(out)
+    except (OSError, ValueError) as exc:
+        print(f"bifurcation: error: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        return 130
+    title = (f"Stroboscopic tip displacement u(L, kT), T = 2π/ω: {len(rows)} values of ω, "
+             f"k ≥ {spec.reductions['strobe']['transient_periods']} of {spec.periods['t_end']:g} periods")
+    scene = spec.points[0].scene
+    draw(rows, png, title=title, stops=(scene.lower, scene.upper))
+    command = "python scripts/bifurcation.py" + (" --quick" if args.quick else "") + "".join(
+        f" --set {shlex.quote(s)}" for s in args.set)
+    print(f"{png}  ({outcome.complete}/{outcome.total} points complete; regenerate: {command})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

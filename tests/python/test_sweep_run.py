@@ -1,0 +1,262 @@
+"""Running sweeps on local processes: outputs, summary, failures, resuming, one spec per folder."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+import pytest
+
+import beamstops
+from beamstops.sweep import load_spec, read_summary, run_sweep
+
+ROOT = Path(__file__).resolve().parents[2]
+TIMING = ("cpu_seconds", "wall_seconds")
+
+SMALL = """
+[scene]
+elements = 4
+dt = 1e-4
+[axes]
+omega = [8.0, 20.0]
+amplitude = [0.1, 0.2]
+[periods]
+t_end = 6
+records_per_period = 8
+[reductions.strobe]
+kind = "strobe"
+transient_periods = 2
+[reductions.v_rms]
+kind = "rms"
+quantity = "tip_v"
+after_periods = 2
+"""
+
+
+def write(tmp_path: Path, text: str, name: str = "spec.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def without_timing(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    return [{k: v for k, v in row.items() if k not in TIMING} for row in rows]
+
+
+def mtimes(folder: Path) -> dict[str, int]:
+    return {p.name: p.stat().st_mtime_ns for p in sorted((folder / "points").glob("*.h5"))}
+
+
+def test_every_point_writes_its_file_and_the_summary_gathers_them(tmp_path: Path) -> None:
+    spec = load_spec(write(tmp_path, SMALL))
+    outcome = run_sweep(spec, tmp_path / "out", jobs=2, stream=None)
+    assert (outcome.total, outcome.complete, outcome.failed, outcome.ran) == (4, 4, 0, 4)
+    rows = read_summary(tmp_path / "out")
+    assert [(r["omega"], r["amplitude"]) for r in rows] == [(8.0, 0.1), (8.0, 0.2), (20.0, 0.1), (20.0, 0.2)]
+    for row, point in zip(rows, spec.points):
+        result = beamstops.load(tmp_path / "out" / row["file"])  # the program's own complete output
+        assert result.status == "complete" and result.attrs["omega"] == row["omega"]
+        assert row["steps"] == result.attrs["steps"] and row["impacts"] == result.attrs["impacts"]
+        assert row["cpu_seconds"] == result.attrs["cpu_seconds"] and row["wall_seconds"] > 0
+        assert row["max_violation"] == 0.0 and row["dissipated"] == result.dissipated[-1]
+        assert row["dt"] == point.scene.dt and row["record_every"] == point.scene.record_every
+        # the strobe: u(L, kT) for k = 2..6 are records k*8 of a grid locked to the forcing
+        assert row["strobe"] == result.tip_u[[8 * k for k in range(2, 7)]].tolist()
+        assert row["strobe_offset"] < 1e-12
+        period = 2 * math.pi / row["omega"]
+        v = result.tip_v[result.t >= 2 * period * (1 - 1e-12)]
+        assert row["v_rms"] == pytest.approx(float(np.sqrt(np.mean(v * v))), rel=1e-15)
+    # the namelist each point ran, and the specification with its hash
+    assert beamstops.Scene.from_namelist(tmp_path / "out" / "points" / "00003.nml").omega == 20.0
+    manifest = json.loads((tmp_path / "out" / "sweep.json").read_text())
+    assert manifest["spec_hash"] == spec.hash and (tmp_path / "out" / "spec.toml").read_text() == SMALL
+    header = (tmp_path / "out" / "summary.csv").read_text().splitlines()[0].split(",")
+    assert header[:8] == ["point", "omega", "amplitude", "status", "cpu_seconds", "wall_seconds", "steps", "impacts"]
+    assert {"max_violation", "dissipated", "strobe", "strobe_offset", "strobe_period", "v_rms", "message"} <= set(header)
+
+
+def test_a_failed_point_is_recorded_and_the_sweep_goes_on(tmp_path: Path) -> None:
+    spec = load_spec(write(tmp_path, """
+[scene]
+elements = 4
+t_end = 0.05
+beta = 0.0
+[axes]
+dt = [1e-4, 1e-3, 2e-5]
+"""))
+    outcome = run_sweep(spec, tmp_path / "out", jobs=2, stream=None)
+    assert (outcome.complete, outcome.failed) == (2, 1)
+    rows = read_summary(tmp_path / "out")
+    assert [r["status"] for r in rows] == ["complete", "failed", "complete"]
+    assert "dt" in rows[1]["message"] and "beamstops" in rows[1]["message"]  # the program's one-line message
+    # a failed point runs again on the next call; finished ones do not
+    again = run_sweep(spec, tmp_path / "out", jobs=2, stream=None)
+    assert (again.ran, again.skipped, again.failed) == (1, 2, 1)
+
+
+def test_a_diverged_run_is_finished_and_kept(tmp_path: Path) -> None:
+    spec = load_spec(write(tmp_path, """
+[scene]
+elements = 4
+t_end = 0.5
+beta = 0.0
+allow_unstable = true
+[axes]
+dt = [1e-4, 1e-3]
+"""))
+    outcome = run_sweep(spec, tmp_path / "out", jobs=2, stream=None)
+    assert (outcome.complete, outcome.diverged, outcome.failed) == (1, 1, 0)
+    row = read_summary(tmp_path / "out")[1]
+    assert row["status"] == "diverged" and "diverged" in row["message"]
+    assert beamstops.load(tmp_path / "out" / row["file"], allow_incomplete=True).status == "diverged"
+    # the engine went to its end: resuming does not run it again
+    assert run_sweep(spec, tmp_path / "out", stream=None).ran == 0
+
+
+def test_a_point_over_its_time_limit_fails_alone(tmp_path: Path) -> None:
+    spec = load_spec(write(tmp_path, """
+[sweep]
+timeout = 0.5
+[scene]
+elements = 4
+dt = 1e-6
+record_every = 100000
+[axes]
+t_end = [0.01, 1000.0]
+"""))
+    start = time.perf_counter()
+    outcome = run_sweep(spec, tmp_path / "out", jobs=2, stream=None)
+    assert time.perf_counter() - start < 20
+    rows = read_summary(tmp_path / "out")
+    assert [r["status"] for r in rows] == ["complete", "failed"] and outcome.failed == 1
+    assert rows[1]["message"].startswith("timed out after 0.5 s")
+
+
+def test_resume_skips_finished_points_and_reruns_interrupted_ones(tmp_path: Path) -> None:
+    spec = load_spec(write(tmp_path, SMALL))
+    out = tmp_path / "out"
+    run_sweep(spec, out, jobs=2, stream=None)
+    first = read_summary(out)
+    before = mtimes(out)
+    points = out / "points"
+    # point 1: interrupted while running (the program marks its file 'running' until the end)
+    with h5py.File(points / "00001.h5", "r+") as f:
+        f.attrs["status"] = np.bytes_(b"running")
+    # point 2: the run finished but its record was not written; point 3: never started
+    (points / "00002.json").unlink()
+    (points / "00003.h5").unlink()
+    (points / "00003.json").unlink()
+    time.sleep(0.01)
+    outcome = run_sweep(spec, out, jobs=2, stream=None)
+    assert (outcome.ran, outcome.skipped, outcome.complete) == (3, 1, 4)
+    after = mtimes(out)
+    assert after["00000.h5"] == before["00000.h5"]  # skipped
+    assert after["00001.h5"] != before["00001.h5"]  # run again
+    assert after["00002.h5"] == before["00002.h5"]  # only reduced again from its complete file
+    assert without_timing(read_summary(out)) == without_timing(first)
+
+
+def test_resume_after_a_real_interruption_gives_the_uninterrupted_results(tmp_path: Path) -> None:
+    text = """
+[scene]
+elements = 10
+dt = 2e-5
+t_end = 12.0
+[axes]
+amplitude = { start = 0.10, stop = 0.15, step = 0.01 }
+"""
+    spec_path = write(tmp_path, text)
+    out = tmp_path / "out"
+    command = [sys.executable, "-m", "beamstops", "sweep", str(spec_path), "-o", str(out), "-j", "1", "--interval", "0.1"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               start_new_session=True)
+    deadline = time.monotonic() + 60
+    while not list((out / "points").glob("*.json")) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    os.killpg(process.pid, signal.SIGTERM)  # a batch system's time limit: the whole job
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 130, err
+    assert "interrupted" in err and "Traceback" not in err
+    statuses = [r["status"] for r in read_summary(out)]
+    assert "complete" in statuses and "pending" in statuses, statuses
+    done = subprocess.run(command, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert "done before" in done.stderr
+    resumed = read_summary(out)
+    assert all(r["status"] == "complete" for r in resumed)
+    clean = run_sweep(load_spec(spec_path), tmp_path / "clean", jobs=2, stream=None)
+    assert clean.complete == len(resumed)
+    assert without_timing(read_summary(tmp_path / "clean")) == without_timing(resumed)
+
+
+def test_a_folder_holds_one_specification(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from beamstops import cli
+
+    spec_path = write(tmp_path, SMALL)
+    out = tmp_path / "out"
+    assert cli.main(["sweep", str(spec_path), "-o", str(out), "-j", "2", "-q"]) == 0
+    other = write(tmp_path, SMALL.replace("t_end = 6", "t_end = 7"), "other.toml")
+    assert cli.main(["sweep", str(other), "-o", str(out), "-q"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"beamstops: error: {out}: holds the results of another specification") and "hash" in err
+    # the same spec with a --set is another spec too
+    assert cli.main(["sweep", str(spec_path), "-o", str(out), "-q", "--set", "scene.elements=5"]) == 1
+    # a folder that is not a sweep's is not used
+    (tmp_path / "busy").mkdir()
+    (tmp_path / "busy" / "notes.txt").write_text("mine")
+    assert cli.main(["sweep", str(spec_path), "-o", str(tmp_path / "busy"), "-q"]) == 1
+    assert "not a sweep folder" in capsys.readouterr().err
+    # the same spec resumes (nothing left to run)
+    assert cli.main(["sweep", str(spec_path), "-o", str(out)]) == 0
+    assert "4 complete" in capsys.readouterr().err
+
+
+def test_progress_lines_in_a_log(tmp_path: Path) -> None:
+    import io
+
+    spec = load_spec(write(tmp_path, SMALL))
+    log = io.StringIO()
+    run_sweep(spec, tmp_path / "out", jobs=2, stream=log, interval=0.0)
+    lines = log.getvalue().splitlines()
+    assert lines[0].startswith("sweep: 4 points in") and "to run on 2 local processes" in lines[0]
+    assert any("4/4 points done, 0 failed" in line and "left" in line for line in lines)
+    assert "\r" not in log.getvalue()
+    assert lines[-1].startswith("sweep: 4 points: 4 complete, 0 diverged, 0 failed")
+
+
+def test_bifurcation_script_quick(tmp_path: Path) -> None:
+    png = tmp_path / "bif.png"
+    done = subprocess.run([sys.executable, str(ROOT / "scripts" / "bifurcation.py"), "--quick", "-o",
+                           str(tmp_path / "bif"), "--png", str(png), "-j", "2", "-q"],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20000
+    assert "python scripts/bifurcation.py --quick" in done.stdout
+    rows = read_summary(tmp_path / "bif")
+    assert len(rows) == 12 and all(r["status"] == "complete" and len(r["strobe"]) == 9 for r in rows)
+
+
+def test_resuming_with_another_build_of_the_engine_says_so(tmp_path: Path, program: str) -> None:
+    import io
+    import shutil
+
+    spec = load_spec(write(tmp_path, SMALL))
+    run_sweep(spec, tmp_path / "out", jobs=2, stream=None)
+    (tmp_path / "out" / "points" / "00000.h5").unlink()
+    rebuilt = tmp_path / "beamstops"
+    shutil.copy2(program, rebuilt)
+    with open(rebuilt, "ab") as f:
+        f.write(b"\0")  # another file, the same program
+    log = io.StringIO()
+    outcome = run_sweep(spec, tmp_path / "out", jobs=1, stream=log, program=str(rebuilt))
+    assert outcome.ran == 1 and outcome.complete == 4
+    assert "another build of the engine" in log.getvalue()

@@ -1,0 +1,514 @@
+"""Running a sweep: its folder, the executor, resuming, progress and the summary table.
+
+The folder of a sweep (``-o DIR``)::
+
+    DIR/sweep.json       the manifest: the specification's hash, file, overrides, axes, reductions
+    DIR/spec.toml        the specification's text, as given
+    DIR/points/NNNNN.nml the point's scene (Scene.to_namelist), run as `beamstops run NNNNN.nml -o NNNNN.h5`
+    DIR/points/NNNNN.h5  the program's own output
+    DIR/points/NNNNN.json the point's record: parameters, status, message, figures, reductions
+    DIR/summary.csv      one row per point (also summary.json, with full lists)
+
+Resuming: a point whose HDF5 says 'complete' (or 'diverged': the run went to its end)
+and whose record belongs to this specification is skipped; every other point (no
+output, an interrupted 'running' file, a failure) runs again. A folder holding another
+specification's results (another hash) is refused, so results never mix.
+"""
+
+from __future__ import annotations
+
+import csv
+import datetime
+import io
+import json
+import math
+import os
+import shutil
+import signal
+import sys
+import sysconfig
+import time
+from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Optional, TextIO
+
+from .reductions import columns as reduction_columns
+from .spec import Spec
+from .worker import FINISHED, read_status, run_point
+
+__all__ = ["run_sweep", "read_summary", "find_program", "make_executor", "Outcome", "MANIFEST", "EXECUTORS"]
+
+MANIFEST = "sweep.json"
+#: Executors of ``--executor``: auto (MPI under ``python -m mpi4py.futures``, else local), local, mpi.
+EXECUTORS = ("auto", "local", "mpi")
+_MANIFEST_FORMAT = 1
+
+
+@dataclass
+class Outcome:
+    """What a sweep did."""
+
+    folder: Path
+    total: int
+    complete: int
+    diverged: int
+    failed: int
+    ran: int
+    """Points run (or reduced again) by this call."""
+    skipped: int
+    """Points finished by an earlier call."""
+    wall_seconds: float
+    executor: str
+
+    @property
+    def summary(self) -> Path:
+        return self.folder / "summary.csv"
+
+
+# ---------------------------------------------------------------------- program and executor
+
+
+def find_program(explicit: Optional[str] = None) -> str:
+    """The `beamstops` program: --program, $BEAMSTOPS_PROGRAM, next to this Python's scripts, or on PATH."""
+    candidates = [explicit] if explicit else []
+    if not explicit:
+        if os.environ.get("BEAMSTOPS_PROGRAM"):
+            candidates.append(os.environ["BEAMSTOPS_PROGRAM"])
+        candidates.append(str(Path(sysconfig.get_path("scripts")) / "beamstops"))
+        candidates.append(shutil.which("beamstops") or "")
+    for candidate in candidates:
+        if candidate and os.path.isfile(candidate) and os.access(candidate, os.X_OK):
+            return os.path.abspath(candidate)
+    if explicit:
+        raise ValueError(f"--program {explicit}: no such executable")
+    raise ValueError("cannot find the beamstops program: install the package (pip install .) "
+                     "or name it with --program")
+
+
+def _under_mpi_futures() -> bool:
+    """Whether this process is rank 0 of ``python -m mpi4py.futures`` (workers wait on the other ranks)."""
+    core = sys.modules.get("mpi4py.futures._core")
+    return core is not None and getattr(core, "SharedPool", None) is not None
+
+
+def _mpi_world_size_from_env() -> int:
+    for key in ("OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE", "MPI_LOCALNRANKS"):
+        try:
+            return int(os.environ[key])
+        except (KeyError, ValueError):
+            continue
+    return 1
+
+
+def _check_not_plain_mpi() -> None:
+    if not _under_mpi_futures() and _mpi_world_size_from_env() > 1:
+        raise ValueError("started as one of several MPI ranks: every rank would run the whole sweep; run "
+                         "`mpiexec -n N python -m mpi4py.futures -m beamstops sweep ...` (rank 0 runs the "
+                         "sweep, the other ranks are its workers)")
+
+
+def make_executor(kind: str = "auto", jobs: Optional[int] = None) -> tuple[Executor, str, int]:
+    """A concurrent.futures executor, its description and its number of workers.
+
+    ``local``: a ProcessPoolExecutor of ``jobs`` processes (default: every core).
+    ``mpi``: mpi4py's MPIPoolExecutor; under ``mpiexec -n N python -m mpi4py.futures -m
+    beamstops sweep ...`` its workers are the ranks 1 … N−1 (rank 0 runs this code).
+    ``auto``: mpi under ``python -m mpi4py.futures``, local otherwise.
+    """
+    under = _under_mpi_futures()
+    if kind == "auto":
+        kind = "mpi" if under else "local"
+    _check_not_plain_mpi()
+    if jobs is not None and jobs < 1:
+        raise ValueError(f"-j {jobs}: the number of workers must be >= 1")
+    if kind == "local":
+        workers = jobs or os.cpu_count() or 1
+        return ProcessPoolExecutor(max_workers=workers), f"{workers} local process{'es' if workers > 1 else ''}", workers
+    if kind == "mpi":
+        try:
+            from mpi4py import MPI
+            from mpi4py.futures import MPIPoolExecutor
+        except ImportError as exc:
+            raise ValueError(f"--executor mpi needs mpi4py ({exc}); install it with `pip install mpi4py` "
+                             "over an MPI library (Debian: openmpi-bin libopenmpi-dev)") from None
+        if under:
+            workers = max(1, MPI.COMM_WORLD.Get_size() - 1)
+            where = (f"{workers} MPI worker rank{'s' if workers > 1 else ''}" if MPI.COMM_WORLD.Get_size() > 1
+                     else "MPI with one rank (tasks run on rank 0)")
+            return MPIPoolExecutor(), where, workers
+        workers = jobs or os.cpu_count() or 1
+        return MPIPoolExecutor(max_workers=workers), f"{workers} spawned MPI workers", workers
+    raise ValueError(f"--executor {kind}: allowed: {', '.join(EXECUTORS)}")
+
+
+# ---------------------------------------------------------------------- folder
+
+
+def _program_hash(program: str) -> str:
+    """sha256 of the program's file: a rebuilt engine may differ at round-off, which impacts amplify."""
+    import hashlib
+
+    digest = hashlib.sha256()
+    with open(program, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def _manifest(spec: Spec, program: str) -> dict[str, Any]:
+    from .. import version
+
+    return {"format": _MANIFEST_FORMAT, "spec_hash": spec.hash, "spec_file": os.path.abspath(spec.path),
+            "program": program, "program_sha256": _program_hash(program),
+            "overrides": list(spec.overrides), "points": len(spec.points), "mode": spec.mode,
+            "axes": spec.axes, "zip": spec.zip_groups, "periods": spec.periods, "reductions": spec.reductions,
+            "base": spec.base, "description": spec.description, "engine_version": version(),
+            "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")}
+
+
+def prepare_folder(spec: Spec, out: Path, program: str) -> tuple[Path, Optional[str]]:
+    """Create or reopen the sweep's folder; a note when the engine changed since the last call."""
+    out = Path(out)
+    manifest = out / MANIFEST
+    note = None
+    if manifest.is_file():
+        try:
+            old = json.loads(manifest.read_text(encoding="utf-8"))
+            old_hash = old["spec_hash"]
+        except (OSError, ValueError, KeyError, TypeError):
+            raise ValueError(f"{out}: {MANIFEST} is unreadable; this is not a sweep folder to resume") from None
+        if old_hash != spec.hash:
+            raise ValueError(f"{out}: holds the results of another specification ({old.get('spec_file')}, "
+                             f"hash {old_hash[:12]}); {spec.path} has hash {spec.hash[:12]}. Use another -o, "
+                             f"or remove {out} to start again")
+        from .. import version
+
+        if old.get("engine_version") != version() or old.get("program_sha256") != _program_hash(program):
+            note = (f"the points done before ran with another build of the engine ({old.get('engine_version')}, "
+                    f"{old.get('program')}); this is {version()}, {program}: results may differ at round-off, "
+                    "which impacts amplify; use a new folder for one build throughout")
+    else:
+        if out.exists() and (not out.is_dir() or any(out.iterdir())):
+            raise ValueError(f"{out}: exists and is not a sweep folder (no {MANIFEST}); use another -o")
+        (out / "points").mkdir(parents=True, exist_ok=True)
+        (out / "spec.toml").write_text(spec.text, encoding="utf-8")
+        tmp = manifest.with_name(MANIFEST + ".tmp")
+        tmp.write_text(json.dumps(_manifest(spec, program), indent=1) + "\n", encoding="utf-8")
+        os.replace(tmp, manifest)
+    (out / "points").mkdir(exist_ok=True)
+    return out, note
+
+
+def _task(spec: Spec, point: Any, folder: Path, program: str, timeout: Optional[float]) -> dict[str, Any]:
+    return {"index": point.index, "name": point.name, "params": point.params, "scene": point.scene.to_dict(),
+            "folder": str(folder / "points"), "program": program, "timeout": timeout,
+            "reductions": spec.reductions, "spec_hash": spec.hash}
+
+
+def plan(spec: Spec, folder: Path, program: str, timeout: Optional[float]
+         ) -> tuple[dict[int, dict[str, Any]], list[dict[str, Any]]]:
+    """Records of the points finished before, and the tasks left (longest runs first)."""
+    done: dict[int, dict[str, Any]] = {}
+    tasks = []
+    for point in spec.points:
+        h5 = folder / "points" / f"{point.name}.h5"
+        status = read_status(h5)
+        task = _task(spec, point, folder, program, timeout)
+        if status in FINISHED:
+            record = _read_record(folder / "points" / f"{point.name}.json")
+            if record and record.get("spec_hash") == spec.hash and record.get("status") == status:
+                done[point.index] = record
+                continue
+            task["reduce_only"] = True  # the run finished but its record was not written
+            if record:
+                task["wall_seconds"] = record.get("wall_seconds")
+        tasks.append(task)
+    costs = {point.index: point.cost() for point in spec.points}
+    tasks.sort(key=lambda t: (0.0 if t.get("reduce_only") else -costs[t["index"]], t["index"]))
+    return done, tasks
+
+
+def _read_record(path: Path) -> Optional[dict[str, Any]]:
+    try:
+        record = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return record if isinstance(record, dict) else None
+
+
+# ---------------------------------------------------------------------- progress
+
+
+def _clock(seconds: float) -> str:
+    if not math.isfinite(seconds):
+        return "?"
+    seconds = int(round(seconds))
+    hours, rest = divmod(seconds, 3600)
+    return f"{hours}:{rest // 60:02d}:{rest % 60:02d}" if hours else f"{rest // 60}:{rest % 60:02d}"
+
+
+class Progress:
+    """Points done, failed and the time left, on one refreshed line (a terminal) or a line every
+    ``interval`` seconds (a log file, a batch job)."""
+
+    def __init__(self, total: int, skipped: int, cost: float, stream: Optional[TextIO], interval: float = 10.0):
+        self.total, self.skipped, self.cost = total, skipped, cost
+        self.done = self.failed = 0
+        self.done_cost = 0.0
+        self.stream = stream
+        self.tty = bool(stream is not None and getattr(stream, "isatty", lambda: False)())
+        self.interval = interval
+        self.start = time.perf_counter()
+        self.last = -math.inf
+
+    def line(self) -> str:
+        elapsed = time.perf_counter() - self.start
+        finished = self.skipped + self.done
+        left = elapsed * (self.cost - self.done_cost) / self.done_cost if self.done_cost > 0 else math.inf
+        if finished >= self.total:
+            left = 0.0
+        width = 24
+        filled = int(width * finished / self.total) if self.total else width
+        bar = "#" * filled + "." * (width - filled)
+        return (f"sweep [{bar}] {finished}/{self.total} points done, {self.failed} failed, "
+                f"{_clock(elapsed)} elapsed, ~{_clock(left)} left")
+
+    def show(self, force: bool = False) -> None:
+        if self.stream is None:
+            return
+        now = time.perf_counter()
+        if self.tty:
+            if force or now - self.last >= 0.2:
+                self.stream.write("\r" + self.line() + "\033[K")
+                self.stream.flush()
+                self.last = now
+        elif force or now - self.last >= self.interval:
+            self.stream.write(self.line() + "\n")
+            self.stream.flush()
+            self.last = now
+
+    def say(self, text: str) -> None:
+        if self.stream is None:
+            return
+        if self.tty:
+            self.stream.write("\r\033[K")
+        self.stream.write(text + "\n")
+        self.stream.flush()
+        if self.tty:
+            self.show(force=True)
+
+    def update(self, record: dict[str, Any], cost: float) -> None:
+        self.done += 1
+        self.done_cost += cost
+        if record.get("status") == "failed":
+            self.failed += 1
+        self.show()
+
+    def close(self) -> None:
+        self.show(force=True)
+        if self.tty and self.stream is not None:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+# ---------------------------------------------------------------------- summary
+
+
+def _columns(spec: Spec) -> list[str]:
+    names = ["point", *spec.axes, "status", "cpu_seconds", "wall_seconds", "steps", "impacts", "max_violation",
+             "dissipated"]
+    for key in ("dt", "t_end", "record_every"):
+        if key not in spec.axes:
+            names.append(key)
+    for name, reduction in spec.reductions.items():
+        names.extend(reduction_columns(name, reduction))
+    return names + ["message", "file"]
+
+
+def _row(spec: Spec, index: int, record: Optional[dict[str, Any]]) -> dict[str, Any]:
+    point = spec.points[index]
+    row: dict[str, Any] = {"point": index, **point.params}
+    if record is None:
+        row.update({"status": "pending", "dt": point.scene.dt, "t_end": point.scene.t_end,
+                    "record_every": point.scene.record_every, "file": f"points/{point.name}.h5"})
+        return row
+    for key in ("status", "cpu_seconds", "wall_seconds", "steps", "impacts", "max_violation", "dissipated",
+                "message", "dt", "t_end", "record_every"):
+        if key not in point.params:
+            row[key] = record.get(key)
+    row["file"] = f"points/{point.name}.h5"
+    row.update(record.get("reductions") or {})
+    return row
+
+
+def _cell(value: Any) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, float):
+        return repr(value)
+    if isinstance(value, list):
+        return " ".join(_cell(v) for v in value)
+    return str(value)
+
+
+def write_summary(spec: Spec, folder: Path, records: dict[int, dict[str, Any]]) -> Path:
+    """summary.csv and summary.json of every point (status 'pending' for those not run yet)."""
+    names = _columns(spec)
+    rows = [_row(spec, point.index, records.get(point.index)) for point in spec.points]
+    text = io.StringIO()
+    writer = csv.writer(text, lineterminator="\n")
+    writer.writerow(names)
+    for row in rows:
+        writer.writerow([_cell(row.get(name)) for name in names])
+    csv_path = folder / "summary.csv"
+    _replace(csv_path, text.getvalue())
+    _replace(folder / "summary.json", json.dumps({"spec_hash": spec.hash, "spec_file": os.path.abspath(spec.path),
+                                                   "columns": names, "points": rows}, indent=1) + "\n")
+    return csv_path
+
+
+def _replace(path: Path, text: str) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text, encoding="utf-8")
+    os.replace(tmp, path)
+
+
+def read_summary(folder: str | os.PathLike[str]) -> list[dict[str, Any]]:
+    """The rows of a sweep's summary.json (one dict per point, lists for strobe reductions)."""
+    path = Path(folder) / "summary.json"
+    try:
+        return list(json.loads(path.read_text(encoding="utf-8"))["points"])
+    except FileNotFoundError:
+        raise FileNotFoundError(f"{path}: no such file (run the sweep first)") from None
+    except (ValueError, KeyError, TypeError) as exc:
+        raise ValueError(f"{path}: not a sweep summary ({exc})") from None
+
+
+# ---------------------------------------------------------------------- the sweep
+
+
+class _Stop(KeyboardInterrupt):
+    """SIGTERM (a batch system's time limit): stop like Ctrl-C, keeping what is done."""
+
+
+def _on_term(signum: int, frame: Any) -> None:
+    raise _Stop()
+
+
+def _refusals(spec: Spec) -> tuple[int, str]:
+    """How many points the engine refuses (they will fail with the program's message), and the first message."""
+    from ..engine import validate
+
+    count, first = 0, ""
+    for point in spec.points:
+        try:
+            validate(point.scene, f"point {point.index}")
+        except ValueError as exc:
+            count += 1
+            first = first or str(exc)
+    return count, first
+
+
+def run_sweep(spec: Spec, out: str | os.PathLike[str], *, executor: str = "auto", jobs: Optional[int] = None,
+              program: Optional[str] = None, timeout: Optional[float] = None, stream: Optional[TextIO] = sys.stderr,
+              interval: float = 10.0) -> Outcome:
+    """Run every point of ``spec`` not finished yet in ``out``, then write the summary.
+
+    ``stream`` gets the progress and the notes (None: silent). A KeyboardInterrupt (or
+    SIGTERM) stops the sweep after writing the summary of what is done; running the same
+    call again resumes it.
+    """
+    _check_not_plain_mpi()
+    program = find_program(program)
+    timeout = timeout if timeout is not None else spec.timeout
+    folder, note = prepare_folder(spec, Path(out), program)
+    done, tasks = plan(spec, folder, program, timeout)
+    records: dict[int, dict[str, Any]] = dict(done)
+    costs = {point.index: point.cost() for point in spec.points}
+    write_summary(spec, folder, records)
+
+    def say(text: str) -> None:
+        if stream is not None:
+            stream.write(text + "\n")
+            stream.flush()
+
+    start = time.perf_counter()
+    description = "nothing to run"
+    if tasks:
+        pool, description, _ = make_executor(executor, jobs)
+        refused, first = _refusals(spec)
+        say(f"sweep: {len(spec.points)} points in {folder} (spec {spec.hash[:12]}): {len(done)} done before, "
+            f"{len(tasks)} to run on {description}")
+        if note:
+            say(f"sweep: note: {note}")
+        if refused:
+            say(f"sweep: note: the engine refuses {refused} point{'s' if refused > 1 else ''}, which will be "
+                f"recorded as failed ({first})")
+        progress = Progress(len(spec.points), len(done), sum(costs[t["index"]] for t in tasks), stream, interval)
+        progress.show(force=True)
+        previous = None
+        try:
+            previous = signal.signal(signal.SIGTERM, _on_term)
+        except ValueError:  # not the main thread
+            pass
+        futures: dict[Future[dict[str, Any]], dict[str, Any]] = {}
+        last_summary = time.perf_counter()
+        try:
+            for task in tasks:
+                futures[pool.submit(run_point, task)] = task
+            for future in as_completed(futures):
+                task = futures[future]
+                try:
+                    record = future.result()
+                except Exception as exc:  # the worker itself died; the point fails, the sweep goes on
+                    record = {"point": task["index"], "params": task["params"], "status": "failed",
+                              "message": f"worker failed: {type(exc).__name__}: {exc}", "reductions": {}}
+                records[task["index"]] = record
+                if record.get("status") == "failed":
+                    progress.say(f"sweep: point {task['index']} ({_params(task['params'])}) failed: "
+                                 f"{record.get('message', '')}")
+                progress.update(record, costs[task["index"]])
+                if time.perf_counter() - last_summary > 60:
+                    write_summary(spec, folder, records)
+                    last_summary = time.perf_counter()
+        except KeyboardInterrupt:
+            _stop(pool, futures)
+            write_summary(spec, folder, records)
+            progress.close()
+            say(f"sweep: interrupted with {len(records)}/{len(spec.points)} points done; run the same command "
+                "again to resume")
+            raise
+        finally:
+            if previous is not None:
+                signal.signal(signal.SIGTERM, previous)
+        pool.shutdown(wait=True)
+        progress.close()
+    write_summary(spec, folder, records)
+    statuses = [r.get("status") for r in records.values()]
+    outcome = Outcome(folder=folder, total=len(spec.points), complete=statuses.count("complete"),
+                      diverged=statuses.count("diverged"), failed=statuses.count("failed"), ran=len(tasks),
+                      skipped=len(done), wall_seconds=time.perf_counter() - start, executor=description)
+    cpu = sum(r.get("cpu_seconds") or 0.0 for i, r in records.items() if i not in done)
+    say(f"sweep: {outcome.total} points: {outcome.complete} complete, {outcome.diverged} diverged, "
+        f"{outcome.failed} failed ({outcome.ran} run now, {outcome.skipped} before; {_clock(outcome.wall_seconds)} "
+        f"wall, {cpu:.1f} s engine CPU); summary: {outcome.summary}")
+    return outcome
+
+
+def _stop(pool: Executor, futures: dict[Future[Any], Any]) -> None:
+    """Cancel what has not started and stop the local workers (each kills its running program)."""
+    for future in futures:
+        future.cancel()
+    handles = list((getattr(pool, "_processes", None) or {}).values()) if isinstance(pool, ProcessPoolExecutor) else []
+    try:
+        pool.shutdown(wait=False, cancel_futures=True)
+    except Exception:
+        pass
+    for handle in handles:
+        if handle is not None and handle.is_alive():
+            handle.terminate()
+
+
+def _params(params: dict[str, Any]) -> str:
+    return ", ".join(f"{k}={v!r}" for k, v in params.items())

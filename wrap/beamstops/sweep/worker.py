@@ -1,0 +1,178 @@
+"""One point of a sweep, as an executor's task: write its namelist, run the program, reduce.
+
+The point runs as ``beamstops run NAME.nml -o NAME.h5`` in a child process, so a crash
+or a hang (``timeout``) fails that point only. Its record (parameters, status, message,
+the run's figures and the reductions) is written next to its HDF5 file as ``NAME.json``
+(atomically) and returned. Tasks and records are plain data, so that any
+``concurrent.futures`` executor carries them: local processes or MPI ranks.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import time
+from pathlib import Path
+from typing import Any, Optional
+
+__all__ = ["run_point", "read_status", "FINISHED"]
+
+#: HDF5 statuses of a run that has gone to its end (rerunning it gives the same file).
+FINISHED = ("complete", "diverged")
+
+
+def read_status(path: Path) -> Optional[str]:
+    """The ``status`` attribute of a program's HDF5 output; None when there is no readable file."""
+    if not path.is_file():
+        return None
+    try:
+        import h5py
+
+        with h5py.File(path, "r") as f:
+            value = f.attrs.get("status")
+    except Exception:  # a truncated file of an interrupted run, or not HDF5 at all
+        return None
+    if isinstance(value, bytes):
+        value = value.decode("utf-8", "replace")
+    return str(value).rstrip(" \x00") if value is not None else None
+
+
+def _message(stderr: str, stdout: str, code: int) -> str:
+    lines = [line.strip() for line in (stderr or "").splitlines() if line.strip()]
+    if not lines:
+        lines = [line.strip() for line in (stdout or "").splitlines() if line.strip()]
+    text = lines[-1] if lines else ""
+    if code < 0:
+        import signal
+
+        try:
+            name = signal.Signals(-code).name
+        except ValueError:
+            name = f"signal {-code}"
+        return f"the program was killed by {name}" + (f": {text}" if text else "")
+    return text or f"the program exited with status {code}"
+
+
+def _write_json(path: Path, record: dict[str, Any]) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(json.dumps(record, indent=1, allow_nan=False) + "\n", encoding="utf-8")
+    os.replace(tmp, path)
+
+
+def _clean(value: Any) -> Any:
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+_ARMED = False
+
+
+def _on_term(signum: int, frame: Any) -> None:
+    raise SystemExit(128 + signum)  # subprocess.run kills the running program on the way out
+
+
+def _arm() -> None:
+    """Make SIGTERM stop this worker and its running program (the sweep stops its workers so)."""
+    global _ARMED
+    if _ARMED:
+        return
+    import multiprocessing
+    import signal
+    import threading
+
+    # only in a worker process of a local pool (never in the caller's own process)
+    if multiprocessing.parent_process() is not None and threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, _on_term)
+    _ARMED = True
+
+
+def run_point(task: dict[str, Any]) -> dict[str, Any]:
+    """Run (or, with ``task['reduce_only']``, only reduce) one point; never raises an Exception."""
+    _arm()
+    folder = Path(task["folder"])
+    name = task["name"]
+    nml, h5, record_path = folder / f"{name}.nml", folder / f"{name}.h5", folder / f"{name}.json"
+    record: dict[str, Any] = {
+        "point": task["index"], "params": task["params"], "spec_hash": task["spec_hash"],
+        "status": "failed", "message": "", "cpu_seconds": None, "wall_seconds": None, "steps": None,
+        "impacts": None, "max_violation": None, "dissipated": None,
+        "dt": task["scene"]["dt"], "t_end": task["scene"]["t_end"], "record_every": task["scene"]["record_every"],
+        "file": f"{folder.name}/{h5.name}", "reductions": {},
+    }
+    start = time.perf_counter()
+    try:
+        if not task.get("reduce_only"):
+            _run_program(task, nml, h5, record)
+        else:
+            record["wall_seconds"] = task.get("wall_seconds")
+        if record["status"] != "failed" or task.get("reduce_only"):
+            _read(task, h5, record)
+    except Exception as exc:  # anything else: this point fails, the sweep goes on
+        record["status"] = "failed"
+        record["message"] = f"{type(exc).__name__}: {exc}"
+    if record["wall_seconds"] is None and not task.get("reduce_only"):
+        record["wall_seconds"] = time.perf_counter() - start
+    try:
+        _write_json(record_path, record)
+    except OSError as exc:
+        record["status"] = "failed"
+        record["message"] = f"cannot write {record_path}: {exc}"
+    return record
+
+
+def _run_program(task: dict[str, Any], nml: Path, h5: Path, record: dict[str, Any]) -> None:
+    from ..scene import Scene
+
+    for stale in (h5, nml.with_suffix(".json")):
+        if stale.exists():
+            stale.unlink()
+    Scene(**task["scene"]).to_namelist(nml)
+    command = [task["program"], "run", str(nml), "-o", str(h5)]
+    start = time.perf_counter()
+    try:
+        done = subprocess.run(command, capture_output=True, text=True, timeout=task.get("timeout"),
+                              stdin=subprocess.DEVNULL)
+    except subprocess.TimeoutExpired:
+        record["wall_seconds"] = time.perf_counter() - start
+        record["message"] = f"timed out after {task['timeout']:g} s (the run was stopped)"
+        return
+    except OSError as exc:
+        record["message"] = f"cannot run {task['program']}: {exc}"
+        return
+    record["wall_seconds"] = time.perf_counter() - start
+    if done.returncode == 0:
+        record["status"] = "complete"
+    elif done.returncode == 3:
+        record["status"] = "diverged"
+        record["message"] = _message(done.stderr, done.stdout, done.returncode)
+    else:
+        record["message"] = _message(done.stderr, done.stdout, done.returncode)
+
+
+def _read(task: dict[str, Any], h5: Path, record: dict[str, Any]) -> None:
+    from ..result import load
+    from .reductions import reduce
+
+    result = load(h5, allow_incomplete=True)
+    attrs = result.attrs
+    status = str(attrs.get("status"))
+    if status not in FINISHED:
+        record["status"] = "failed"
+        record["message"] = record["message"] or f"the output says status {status!r}"
+        return
+    record["status"] = status
+    if status != "complete" and not record["message"]:
+        record["message"] = str(attrs.get("message", ""))
+    for key in ("cpu_seconds", "max_violation"):
+        if key in attrs:
+            record[key] = _clean(float(attrs[key]))
+    for key in ("steps", "impacts"):
+        if key in attrs:
+            record[key] = int(attrs[key])
+    if result.dissipated.size:
+        record["dissipated"] = _clean(float(result.dissipated[-1]))
+    if status == "complete":
+        record["reductions"] = reduce(result, task["reductions"])
