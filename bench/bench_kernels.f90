@@ -179,6 +179,7 @@ contains
       call put('step_fused_min_ns', minval(t_fused))
       call put('step_lapack_min_ns', minval(t_lapack))
       call put('step_fused_fmas', median(t_fused/t_fma))
+      call put('step_fused_fmas_min', minval(t_fused/t_fma))
       call put('step_lapack_fmas', median(t_lapack/t_fma))
    end subroutine bench_step
 

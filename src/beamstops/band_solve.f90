@@ -1,21 +1,26 @@
 !> Fused forward and back substitution for the kd = 3 band Cholesky factor of
-!> LAPACK (dpbtrf, 'U'), the solve of the time loop.
+!> LAPACK (dpbtrf, 'U'), the solve of the time loop; S and M by diagonals for its
+!> vectorized products.
 !>
 !> LAPACK stays the factorization: A = U^T U comes from dpbtrf. The factor is
 !> rewritten once as A = (I + N)^T D^2 (I + N), D = diag(U), N = D^{-1} U - I
 !> (strictly upper, three diagonals). Each row of each substitution is then three
 !> multiply-adds and no division, and the dependency from one row to the next is a
-!> single multiply-add: the chain of the two solves is 2n fused multiply-adds, the
-!> shortest a row-by-row substitution can have. dpbtrs (two dtbsv calls) divides
-!> by the diagonal on the chain and goes through the generic band loops.
-!> Agrees with dpbtrs to round-off (tests/python/test_speed_fused.py).
+!> single multiply-add (the nearest value is subtracted last): the chain of the two
+!> solves is 2n multiply-adds, the shortest a row-by-row substitution can have.
+!> dpbtrs (two dtbsv calls) divides by the diagonal on the chain and goes through the
+!> generic band loops. Agrees with dpbtrs to round-off (tests/python/test_speed_fused.py).
+!>
+!> The loops take three rows a turn: the last three values stay in three registers
+!> and each new row overwrites the farthest, so the roles rotate and no value is
+!> copied between rows (a register copy lengthens the chain by a cycle a row).
 module beamstops_band_solve
    use beamstops_kinds, only: wp
    use beamstops_band, only: kd
    implicit none
    private
-   public :: band_solver, prepare_solver, fused_solve, forward_substitution, back_substitution, back_substitution_edge
-   public :: band_diagonals, prepare_diagonals, diagonal_matvec
+   public :: band_solver, prepare_solver, fused_solve, forward_substitution, back_substitution
+   public :: band_diagonals, prepare_diagonals, diagonal_matvec, dot
 
    !> The factor of A = M + dt^2 beta S in the form the fused substitutions read.
    type :: band_solver
@@ -56,103 +61,116 @@ contains
       end do
    end subroutine prepare_solver
 
-   !> Solve A x = b in place: (I + N)^T w = b, then (I + N) x = D^{-2} w.
+   !> Solve A x = b in place.
    pure subroutine fused_solve(solver, b)
       !> Solver from prepare_solver.
       type(band_solver), intent(in) :: solver
       !> Right-hand side (n), replaced by the solution.
-      real(wp), intent(inout) :: b(:)
+      real(wp), intent(inout), contiguous :: b(:)
       call forward_substitution(solver, b)
       call back_substitution(solver, b)
    end subroutine fused_solve
 
-   !> Forward substitution (I + N)^T w = b in place:
-   !> w_j = b_j - N(j-3,j) w_{j-3} - N(j-2,j) w_{j-2} - N(j-1,j) w_{j-1}.
-   !> The last three values travel in registers (x1 the nearest, x3 the farthest), and
-   !> the nearest is subtracted last, so that one multiply-add per row waits on the
-   !> previous row.
+   !> Forward substitution (I + N)^T w = b, w_j = b_j - N(j-3,j) w_{j-3} - N(j-2,j) w_{j-2}
+   !> - N(j-1,j) w_{j-1}; b is replaced by D^{-2} w, the right-hand side of back_substitution
+   !> (the scaling is off the chain here; in the back substitution it would be on it).
    pure subroutine forward_substitution(solver, b)
       !> Solver from prepare_solver.
       type(band_solver), intent(in) :: solver
-      !> Right-hand side b (n), replaced by w.
+      !> Right-hand side b (n), replaced by D^{-2} w.
       real(wp), intent(inout), contiguous :: b(:)
-      real(wp) :: x, x1, x2, x3
+      real(wp) :: xa, xb, xc
       integer :: j, n
       n = solver%n
-      if (n <= kd) then
-         call small_forward(solver, b)
-         return
-      end if
-      associate (off => solver%off)
-         x3 = b(1)
-         x2 = b(2) - off(3, 2)*x3
-         x1 = b(3) - off(2, 3)*x3 - off(3, 3)*x2
-         b(2) = x2
-         b(3) = x1
-         do j = kd + 1, n
-            x = b(j) - off(1, j)*x3 - off(2, j)*x2 - off(3, j)*x1
-            b(j) = x
-            x3 = x2
-            x2 = x1
-            x1 = x
+      associate (off => solver%off, inv_d2 => solver%inv_d2)
+         if (n < kd) then
+            do j = 2, n
+               b(j) = b(j) - sum(off(kd + 1 - min(j - 1, kd):kd, j)*b(max(1, j - kd):j - 1))
+            end do
+            b = b*inv_d2
+            return
+         end if
+         xa = b(1)
+         xb = b(2) - off(3, 2)*xa
+         xc = b(3) - off(2, 3)*xa - off(3, 3)*xb
+         b(1) = xa*inv_d2(1)
+         b(2) = xb*inv_d2(2)
+         b(3) = xc*inv_d2(3)
+         do j = kd + 1, n - 2, 3
+            xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
+            b(j) = xa*inv_d2(j)
+            xb = row(b(j + 1), off(1, j + 1), off(2, j + 1), off(3, j + 1), xb, xc, xa)
+            b(j + 1) = xb*inv_d2(j + 1)
+            xc = row(b(j + 2), off(1, j + 2), off(2, j + 2), off(3, j + 2), xc, xa, xb)
+            b(j + 2) = xc*inv_d2(j + 2)
          end do
+         ! The last rows (fewer than three): xa, xb, xc hold w_{j-3}, w_{j-2}, w_{j-1}.
+         if (j <= n) then
+            xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
+            b(j) = xa*inv_d2(j)
+         end if
+         if (j + 1 <= n) b(j + 1) = row(b(j + 1), off(1, j + 1), off(2, j + 1), off(3, j + 1), xb, xc, xa) &
+            & *inv_d2(j + 1)
       end associate
    end subroutine forward_substitution
 
-   !> Back substitution (I + N) x = D^{-2} w in place:
-   !> x_i = w_i/d_i^2 - N(i,i+3) x_{i+3} - N(i,i+2) x_{i+2} - N(i,i+1) x_{i+1}.
+   !> Back substitution (I + N) x = b in place (b from forward_substitution):
+   !> x_i = b_i - N(i,i+3) x_{i+3} - N(i,i+2) x_{i+2} - N(i,i+1) x_{i+1}.
    pure subroutine back_substitution(solver, b)
       !> Solver from prepare_solver.
       type(band_solver), intent(in) :: solver
-      !> w (n), replaced by x.
+      !> D^{-2} w (n), replaced by x.
       real(wp), intent(inout), contiguous :: b(:)
-      real(wp) :: x, x1, x2, x3
+      real(wp) :: xa, xb, xc
       integer :: i, n
       n = solver%n
       call back_substitution_edge(solver, b)
       if (n <= kd) return
-      associate (off => solver%off, inv_d2 => solver%inv_d2)
-         x3 = b(n)
-         x2 = b(n - 1)
-         x1 = b(n - 2)
-         do i = n - kd, 1, -1
-            x = b(i)*inv_d2(i) - off(1, i + 3)*x3 - off(2, i + 2)*x2 - off(3, i + 1)*x1
-            b(i) = x
-            x3 = x2
-            x2 = x1
-            x1 = x
+      associate (off => solver%off)
+         xa = b(n)
+         xb = b(n - 1)
+         xc = b(n - 2)
+         do i = n - kd, 3, -3
+            xa = row(b(i), off(1, i + 3), off(2, i + 2), off(3, i + 1), xa, xb, xc)
+            b(i) = xa
+            xb = row(b(i - 1), off(1, i + 2), off(2, i + 1), off(3, i), xb, xc, xa)
+            b(i - 1) = xb
+            xc = row(b(i - 2), off(1, i + 1), off(2, i), off(3, i - 1), xc, xa, xb)
+            b(i - 2) = xc
          end do
+         ! The first rows (fewer than three): xa, xb, xc hold x_{i+3}, x_{i+2}, x_{i+1}.
+         if (i >= 1) then
+            xa = row(b(i), off(1, i + 3), off(2, i + 2), off(3, i + 1), xa, xb, xc)
+            b(i) = xa
+         end if
+         if (i - 1 >= 1) b(i - 1) = row(b(i - 1), off(1, i + 2), off(2, i + 1), off(3, i), xb, xc, xa)
       end associate
    end subroutine back_substitution
 
-   !> The first kd rows of the back substitution (x_n, x_{n-1}, x_{n-2}); all of them when n <= kd.
-   !> The time loop needs the tip value (row n-1) before it finishes the substitution.
+   !> The first kd rows of the back substitution (x_n, x_{n-1}, x_{n-2}); all of them when
+   !> n <= kd. The time loop needs the tip value (row n-1) before it finishes the substitution.
    pure subroutine back_substitution_edge(solver, b)
       !> Solver from prepare_solver.
       type(band_solver), intent(in) :: solver
-      !> w (n); its last kd rows replaced by those of x.
-      real(wp), intent(inout) :: b(:)
+      !> D^{-2} w (n); its last kd rows replaced by those of x.
+      real(wp), intent(inout), contiguous :: b(:)
       integer :: i, j, n
       n = solver%n
-      do i = n, max(n - kd + 1, 1), -1
-         b(i) = b(i)*solver%inv_d2(i)
-         do j = n, i + 1, -1
+      do i = n - 1, max(n - kd + 1, 1), -1
+         do j = min(n, i + kd), i + 1, -1
             b(i) = b(i) - solver%off(kd + 1 + i - j, j)*b(j)
          end do
       end do
    end subroutine back_substitution_edge
 
-   !> Forward substitution for n <= kd (every row is an edge row).
-   pure subroutine small_forward(solver, b)
-      type(band_solver), intent(in) :: solver
-      real(wp), intent(inout) :: b(:)
-      integer :: i, j
-      do j = 2, solver%n
-         do i = 1, j - 1
-            b(j) = b(j) - solver%off(kd + 1 + i - j, j)*b(i)
-         end do
-      end do
-   end subroutine small_forward
+   !> One row of a substitution, b - o3 x3 - o2 x2 - o1 x1, with x1 the nearest value:
+   !> subtracted last, it is the only input the row waits for.
+   pure function row(b, o3, o2, o1, x3, x2, x1) result(x)
+      real(wp), intent(in) :: b, o3, o2, o1, x3, x2, x1
+      real(wp) :: x
+      x = b - o3*x3 - o2*x2 - o1*x1
+   end function row
+
    !> Copy a symmetric band matrix from LAPACK upper band storage into diagonals.
    pure subroutine prepare_diagonals(ab, diagonals)
       !> Upper band storage (kd+1, n), kd = 3.
@@ -207,4 +225,23 @@ contains
          y(n) = a(n, 3)*x(n - 3) + a(n, 2)*x(n - 2) + a(n, 1)*x(n - 1) + a(n, 0)*x(n)
       end associate
    end subroutine diagonal_matvec
+
+   !> x . y with eight partial sums: the products vectorize and the dependency chain is
+   !> n/8 additions long instead of n (a fixed order, so the result is reproducible).
+   pure function dot(x, y) result(s)
+      !> Vectors of the same length.
+      real(wp), intent(in), contiguous :: x(:), y(:)
+      real(wp) :: s
+      real(wp) :: partial(8)
+      integer :: j, n
+      n = size(x)
+      partial = 0
+      do j = 1, n - 7, 8
+         partial = partial + x(j:j + 7)*y(j:j + 7)
+      end do
+      s = ((partial(1) + partial(5)) + (partial(2) + partial(6))) + ((partial(3) + partial(7)) + (partial(4) + partial(8)))
+      do j = j, n
+         s = s + x(j)*y(j)
+      end do
+   end function dot
 end module beamstops_band_solve

@@ -9,9 +9,8 @@ module beamstops_scheme
    use beamstops_model, only: model_type
    use beamstops_error, only: error_type
    use beamstops_band, only: band_matvec, cholesky_factor, cholesky_solve
-   use beamstops_band, only: kd
-   use beamstops_band_solve, only: band_solver, prepare_solver, forward_substitution, back_substitution_edge, &
-      & band_diagonals, prepare_diagonals, diagonal_matvec
+   use beamstops_band_solve, only: band_solver, prepare_solver, forward_substitution, back_substitution, &
+      & band_diagonals, prepare_diagonals, diagonal_matvec, dot
    use beamstops_forcing, only: load_average, support_position
    use beamstops_contact_tip_projection, only: project_tip
    use beamstops_contact_compliance, only: spring_force, solve_spring_tip
@@ -261,17 +260,12 @@ contains
       end do
    end subroutine advance_reference
 
-   !> The same step arranged around the dependency chain of the two triangular solves
-   !> (2n multiply-adds in a row, the bound of a step). Two passes over the unknowns:
-   !>  - forward (forward_pass): S u^n as a vectorized product, then row by row the
-   !>    right-hand side dt^2 (G^n - S u^n), the forward substitution and the dot products
-   !>    the energy needs;
-   !>  - back: the first kd rows of the back substitution give the trial tip value, the
-   !>    contact law gives c, then back_substitution_update finishes the substitution and
-   !>    updates d and u row by row.
-   !> The work besides the substitutions runs in the shadow of their chain. The energy of a
-   !> recorded step needs S u^{n+1}, which the next forward pass computes: its record is
-   !> handed to the recorder one step later (at the end of the call for the last step).
+   !> The same step with the fused substitutions of beamstops_band_solve (the dependency
+   !> chain of the two triangular solves, 2n multiply-adds in a row, bounds a step) and the
+   !> products and dot products vectorized over S and M by diagonals; the sine of the load
+   !> is computed a step ahead, off the chain. S u^{n+1} is computed once, by the next
+   !> forward pass: the record of a step, whose energy needs it, is handed to the recorder
+   !> one step later (at the end of the call for the last step).
    subroutine advance_fused(scene, model, state, recorder, last)
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
@@ -296,7 +290,8 @@ contains
          sigma_after = load_average(step + 2, model%dt, scene%omega, scene%centered_load)
          weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
          call forward_pass(state%stiffness, state%solver, model%load, state%u, state%d, model%dt2*weight, &
-            & model%dt2, spring_term(scene, model, state), state%su, state%rhs, usu, dsu)
+            & model%dt2, spring_term(scene, model, state), pending .or. step == next_record, state%su, state%rhs, &
+            & usu, dsu)
          if (pending) then
             ! usu = u^n.S u^n and dsu = d^{n-1}.S u^n complete the energy of step n-1.
             row(col_energy) = scene%mass_per_length*energy(model, dmd, usu, dsu, u_old_su)
@@ -304,17 +299,19 @@ contains
             pending = .false.
          end if
          u_old_su = usu
-         call back_substitution_edge(state%solver, state%rhs)
+         call back_substitution(state%solver, state%rhs)
          d_tip_prev = state%d(tip)
          u_tip_prev = state%u(tip)
          trial = u_tip_prev + (d_tip_prev + state%rhs(tip))
          call contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
-         call back_substitution_update(state%solver, state%rhs, c, model%z, model%load, state%d, state%u, gd)
+         state%d = state%d + state%rhs + c*model%z
+         state%u = state%u + state%d
+         gd = dot(model%load, state%d)
          call close_step(scene, model, state, contact, tip_value, gd, weight, r_step, d_tip_prev, sigma_next)
          if (step == next_record) then
             next_record = next_record + scene%record_every
             call diagonal_matvec(state%mass, state%d, state%scratch)
-            dmd = dot_product(state%d, state%scratch)
+            dmd = dot(state%d, state%scratch)
             call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_step, row)
             pending = .true.
          end if
@@ -326,17 +323,16 @@ contains
       ! The state carries S u^{last+1}; it also completes a waiting record.
       call diagonal_matvec(state%stiffness, state%u, state%su)
       if (pending) then
-         row(col_energy) = scene%mass_per_length*energy(model, dmd, dot_product(state%u, state%su), &
-            & dot_product(state%d, state%su), u_old_su)
+         row(col_energy) = scene%mass_per_length*energy(model, dmd, dot(state%u, state%su), dot(state%d, state%su), &
+            & u_old_su)
          call recorder%record(row)
       end if
    end subroutine advance_fused
 
-   !> Forward pass of a step: su = S u (a vectorized product); rhs = a g - b su, plus `spring`
-   !> in the tip row (n-1), replaced by w, the forward substitution (I + N)^T w = rhs; with
-   !> usu = u.su and dsu = d.su. The right-hand side and the dot products are off the chain
-   !> of the substitution (one multiply-add per row, the nearest row subtracted last).
-   pure subroutine forward_pass(stiffness, solver, g, u, d, a, b, spring, su, rhs, usu, dsu)
+   !> Forward pass of a step: su = S u, rhs = a g - b su plus `spring` in the tip row (n-1),
+   !> both vectorized, then the forward substitution (rhs replaced by D^{-2} w); with `energy`,
+   !> usu = u.su and dsu = d.su.
+   subroutine forward_pass(stiffness, solver, g, u, d, a, b, spring, energy, su, rhs, usu, dsu)
       !> S by diagonals.
       type(band_diagonals), intent(in) :: stiffness
       !> Factor of A.
@@ -345,91 +341,27 @@ contains
       real(wp), intent(in), contiguous :: g(:), u(:), d(:)
       !> Coefficients of rhs = a g - b S u, and the force added in the tip row.
       real(wp), intent(in) :: a, b, spring
+      !> Whether the dot products are wanted.
+      logical, intent(in) :: energy
       !> S u^n (n).
       real(wp), intent(out), contiguous :: su(:)
-      !> w (n).
+      !> D^{-2} w (n).
       real(wp), intent(out), contiguous :: rhs(:)
-      !> u.S u and d.S u.
+      !> u.S u and d.S u (when energy).
       real(wp), intent(out) :: usu, dsu
-      real(wp) :: x, x1, x2, x3
-      integer :: j, n
+      integer :: n
       n = solver%n
       call diagonal_matvec(stiffness, u, su)
-      if (n <= kd + 1) then
-         ! The tip row is among the first kd rows.
-         rhs = a*g - b*su
-         rhs(n - 1) = rhs(n - 1) + spring
-         call forward_substitution(solver, rhs)
-         usu = dot_product(u, su)
-         dsu = dot_product(d, su)
-         return
+      rhs = a*g - b*su
+      rhs(n - 1) = rhs(n - 1) + spring
+      call forward_substitution(solver, rhs)
+      usu = 0
+      dsu = 0
+      if (energy) then
+         usu = dot(u, su)
+         dsu = dot(d, su)
       end if
-      associate (off => solver%off)
-         x3 = a*g(1) - b*su(1)
-         x2 = (a*g(2) - b*su(2)) - off(3, 2)*x3
-         x1 = (a*g(3) - b*su(3)) - off(2, 3)*x3 - off(3, 3)*x2
-         rhs(1) = x3
-         rhs(2) = x2
-         rhs(3) = x1
-         usu = u(1)*su(1) + u(2)*su(2) + u(3)*su(3)
-         dsu = d(1)*su(1) + d(2)*su(2) + d(3)*su(3)
-         do j = kd + 1, n
-            x = a*g(j) - b*su(j)
-            if (j == n - 1) x = x + spring
-            x = x - off(1, j)*x3 - off(2, j)*x2 - off(3, j)*x1
-            rhs(j) = x
-            usu = usu + u(j)*su(j)
-            dsu = dsu + d(j)*su(j)
-            x3 = x2
-            x2 = x1
-            x1 = x
-         end do
-      end associate
    end subroutine forward_pass
-
-   !> The back substitution after its first kd rows (back_substitution_edge), fused with the
-   !> update of the step: row by row from the last, x_i = w_i/d_i^2 - N(i, i+1..i+kd) x,
-   !> d_i = d_i + x_i + c z_i, u_i = u_i + d_i, and gd = g.d. The updates run in the shadow
-   !> of the substitution's chain.
-   pure subroutine back_substitution_update(solver, b, c, z, g, d, u, gd)
-      !> Factor of A.
-      type(band_solver), intent(in) :: solver
-      !> w with its last kd rows solved (n); the solution x on return.
-      real(wp), intent(inout), contiguous :: b(:)
-      !> Multiple of z to add (contact).
-      real(wp), intent(in) :: c
-      !> z = A^{-1} e_tip and the load vector g (n).
-      real(wp), intent(in), contiguous :: z(:), g(:)
-      !> d^{n-1} and u^n on entry, d^n and u^{n+1} on return (n).
-      real(wp), intent(inout), contiguous :: d(:), u(:)
-      !> g.d^n.
-      real(wp), intent(out) :: gd
-      real(wp) :: x, x1, x2, x3
-      integer :: i, n
-      n = solver%n
-      gd = 0
-      do i = n, max(n - kd + 1, 1), -1
-         d(i) = d(i) + b(i) + c*z(i)
-         u(i) = u(i) + d(i)
-         gd = gd + g(i)*d(i)
-      end do
-      if (n <= kd) return
-      x3 = b(n)
-      x2 = b(n - 1)
-      x1 = b(n - 2)
-      associate (off => solver%off, inv_d2 => solver%inv_d2)
-         do i = n - kd, 1, -1
-            x = b(i)*inv_d2(i) - off(1, i + 3)*x3 - off(2, i + 2)*x2 - off(3, i + 1)*x1
-            b(i) = x
-            d(i) = d(i) + x + c*z(i)
-            u(i) = u(i) + d(i)
-            gd = gd + g(i)*d(i)
-            x3 = x2
-            x2 = x1
-            x1 = x
-         end do
-      end associate
-   end subroutine back_substitution_update
 
    !> dt^2 times the explicit part of the Newmark-weighted spring force, added to the tip row of
    !> the right-hand side (normal compliance; zero otherwise).
