@@ -32,7 +32,8 @@ end module bench_null_recorder
 
 !> Microbenchmarks of the hot loop; prints `key value` lines (times in ns, medians of repeats).
 !>
-!>   bench_kernels fma [repeats]                    latency of one dependent multiply-add
+!>   bench_kernels fma [repeats]                    latency of one dependent multiply-add, and
+!>                                                  the peak rate of independent (vectorized) ones
 !>   bench_kernels solve J [repeats]                one solve with A = M + dt^2 beta S (dt = 1e-6,
 !>                                                  beta = 1/2): LAPACK dpbtrs against the fused
 !>                                                  substitutions, each solve feeding the next
@@ -41,8 +42,9 @@ end module bench_null_recorder
 !>                                                  recorder that keeps nothing, fused and LAPACK
 !>                                                  paths; LAW signorini|compliance|none; EVERY
 !>                                                  = record_every (0: never)
-!>   bench_kernels triad MB [repeats]               memory bandwidth, a = b + s c over 3 arrays
-!>                                                  of MB megabytes each (GB/s, 24 bytes/element)
+!>   bench_kernels triad KB [repeats]               bandwidth of a = b + s c over 3 arrays of KB
+!>                                                  kilobytes each (GB/s, 24 bytes an element):
+!>                                                  memory, or a cache level for small KB
 !>
 !> Timings are wall-clock (system_clock) of the code under test only; the repeats of the
 !> variants that are compared are interleaved, so that a slow moment of a shared machine
@@ -67,13 +69,14 @@ program bench_kernels
    case ('fma')
       repeats = int_argument(2, 7)
       call put('fma_latency_ns', median_of(fma_latency, repeats))
+      call put('fma_per_ns', median_of(fma_throughput, repeats))
    case ('solve')
       call bench_solve(int_argument(2, 19), int_argument(3, 7))
    case ('step')
       call bench_step(int_argument(2, 19), argument(3, 'signorini'), int_argument(4, 1), &
          & int_argument(5, 200000), int_argument(6, 5), argument(7, 'both'))
    case ('triad')
-      call bench_triad(int_argument(2, 256), int_argument(3, 5))
+      call bench_triad(int_argument(2, 256000), int_argument(3, 5))
    case default
       write (error_unit, '(a)') 'usage: bench_kernels fma|solve|step|triad ...'
       error stop 2
@@ -100,6 +103,25 @@ contains
       ns = 1.0e9_wp*real(t1 - t0, wp)/real(rate, wp)/count
       if (x == 12345) print *, x
    end function fma_latency
+
+   !> Independent multiply-adds per nanosecond: 64 accumulators, vectorized.
+   function fma_throughput() result(per_ns)
+      real(wp) :: per_ns
+      integer, parameter :: count = 2000000, width = 64
+      real(wp) :: acc(width), a, b
+      integer(int64) :: t0, t1, rate
+      integer :: k
+      a = 0.999_wp*runtime_one()
+      b = 1.0e-3_wp
+      acc = [(real(k, wp)/width, k=1, width)]
+      call system_clock(t0, rate)
+      do k = 1, count
+         acc = acc*a + b
+      end do
+      call system_clock(t1)
+      per_ns = real(count, wp)*width/(1.0e9_wp*real(t1 - t0, wp)/real(rate, wp))
+      if (sum(acc) == 12345) print *, acc(1)
+   end function fma_throughput
 
    !> One solve of the Figure 4 matrix, LAPACK against fused.
    subroutine bench_solve(elements, repeats)
@@ -204,15 +226,16 @@ contains
       if (recorder%sink == 12345) print *, recorder%sink
    end function time_steps
 
-   !> Memory bandwidth of a = b + s c (GB/s, 24 bytes per element as STREAM counts them).
-   subroutine bench_triad(megabytes, repeats)
-      integer, intent(in) :: megabytes, repeats
+   !> Bandwidth of a = b + s c (GB/s, 24 bytes per element as STREAM counts them) over three
+   !> arrays of `kilobytes` each.
+   subroutine bench_triad(kilobytes, repeats)
+      integer, intent(in) :: kilobytes, repeats
       real(wp), allocatable :: a(:), b(:), c(:)
       real(wp) :: s, rates(repeats)
       integer(int64) :: t0, t1, rate
-      integer :: n, rep, k
-      integer, parameter :: passes = 10
-      n = int(int(megabytes, int64)*1000000_int64/8)
+      integer :: n, rep, k, passes
+      n = max(8, int(int(kilobytes, int64)*1000_int64/8))
+      passes = max(10, int(2.0e9_wp/(24.0_wp*n)))
       allocate (a(n), b(n), c(n))
       a = 0
       b = 1

@@ -20,6 +20,7 @@ module beamstops_band_solve
    implicit none
    private
    public :: band_solver, prepare_solver, fused_solve, forward_substitution, back_substitution
+   public :: forward_substitution_energy
    public :: band_diagonals, prepare_diagonals, diagonal_matvec, dot
 
    !> The factor of A = M + dt^2 beta S in the form the fused substitutions read.
@@ -113,6 +114,76 @@ contains
             & *inv_d2(j + 1)
       end associate
    end subroutine forward_substitution
+
+   !> forward_substitution with, in the shadow of its chain, the dot products of the discrete
+   !> energy: usu = u.su, dsu = d.su and dmd = d.M d = sum_j d_j (M_jj d_j + 2 sum_k M_j-k,j d_j-k)
+   !> (M by diagonals). Each sum is one multiply-add a row on its own chain, beside the
+   !> substitution's.
+   pure subroutine forward_substitution_energy(solver, mass, u, d, su, b, usu, dsu, dmd)
+      !> Solver from prepare_solver.
+      type(band_solver), intent(in) :: solver
+      !> M by diagonals.
+      type(band_diagonals), intent(in) :: mass
+      !> u, d and su (n).
+      real(wp), intent(in), contiguous :: u(:), d(:), su(:)
+      !> Right-hand side b (n), replaced by D^{-2} w.
+      real(wp), intent(inout), contiguous :: b(:)
+      !> u.su, d.su and d.M d.
+      real(wp), intent(out) :: usu, dsu, dmd
+      real(wp) :: xa, xb, xc
+      integer :: i, j, n
+      n = solver%n
+      associate (off => solver%off, inv_d2 => solver%inv_d2, m => mass%a)
+         if (n < 2*kd) then
+            call forward_substitution(solver, b)
+            usu = dot_product(u, su)
+            dsu = dot_product(d, su)
+            dmd = 0
+            do j = 1, n
+               xa = m(j, 0)*d(j)
+               do i = max(1, j - kd), j - 1
+                  xa = xa + 2*m(j, j - i)*d(i)
+               end do
+               dmd = dmd + d(j)*xa
+            end do
+            return
+         end if
+         xa = b(1)
+         xb = b(2) - off(3, 2)*xa
+         xc = b(3) - off(2, 3)*xa - off(3, 3)*xb
+         b(1) = xa*inv_d2(1)
+         b(2) = xb*inv_d2(2)
+         b(3) = xc*inv_d2(3)
+         usu = u(1)*su(1) + u(2)*su(2) + u(3)*su(3)
+         dsu = d(1)*su(1) + d(2)*su(2) + d(3)*su(3)
+         dmd = d(1)*m(1, 0)*d(1) + d(2)*(m(2, 0)*d(2) + 2*m(2, 1)*d(1)) &
+            & + d(3)*(m(3, 0)*d(3) + 2*(m(3, 1)*d(2) + m(3, 2)*d(1)))
+         do j = kd + 1, n - 2, 3
+            xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
+            b(j) = xa*inv_d2(j)
+            xb = row(b(j + 1), off(1, j + 1), off(2, j + 1), off(3, j + 1), xb, xc, xa)
+            b(j + 1) = xb*inv_d2(j + 1)
+            xc = row(b(j + 2), off(1, j + 2), off(2, j + 2), off(3, j + 2), xc, xa, xb)
+            b(j + 2) = xc*inv_d2(j + 2)
+            do i = j, j + 2
+               usu = usu + u(i)*su(i)
+               dsu = dsu + d(i)*su(i)
+               dmd = dmd + d(i)*(m(i, 0)*d(i) + 2*(m(i, 1)*d(i - 1) + m(i, 2)*d(i - 2) + m(i, 3)*d(i - 3)))
+            end do
+         end do
+         if (j <= n) then
+            xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
+            b(j) = xa*inv_d2(j)
+         end if
+         if (j + 1 <= n) b(j + 1) = row(b(j + 1), off(1, j + 1), off(2, j + 1), off(3, j + 1), xb, xc, xa) &
+            & *inv_d2(j + 1)
+         do i = j, n
+            usu = usu + u(i)*su(i)
+            dsu = dsu + d(i)*su(i)
+            dmd = dmd + d(i)*(m(i, 0)*d(i) + 2*(m(i, 1)*d(i - 1) + m(i, 2)*d(i - 2) + m(i, 3)*d(i - 3)))
+         end do
+      end associate
+   end subroutine forward_substitution_energy
 
    !> Back substitution (I + N) x = b in place (b from forward_substitution):
    !> x_i = b_i - N(i,i+3) x_{i+3} - N(i,i+2) x_{i+2} - N(i,i+1) x_{i+1}.

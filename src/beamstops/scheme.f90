@@ -10,6 +10,7 @@ module beamstops_scheme
    use beamstops_error, only: error_type
    use beamstops_band, only: band_matvec, cholesky_factor, cholesky_solve
    use beamstops_band_solve, only: band_solver, prepare_solver, forward_substitution, back_substitution, &
+      & forward_substitution_energy, &
       & band_diagonals, prepare_diagonals, diagonal_matvec, dot
    use beamstops_forcing, only: load_average, support_position
    use beamstops_contact_tip_projection, only: project_tip
@@ -238,8 +239,7 @@ contains
          u_tip_prev = state%u(tip)
          trial = u_tip_prev + (d_tip_prev + state%rhs(tip))
          call contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
-         state%d = state%d + state%rhs + c*model%z
-         state%u = state%u + state%d
+         call update(state%rhs, c, model%z, state%d, state%u)
          gd = dot_product(model%load, state%d)
          call close_step(scene, model, state, contact, tip_value, gd, weight, r_step, d_tip_prev, sigma_next)
          if (step == next_record) u_old_su = dot_product(state%u, state%su) - dot_product(state%d, state%su)
@@ -289,11 +289,12 @@ contains
          sigma_next = sigma_after
          sigma_after = load_average(step + 2, model%dt, scene%omega, scene%centered_load)
          weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
-         call forward_pass(state%stiffness, state%solver, model%load, state%u, state%d, model%dt2*weight, &
-            & model%dt2, spring_term(scene, model, state), pending .or. step == next_record, state%su, state%rhs, &
-            & usu, dsu)
+         call forward_pass(state%stiffness, state%mass, state%solver, model%load, state%u, state%d, &
+            & model%dt2*weight, model%dt2, spring_term(scene, model, state), pending .or. step == next_record, &
+            & state%su, state%rhs, usu, dsu, dmd)
          if (pending) then
-            ! usu = u^n.S u^n and dsu = d^{n-1}.S u^n complete the energy of step n-1.
+            ! usu = u^n.S u^n, dsu = d^{n-1}.S u^n and dmd = d^{n-1}.M d^{n-1} complete the energy
+            ! of step n-1.
             row(col_energy) = scene%mass_per_length*energy(model, dmd, usu, dsu, u_old_su)
             call recorder%record(row)
             pending = .false.
@@ -304,14 +305,11 @@ contains
          u_tip_prev = state%u(tip)
          trial = u_tip_prev + (d_tip_prev + state%rhs(tip))
          call contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
-         state%d = state%d + state%rhs + c*model%z
-         state%u = state%u + state%d
+         call update(state%rhs, c, model%z, state%d, state%u)
          gd = dot(model%load, state%d)
          call close_step(scene, model, state, contact, tip_value, gd, weight, r_step, d_tip_prev, sigma_next)
          if (step == next_record) then
             next_record = next_record + scene%record_every
-            call diagonal_matvec(state%mass, state%d, state%scratch)
-            dmd = dot(state%d, state%scratch)
             call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_step, row)
             pending = .true.
          end if
@@ -323,18 +321,19 @@ contains
       ! The state carries S u^{last+1}; it also completes a waiting record.
       call diagonal_matvec(state%stiffness, state%u, state%su)
       if (pending) then
-         row(col_energy) = scene%mass_per_length*energy(model, dmd, dot(state%u, state%su), dot(state%d, state%su), &
-            & u_old_su)
+         call diagonal_matvec(state%mass, state%d, state%scratch)
+         row(col_energy) = scene%mass_per_length*energy(model, dot(state%d, state%scratch), dot(state%u, state%su), &
+            & dot(state%d, state%su), u_old_su)
          call recorder%record(row)
       end if
    end subroutine advance_fused
 
    !> Forward pass of a step: su = S u, rhs = a g - b su plus `spring` in the tip row (n-1),
    !> both vectorized, then the forward substitution (rhs replaced by D^{-2} w); with `energy`,
-   !> usu = u.su and dsu = d.su.
-   subroutine forward_pass(stiffness, solver, g, u, d, a, b, spring, energy, su, rhs, usu, dsu)
-      !> S by diagonals.
-      type(band_diagonals), intent(in) :: stiffness
+   !> usu = u.su, dsu = d.su and dmd = d.M d, accumulated beside the substitution.
+   subroutine forward_pass(stiffness, mass, solver, g, u, d, a, b, spring, energy, su, rhs, usu, dsu, dmd)
+      !> S and M by diagonals.
+      type(band_diagonals), intent(in) :: stiffness, mass
       !> Factor of A.
       type(band_solver), intent(in) :: solver
       !> Load vector, u^n and d^{n-1} (n).
@@ -347,21 +346,34 @@ contains
       real(wp), intent(out), contiguous :: su(:)
       !> D^{-2} w (n).
       real(wp), intent(out), contiguous :: rhs(:)
-      !> u.S u and d.S u (when energy).
-      real(wp), intent(out) :: usu, dsu
+      !> u.S u, d.S u and d.M d (when energy).
+      real(wp), intent(out) :: usu, dsu, dmd
       integer :: n
       n = solver%n
       call diagonal_matvec(stiffness, u, su)
       rhs = a*g - b*su
       rhs(n - 1) = rhs(n - 1) + spring
-      call forward_substitution(solver, rhs)
-      usu = 0
-      dsu = 0
       if (energy) then
-         usu = dot(u, su)
-         dsu = dot(d, su)
+         call forward_substitution_energy(solver, mass, u, d, su, rhs, usu, dsu, dmd)
+      else
+         call forward_substitution(solver, rhs)
+         usu = 0
+         dsu = 0
+         dmd = 0
       end if
    end subroutine forward_pass
+
+   !> The update of the step: d^n = d^{n-1} + x + c z, u^{n+1} = u^n + d^n.
+   pure subroutine update(x, c, z, d, u)
+      !> A^{-1} rhs and z = A^{-1} e_tip (n).
+      real(wp), intent(in), contiguous :: x(:), z(:)
+      !> Multiple of z (contact).
+      real(wp), intent(in) :: c
+      !> d^{n-1} and u^n on entry, d^n and u^{n+1} on return (n).
+      real(wp), intent(inout), contiguous :: d(:), u(:)
+      d = d + x + c*z
+      u = u + d
+   end subroutine update
 
    !> dt^2 times the explicit part of the Newmark-weighted spring force, added to the tip row of
    !> the right-hand side (normal compliance; zero otherwise).

@@ -1,0 +1,390 @@
+#!/usr/bin/env python3
+"""How fast beamstops runs the Dumont-Paoli scheme, measured side by side in one run.
+
+    python scripts/bench.py                 # the full tables (a few minutes)
+    python scripts/bench.py --quick         # the same tables, shorter runs (CI smoke use)
+    python scripts/bench.py --out bench.md  # also write the markdown to a file
+
+What it measures, on this machine, in one process (medians of --repeats repeats; every
+ratio is computed from numbers of the same run):
+
+- the ``beamstops`` program on the paper's scene (J = 19): Figure 4 (Signorini, beta = 1/2,
+  dt = 1e-6, T = 2 s, two million steps, the tip recorded every step) and the same with
+  normal compliance (1/eps = 1e8 per unit mass, beta = 1/4); the engine's own
+  ``cpu_seconds`` attribute (time loop only) from the HDF5 output, and the wall time of the
+  whole program (start-up and output included);
+- the engine's loop alone (bench/bench_kernels: start_state + advance with a recorder that
+  keeps nothing), on its fused path and on the LAPACK reference path (dpbtrs and one pass
+  per operation, ``state%lapack_solve``);
+- the same scheme in numpy/scipy, the way a user would write it (scripts/reference_scheme.py:
+  ``cholesky_banded`` once, ``cho_solve_banded`` every step), and a loop driven from Python
+  that calls the engine once per step through a small f2py module (scripts/bench_step.f90,
+  built by scripts/bench_ext.py against the same build): the cost of crossing the
+  language boundary at every step;
+- the floor: the two triangular solves are a chain of 2n dependent multiply-adds (n = 2J
+  unknowns); with the multiply-add latency measured here, 2n latencies is a lower bound of
+  any step that substitutes row by row. The operation count over the measured peak rate of
+  independent multiply-adds, and (for large J) the bytes a step must move over the measured
+  memory bandwidth, are the other two bounds; the floor is the largest of the three;
+- scaling in J from 19 to 1e5 (time per step and per unknown, peak memory of the program),
+  and in the number of records (record_every);
+- the paper's CPU-time table beside ours.
+
+The build: --build DIR (a meson build directory; configured with -Dbench=true if needed),
+else build/bench, configured and compiled here. The program: --program PATH, else the
+build's ``beamstops``, else ``beamstops`` on PATH.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import platform
+import re
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import h5py
+import numpy as np
+import scipy
+
+SCRIPTS = Path(__file__).resolve().parent
+sys.path.insert(0, str(SCRIPTS))
+
+import bench_ext  # noqa: E402
+import reference_scheme  # noqa: E402
+
+# The paper's CPU times (SPEC 2; Scilab on a 1.1 GHz PowerPC G4), its runs: figure ->
+# (law, beta, dt, seconds). T = 2 s, J = 19 for all.
+PAPER = {
+    2: ("signorini", 0.5, 5e-5, 18.24),
+    3: ("signorini", 0.5, 5e-6, 173.71),
+    4: ("signorini", 0.5, 1e-6, 870.45),
+    5: ("compliance", 0.25, 5e-6, 241.17),
+    6: ("compliance", 0.25, 1e-6, 1187.9),
+    7: ("compliance", 0.25, 5e-7, 2426.4),
+    8: ("signorini", 0.25, 1e-6, 859.38),
+}
+STIFFNESS = 1e8  # the paper's 1/eps, per unit mass
+BYTES = 8
+
+
+# ----------------------------------------------------------------------------------- tools
+def median(values: list[float]) -> float:
+    return statistics.median(values)
+
+
+def fmt(x: float, digits: int = 3) -> str:
+    """Shortest readable number: 3 significant digits, no exponent between 1e-3 and 1e5."""
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return "—"
+    if x == 0:
+        return "0"
+    if 1e-3 <= abs(x) < 1e5:
+        decimals = max(0, digits - 1 - int(math.floor(math.log10(abs(x)))))
+        return f"{x:.{decimals}f}"
+    return f"{x:.{digits - 1}e}"
+
+
+def table(header: list[str], rows: list[list[str]]) -> str:
+    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
+    lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def kernels(binary: Path, *args: object) -> dict[str, float]:
+    """Run bench_kernels and parse its `key value` lines."""
+    out = subprocess.run([str(binary), *map(str, args)], check=True, capture_output=True, text=True).stdout
+    return {k: float(v) for k, v in (line.split() for line in out.splitlines() if line.strip())}
+
+
+@dataclass
+class ProgramRun:
+    cpu_seconds: float  # the engine's time loop (HDF5 attribute cpu_seconds)
+    wall_seconds: float  # the whole program
+    steps: int
+    max_rss_mb: float  # peak resident memory of the program
+    output_mb: float
+
+
+def namelist(path: Path, out: Path, *, law="signorini", beta=0.5, dt=1e-6, t_end=2.0, elements=19,
+             record_every=1) -> None:
+    stops = f"law='{law}'" + (f", stiffness_per_mass={STIFFNESS:g}" if law == "compliance" else "")
+    path.write_text(
+        "&beam     length=1.501, k2=282.84, mass_per_length=0.11938 /\n"
+        "&support  amplitude=0.2, omega=10.0 /\n"
+        f"&stops    lower=-0.1, upper=0.1, {stops} /\n"
+        f"&mesh     elements={elements} /\n"
+        f"&time     dt={dt:g}, t_end={t_end:.12g}, beta={beta:g}, load_rule='paper', start='euler' /\n"
+        f"&output   file='{out}', record_every={record_every}, snapshot_every=0, max_output_gb=100 /\n")
+
+
+def peak_rss_mb(pid: int) -> float | None:
+    """VmHWM of a running process (its peak resident memory so far), MB; None once it is gone."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return None
+    found = re.search(r"VmHWM:\s*(\d+)\s*kB", status)
+    return int(found.group(1)) / 1024 if found else None
+
+
+def run_program(program: Path, work: Path, **scene) -> ProgramRun:
+    nml, out = work / "scene.nml", work / "out.h5"
+    namelist(nml, out, **scene)
+    start = time.perf_counter()
+    proc = subprocess.Popen([str(program), "run", str(nml)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    # The peak resident memory of the program itself (the rusage of a child forked from
+    # Python would count the interpreter's pages too): VmHWM, read until the process ends.
+    peak = 0.0
+    while proc.poll() is None:
+        peak = max(peak, peak_rss_mb(proc.pid) or 0.0)
+        time.sleep(0.002)
+    wall = time.perf_counter() - start
+    err = proc.stderr.read().decode()
+    proc.stderr.close()
+    if proc.returncode != 0:
+        raise RuntimeError(f"{program} run failed: {err}")
+    with h5py.File(out, "r") as f:
+        cpu, steps = float(f.attrs["cpu_seconds"]), int(f.attrs["steps"])
+    size = out.stat().st_size / 1e6
+    out.unlink()
+    return ProgramRun(cpu, wall, steps, peak, size)
+
+
+def program_median(program: Path, work: Path, repeats: int, **scene) -> ProgramRun:
+    runs = [run_program(program, work, **scene) for _ in range(repeats)]
+    return ProgramRun(median([r.cpu_seconds for r in runs]), median([r.wall_seconds for r in runs]),
+                      runs[0].steps, max(r.max_rss_mb for r in runs), runs[0].output_mb)
+
+
+# ------------------------------------------------------------------------------- sections
+def machine(build: Path, program: Path) -> str:
+    cpu = platform.processor()
+    try:
+        info = Path("/proc/cpuinfo").read_text()
+        cpu = re.search(r"model name\s*:\s*(.*)", info).group(1).strip()
+    except (OSError, AttributeError):
+        pass
+    fc = subprocess.run([os.environ.get("FC", "gfortran"), "--version"], capture_output=True, text=True).stdout
+    lapack = "?"
+    try:
+        ldd = subprocess.run(["ldd", str(program)], capture_output=True, text=True).stdout
+        lapack = ", ".join(sorted({Path(m).name for m in re.findall(r"=> (\S*(?:lapack|blas)\S*)", ldd)})) or "static"
+    except OSError:
+        pass
+    options = ""
+    intro = build / "meson-info" / "intro-buildoptions.json"
+    if intro.exists():
+        import json
+        opts = {o["name"]: o["value"] for o in json.loads(intro.read_text())}
+        options = f"buildtype={opts.get('buildtype')}, native={opts.get('native')}"
+    return (f"Machine: {cpu}, {os.cpu_count()} logical CPUs, {platform.system()} {platform.release()}; "
+            f"{fc.splitlines()[0] if fc else 'no gfortran'} ({options}); LAPACK/BLAS: {lapack}; "
+            f"Python {platform.python_version()}, numpy {np.__version__}, scipy {scipy.__version__}.")
+
+
+def python_loops(ext, steps: int, repeats: int) -> dict[str, float]:
+    """µs/step: numpy/scipy scheme, and the engine called once per step from Python."""
+    numpy_us, crossing_us, one_call_us = [], [], []
+    for _ in range(repeats):
+        res = reference_scheme.run_reference(J=19, dt=1e-6, t_end=steps * 1e-6, beta=0.5,
+                                             load_rule="paper", start="euler")
+        numpy_us.append(1e6 * float(res["cpu_seconds"]) / int(res["steps"]))
+        assert ext.init(19, 1e-6, 2.0, 0.5, 1, 0.0, 1, 0) == 0
+        step = ext.step
+        start = time.process_time()
+        for _ in range(steps):
+            step()
+        crossing_us.append(1e6 * (time.process_time() - start) / steps)
+        assert ext.init(19, 1e-6, 2.0, 0.5, 1, 0.0, 1, 0) == 0
+        start = time.process_time()
+        ext.steps(steps)
+        one_call_us.append(1e6 * (time.process_time() - start) / steps)
+    return {"numpy": median(numpy_us), "per_step_call": median(crossing_us), "one_call": median(one_call_us)}
+
+
+def step_ops(n: int, record: bool) -> int:
+    """Floating-point operations of one fused step (a multiply-add counts one): S u 7n,
+    right-hand side 2n, forward substitution 3n + scaling n, back substitution 3n, update of
+    d and u 3n, g.d n; recording adds M d 7n and three dot products 3n."""
+    return (7 + 2 + 4 + 3 + 3 + 1) * n + ((7 + 3) * n if record else 0)
+
+
+def step_bytes(n: int, record: bool) -> int:
+    """Bytes one step must move when nothing stays in cache: read S (4n), the factor (3n
+    multipliers + n scalings), g, z, u, d; write u, d, S u; w once out and back between the
+    two sweeps (they run in opposite directions); recording reads M (4n)."""
+    return BYTES * ((4 + 4 + 1 + 1 + 1 + 1) + 3 + 2 + (4 if record else 0)) * n
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--quick", action="store_true", help="short runs (a few seconds of measuring), for CI")
+    parser.add_argument("--build", type=Path, help="meson build directory (default build/bench, made if missing)")
+    parser.add_argument("--program", type=Path, help="the beamstops program (default: the build's, else PATH)")
+    parser.add_argument("--repeats", type=int, default=None, help="repeats of every measurement (default 5, quick 3)")
+    parser.add_argument("--out", type=Path, help="also write the markdown here")
+    args = parser.parse_args()
+    quick = args.quick
+    repeats = args.repeats or (3 if quick else 5)
+
+    build = bench_ext.meson_build(args.build, bench=True)
+    kernels_bin = build / "bench" / "bench_kernels"
+    program = args.program or (build / "beamstops" if (build / "beamstops").exists() else None)
+    program = program or (Path(shutil.which("beamstops")) if shutil.which("beamstops") else None)
+    if program is None:
+        parser.error("no beamstops program: give --program or --build")
+    ext = bench_ext.step_extension(build)
+    t_end = 0.2 if quick else 2.0  # seconds of simulated time for the J = 19 program runs
+    out: list[str] = []
+    say = out.append
+
+    # ------------------------------------------------------------ floor ingredients
+    fma = kernels(kernels_bin, "fma", repeats)
+    latency, rate = fma["fma_latency_ns"], fma["fma_per_ns"]
+    triad = kernels(kernels_bin, "triad", 256_000, repeats)["triad_GBps"]  # memory (3 x 256 MB)
+    solve = kernels(kernels_bin, "solve", 19, repeats)
+
+    # ------------------------------------------------------------ J = 19, per step
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        fig4 = program_median(program, work, repeats, law="signorini", beta=0.5, dt=1e-6, t_end=t_end)
+        comp = program_median(program, work, repeats, law="compliance", beta=0.25, dt=1e-6, t_end=t_end)
+        loop_steps = 200_000 if quick else 2_000_000
+        loop = {law: kernels(kernels_bin, "step", 19, law, 1, loop_steps, repeats)
+                for law in ("signorini", "compliance")}
+        loop_free = {law: kernels(kernels_bin, "step", 19, law, 0, loop_steps, repeats)
+                     for law in ("signorini", "compliance")}
+        py = python_loops(ext, 2_000 if quick else 20_000, repeats)
+
+        n = 38
+        chain = 2 * n * latency
+        ops_floor = {r: step_ops(n, r) / rate for r in (False, True)}
+        floor = {r: max(chain, ops_floor[r]) for r in (False, True)}
+        us = 1e-3
+        sig_prog = 1e6 * fig4.cpu_seconds / fig4.steps
+        comp_prog = 1e6 * comp.cpu_seconds / comp.steps
+        sig_loop, comp_loop = loop["signorini"]["step_fused_ns"] * us, loop["compliance"]["step_fused_ns"] * us
+        sig_free, comp_free = (loop_free["signorini"]["step_fused_ns"] * us,
+                               loop_free["compliance"]["step_fused_ns"] * us)
+        sig_lapack, comp_lapack = loop["signorini"]["step_lapack_ns"] * us, loop["compliance"]["step_lapack_ns"] * us
+
+        say(f"## Speed (scripts/bench.py{' --quick' if quick else ''})\n")
+        say(machine(build, program) + f" Medians of {repeats} repeats; ratios from the same run.\n")
+        say(f"### Per step, the paper's scene (J = 19, n = 38 unknowns, dt = 1e-6 s, "
+            f"{fig4.steps:,} steps)\n")
+        rows = [
+            ["`beamstops` program, tip recorded every step (HDF5), engine's `cpu_seconds`",
+             fmt(sig_prog), fmt(comp_prog), "1"],
+            ["engine loop alone, every step recorded (recorder keeps nothing)", fmt(sig_loop), fmt(comp_loop),
+             fmt(sig_loop / sig_prog)],
+            ["engine loop alone, nothing recorded", fmt(sig_free), fmt(comp_free), fmt(sig_free / sig_prog)],
+            ["engine loop, LAPACK path (dpbtrs, one pass per operation), every step recorded",
+             fmt(sig_lapack), fmt(comp_lapack), fmt(sig_lapack / sig_prog)],
+            ["Python loop calling the engine once per step (f2py)", fmt(py["per_step_call"]), "—",
+             fmt(py["per_step_call"] / sig_prog)],
+            ["numpy/scipy loop (scripts/reference_scheme.py, cho_solve_banded per step)", fmt(py["numpy"]), "—",
+             fmt(py["numpy"] / sig_prog)],
+            ["floor: 2n dependent multiply-adds of the two solves", fmt(chain * us), fmt(chain * us),
+             fmt(chain * us / sig_prog)],
+        ]
+        say(table(["µs per step", "Signorini, β = 1/2", "compliance, β = 1/4", "× program (Signorini)"], rows))
+        say("")
+        say(f"- numpy/scipy over the program: **{py['numpy'] / sig_prog:.0f}×** per step; over the engine loop "
+            f"alone: {py['numpy'] / sig_loop:.0f}×. Crossing into Fortran and back at every step costs "
+            f"{fmt(py['per_step_call'] - py['one_call'])} µs (the same steps in one call: "
+            f"{fmt(py['one_call'])} µs/step).")
+        say(f"- Figure 4 ({'0.2 s of it, ' if quick else ''}{fig4.steps:,} steps, tip recorded every step): "
+            f"{fmt(fig4.cpu_seconds)} s of CPU in the time loop, {fmt(fig4.wall_seconds)} s for the whole "
+            f"program ({fmt(fig4.output_mb)} MB of HDF5)" +
+            ("." if quick else f"; target < 1 s: {'met' if fig4.wall_seconds < 1 else 'NOT met'}."))
+        say(f"- Fused path over the LAPACK path (same loop, same records): {sig_lapack / sig_loop:.1f}× "
+            f"(Signorini), {comp_lapack / comp_loop:.1f}× (compliance).")
+        say("")
+
+        # -------------------------------------------------------- the floor
+        say("### The floor (J = 19)\n")
+        rows = [
+            ["multiply-add latency (dependent chain)", f"{fmt(latency)} ns"],
+            ["independent multiply-adds (vectorized peak)", f"{fmt(rate)} per ns"],
+            ["chain of the two substitutions: 2n = 76 latencies", f"{fmt(chain)} ns"],
+            [f"operations: {step_ops(n, False)} (nothing recorded), {step_ops(n, True)} (recorded) / peak rate",
+             f"{fmt(ops_floor[False])} ns, {fmt(ops_floor[True])} ns"],
+            ["floor = the largest", f"{fmt(floor[False])} ns, {fmt(floor[True])} ns"],
+            ["one solve: LAPACK dpbtrs / fused / chain",
+             f"{fmt(solve['solve_lapack_ns'])} / {fmt(solve['solve_fused_ns'])} / {fmt(chain)} ns"],
+            ["engine step, nothing recorded / floor",
+             f"{fmt(sig_free * 1e3)} ns = **{sig_free * 1e3 / floor[False]:.1f}×**"],
+            ["engine step, every step recorded / floor",
+             f"{fmt(sig_loop * 1e3)} ns = **{sig_loop * 1e3 / floor[True]:.1f}×**"],
+            ["program step (HDF5 output every step) / floor", f"{fmt(sig_prog * 1e3)} ns = "
+             f"{sig_prog * 1e3 / floor[True]:.1f}×"],
+        ]
+        say(table(["quantity", "value"], rows))
+        say("")
+
+        # -------------------------------------------------------- scaling in J
+        say("### Scaling in J (Signorini, β = 1/2, dt = 1e-6 s, tip recorded every step)\n")
+        elements = [19, 100, 1000, 10_000] if quick else [19, 100, 1000, 10_000, 100_000]
+        rows = []
+        for j in elements:
+            n = 2 * j
+            steps = max(20, int((2e6 if not quick else 2e5) * 38 / n / 10))
+            run = program_median(program, work, repeats, elements=j, t_end=steps * 1e-6)
+            step_us = 1e6 * run.cpu_seconds / run.steps
+            chain_j = 2 * n * latency * 1e-3
+            # the bandwidth of the cache level (or memory) that holds a step's data
+            bandwidth = kernels(kernels_bin, "triad", max(1, step_bytes(n, True) // 3000), repeats)["triad_GBps"]
+            mem_j = step_bytes(n, True) / (bandwidth * 1e3)
+            floor_j = max(chain_j, mem_j, step_ops(n, True) / rate * 1e-3)
+            rows.append([f"{j:,}", f"{n:,}", f"{run.steps:,}", fmt(step_us), fmt(1e3 * step_us / n),
+                         fmt(chain_j), fmt(step_bytes(n, True) / 1e6), fmt(bandwidth), fmt(mem_j),
+                         fmt(step_us / floor_j), fmt(run.max_rss_mb)])
+        say(table(["J", "n", "steps", "µs/step", "ns/(step·unknown)", "chain floor µs", "MB/step",
+                   "bandwidth GB/s", "memory floor µs", "× floor", "peak RSS MB"], rows))
+        say(f"\nMB/step: the bytes a step must move, {step_bytes(1, True)} per unknown (S, M, the factor, g, z, "
+            f"u, d, S u, w); bandwidth: a triad over the same amount of data (the cache level that holds it, "
+            f"or memory: {fmt(triad)} GB/s). Peak RSS: the program's VmHWM.\n")
+
+        # -------------------------------------------------------- scaling in records
+        say(f"### Records (Figure 4 scene{', 0.2 s' if quick else ''}; `record_every`)\n")
+        rows = []
+        steps_total = int(round(t_end / 1e-6))
+        for every in (1, 10, 100, 1000, steps_total):
+            run = program_median(program, work, repeats, t_end=t_end, record_every=every)
+            rows.append([f"{every:,}" + (" (none)" if every == steps_total else ""), fmt(1e6 * run.cpu_seconds / run.steps),
+                         fmt(run.cpu_seconds), fmt(run.wall_seconds), fmt(run.output_mb)])
+        say(table(["record_every", "µs/step", "cpu_seconds", "wall s", "output MB"], rows))
+        say("")
+
+        # -------------------------------------------------------- the paper's table
+        say("### The paper's CPU times beside ours (T = 2 s, J = 19, tip recorded every step)\n")
+        say("Different hardware: the paper used Scilab on a 1.1 GHz PowerPC G4; ours is the machine above.\n")
+        rows = []
+        for figure, (law, beta, dt, paper_s) in PAPER.items():
+            if quick and figure not in (2, 4):
+                continue
+            run = program_median(program, work, repeats, law=law, beta=beta, dt=dt, t_end=2.0)
+            rows.append([str(figure), law, f"{beta:g}", f"{dt:g}", f"{run.steps:,}", fmt(paper_s),
+                         fmt(run.cpu_seconds), fmt(run.wall_seconds), f"{paper_s / run.cpu_seconds:,.0f}×"])
+        say(table(["figure", "law", "β", "dt (s)", "steps", "paper CPU s", "beamstops cpu_seconds",
+                   "beamstops wall s", "paper / beamstops"], rows))
+        if quick:
+            say("\n(--quick: figures 2 and 4 only.)")
+    text = "\n".join(out) + "\n"
+    print(text)
+    if args.out:
+        args.out.write_text(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
