@@ -230,6 +230,8 @@ def main() -> int:
     parser.add_argument("--quick", action="store_true", help="short runs (a few seconds of measuring), for CI")
     parser.add_argument("--build", type=Path, help="meson build directory (default build/bench, made if missing)")
     parser.add_argument("--program", type=Path, help="the beamstops program (default: the build's, else PATH)")
+    parser.add_argument("--baseline", type=Path,
+                        help="another beamstops program (e.g. built from an older commit) to time beside this one")
     parser.add_argument("--repeats", type=int, default=None, help="repeats of every measurement (default 5, quick 3)")
     parser.add_argument("--out", type=Path, help="also write the markdown here")
     args = parser.parse_args()
@@ -258,6 +260,10 @@ def main() -> int:
         work = Path(tmp)
         fig4 = program_median(program, work, repeats, law="signorini", beta=0.5, dt=1e-6, t_end=t_end)
         comp = program_median(program, work, repeats, law="compliance", beta=0.25, dt=1e-6, t_end=t_end)
+        if args.baseline:
+            base_sig = program_median(args.baseline, work, repeats, law="signorini", beta=0.5, dt=1e-6, t_end=t_end)
+            base_comp = program_median(args.baseline, work, repeats, law="compliance", beta=0.25, dt=1e-6,
+                                       t_end=t_end)
         loop_steps = 200_000 if quick else 2_000_000
         loop = {law: kernels(kernels_bin, "step", 19, law, 1, loop_steps, repeats)
                 for law in ("signorini", "compliance")}
@@ -284,6 +290,12 @@ def main() -> int:
         rows = [
             ["`beamstops` program, tip recorded every step (HDF5), engine's `cpu_seconds`",
              fmt(sig_prog), fmt(comp_prog), "1"],
+        ]
+        if args.baseline:
+            base_sig_us = 1e6 * base_sig.cpu_seconds / base_sig.steps
+            rows.append([f"baseline program (`{args.baseline}`), same runs", fmt(base_sig_us),
+                         fmt(1e6 * base_comp.cpu_seconds / base_comp.steps), fmt(base_sig_us / sig_prog)])
+        rows += [
             ["engine loop alone, every step recorded (recorder keeps nothing)", fmt(sig_loop), fmt(comp_loop),
              fmt(sig_loop / sig_prog)],
             ["engine loop alone, nothing recorded", fmt(sig_free), fmt(comp_free), fmt(sig_free / sig_prog)],

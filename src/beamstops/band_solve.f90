@@ -130,7 +130,7 @@ contains
       real(wp), intent(inout), contiguous :: b(:)
       !> u.su, d.su and d.M d.
       real(wp), intent(out) :: usu, dsu, dmd
-      real(wp) :: xa, xb, xc
+      real(wp) :: xa, xb, xc, da, db, dc, d1, d2, d3
       integer :: i, j, n
       n = solver%n
       associate (off => solver%off, inv_d2 => solver%inv_d2, m => mass%a)
@@ -158,6 +158,9 @@ contains
          dsu = d(1)*su(1) + d(2)*su(2) + d(3)*su(3)
          dmd = d(1)*m(1, 0)*d(1) + d(2)*(m(2, 0)*d(2) + 2*m(2, 1)*d(1)) &
             & + d(3)*(m(3, 0)*d(3) + 2*(m(3, 1)*d(2) + m(3, 2)*d(1)))
+         da = d(1)
+         db = d(2)
+         dc = d(3)
          do j = kd + 1, n - 2, 3
             xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
             b(j) = xa*inv_d2(j)
@@ -165,11 +168,22 @@ contains
             b(j + 1) = xb*inv_d2(j + 1)
             xc = row(b(j + 2), off(1, j + 2), off(2, j + 2), off(3, j + 2), xc, xa, xb)
             b(j + 2) = xc*inv_d2(j + 2)
-            do i = j, j + 2
-               usu = usu + u(i)*su(i)
-               dsu = dsu + d(i)*su(i)
-               dmd = dmd + d(i)*(m(i, 0)*d(i) + 2*(m(i, 1)*d(i - 1) + m(i, 2)*d(i - 2) + m(i, 3)*d(i - 3)))
-            end do
+            ! the sums, d_{j-3..j+2} loaded once (da, db, dc: the three before row j)
+            d1 = d(j)
+            d2 = d(j + 1)
+            d3 = d(j + 2)
+            usu = usu + u(j)*su(j)
+            dsu = dsu + d1*su(j)
+            dmd = dmd + d1*(m(j, 0)*d1 + 2*(m(j, 1)*dc + m(j, 2)*db + m(j, 3)*da))
+            usu = usu + u(j + 1)*su(j + 1)
+            dsu = dsu + d2*su(j + 1)
+            dmd = dmd + d2*(m(j + 1, 0)*d2 + 2*(m(j + 1, 1)*d1 + m(j + 1, 2)*dc + m(j + 1, 3)*db))
+            usu = usu + u(j + 2)*su(j + 2)
+            dsu = dsu + d3*su(j + 2)
+            dmd = dmd + d3*(m(j + 2, 0)*d3 + 2*(m(j + 2, 1)*d2 + m(j + 2, 2)*d1 + m(j + 2, 3)*dc))
+            da = d1
+            db = d2
+            dc = d3
          end do
          if (j <= n) then
             xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
