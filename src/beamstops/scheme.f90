@@ -61,6 +61,22 @@ module beamstops_scheme
       logical :: lapack_solve = .false.
    end type state_type
 
+   !> The load averages sigma_k = f sin(omega c_k) (forcing's load_average; f = sinc(omega dt/2),
+   !> c_k the centre of step k's interval) step after step by rotating (f sin, f cos)(omega c_k)
+   !> by omega dt: four multiply-adds instead of a sine. Every restart_every steps they restart
+   !> from load_average itself, so they differ from it by a few ulps at most.
+   type :: load_rotation
+      !> Index k of the current value.
+      integer(ik) :: k = 0
+      !> sigma_k = f sin(omega c_k) and f cos(omega c_k).
+      real(wp) :: sigma = 0, cosine = 0
+      !> cos(omega dt), sin(omega dt).
+      real(wp) :: cos_step = 1, sin_step = 0
+   end type load_rotation
+
+   !> Steps between two restarts of load_rotation from exact values.
+   integer(ik), parameter :: restart_every = 64
+
 contains
 
    !> Start a run: u^0 = u0 and u^1 by the Taylor (or Euler) start, projected into K;
@@ -262,8 +278,8 @@ contains
 
    !> The same step with the fused substitutions of beamstops_band_solve (the dependency
    !> chain of the two triangular solves, 2n multiply-adds in a row, bounds a step) and the
-   !> products and dot products vectorized over S and M by diagonals; the sine of the load
-   !> is computed a step ahead, off the chain. S u^{n+1} is computed once, by the next
+   !> products and dot products vectorized over S and M by diagonals; the load averages by
+   !> rotation (load_rotation) instead of a sine a step. S u^{n+1} is computed once, by the next
    !> forward pass: the record of a step, whose energy needs it, is handed to the recorder
    !> one step later (at the end of the call for the last step).
    subroutine advance_fused(scene, model, state, recorder, last)
@@ -274,20 +290,20 @@ contains
       integer(ik), intent(in) :: last
       integer(ik) :: step, next_record, next_snapshot
       integer :: tip
-      real(wp) :: sigma_next, sigma_after, weight, c, tip_value, trial, r_step, gd, d_tip_prev, u_tip_prev
+      real(wp) :: sigma_next, weight, c, tip_value, trial, r_step, gd, d_tip_prev, u_tip_prev
       real(wp) :: usu, dsu, u_old_su, dmd, row(n_columns)
       logical :: contact, pending
+      type(load_rotation) :: loads
 
       tip = model%tip
       call first_events(scene, state%step, next_record, next_snapshot)
       pending = .false.
       u_old_su = 0
       dmd = 0
-      sigma_after = load_average(state%step + 1, model%dt, scene%omega, scene%centered_load)
+      call start_loads(loads, state%step + 1, scene, model)
       do step = state%step, last
-         ! The load average is computed a step ahead: its sine is then off the chain.
-         sigma_next = sigma_after
-         sigma_after = load_average(step + 2, model%dt, scene%omega, scene%centered_load)
+         sigma_next = loads%sigma
+         call next_load(loads, scene, model)
          weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
          call forward_pass(state%stiffness, state%mass, state%solver, model%load, state%u, state%d, &
             & model%dt2*weight, model%dt2, spring_term(scene, model, state), pending .or. step == next_record, &
@@ -362,6 +378,57 @@ contains
          dmd = 0
       end if
    end subroutine forward_pass
+
+   !> load_rotation at step k: from load_average at the last multiple of restart_every, then
+   !> rotated, so that the value of every step is the same however the run is cut into calls.
+   subroutine start_loads(loads, k, scene, model)
+      type(load_rotation), intent(out) :: loads
+      integer(ik), intent(in) :: k
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      call restart_loads(loads, (k/restart_every)*restart_every, scene, model)
+      do while (loads%k < k)
+         call next_load(loads, scene, model)
+      end do
+   end subroutine start_loads
+
+   !> load_rotation at step k, exact: load_average and the same centre and factor for the cosine.
+   subroutine restart_loads(loads, k, scene, model)
+      type(load_rotation), intent(out) :: loads
+      integer(ik), intent(in) :: k
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      real(wp) :: centre, x, factor
+      centre = real(k, wp)*model%dt
+      if (.not. scene%centered_load) centre = (real(k, wp) + 0.5_wp)*model%dt
+      x = 0.5_wp*scene%omega*model%dt
+      if (abs(x) < 1.0e-8_wp) then
+         factor = 1 - x**2/6
+      else
+         factor = sin(x)/x
+      end if
+      loads%k = k
+      loads%sigma = load_average(k, model%dt, scene%omega, scene%centered_load)
+      loads%cosine = factor*cos(scene%omega*centre)
+      loads%cos_step = cos(scene%omega*model%dt)
+      loads%sin_step = sin(scene%omega*model%dt)
+   end subroutine restart_loads
+
+   !> load_rotation moved on to step k + 1.
+   subroutine next_load(loads, scene, model)
+      type(load_rotation), intent(inout) :: loads
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      real(wp) :: sigma
+      if (mod(loads%k + 1, restart_every) == 0) then
+         call restart_loads(loads, loads%k + 1, scene, model)
+         return
+      end if
+      sigma = loads%sigma*loads%cos_step + loads%cosine*loads%sin_step
+      loads%cosine = loads%cosine*loads%cos_step - loads%sigma*loads%sin_step
+      loads%sigma = sigma
+      loads%k = loads%k + 1
+   end subroutine next_load
 
    !> The update of the step: d^n = d^{n-1} + x + c z, u^{n+1} = u^n + d^n.
    pure subroutine update(x, c, z, d, u)
