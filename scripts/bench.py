@@ -347,6 +347,7 @@ def main() -> int:
         say("### Scaling in J (Signorini, β = 1/2, dt = 1e-6 s, tip recorded every step)\n")
         elements = [19, 100, 1000, 10_000] if quick else [19, 100, 1000, 10_000, 100_000]
         rows = []
+        rss = {}
         for j in elements:
             n = 2 * j
             steps = max(20, int((2e6 if not quick else 2e5) * 38 / n / 10))
@@ -357,14 +358,18 @@ def main() -> int:
             bandwidth = kernels(kernels_bin, "triad", max(1, step_bytes(n, True) // 3000), repeats)["triad_GBps"]
             mem_j = step_bytes(n, True) / (bandwidth * 1e3)
             floor_j = max(chain_j, mem_j, step_ops(n, True) / rate * 1e-3)
+            rss[n] = run.max_rss_mb
             rows.append([f"{j:,}", f"{n:,}", f"{run.steps:,}", fmt(step_us), fmt(1e3 * step_us / n),
                          fmt(chain_j), fmt(step_bytes(n, True) / 1e6), fmt(bandwidth), fmt(mem_j),
                          fmt(step_us / floor_j), fmt(run.max_rss_mb)])
         say(table(["J", "n", "steps", "µs/step", "ns/(step·unknown)", "chain floor µs", "MB/step",
                    "bandwidth GB/s", "memory floor µs", "× floor", "peak RSS MB"], rows))
+        (n1, r1), (n2, r2) = sorted(rss.items())[-2:]
         say(f"\nMB/step: the bytes a step must move, {step_bytes(1, True)} per unknown (S, M, the factor, g, z, "
             f"u, d, S u, w); bandwidth: a triad over the same amount of data (the cache level that holds it, "
-            f"or memory: {fmt(triad)} GB/s). Peak RSS: the program's VmHWM.\n")
+            f"or memory: {fmt(triad)} GB/s). Peak RSS: the program's VmHWM (libraries and HDF5 buffers "
+            f"dominate it for small J); from n = {n1:,} to {n2:,} it grows by {fmt(1e6 * (r2 - r1) / (n2 - n1))} "
+            f"bytes per unknown.\n")
 
         # -------------------------------------------------------- scaling in records
         say(f"### Records (Figure 4 scene{', 0.2 s' if quick else ''}; `record_every`)\n")
