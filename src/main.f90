@@ -1,10 +1,12 @@
 !> The `beamstops` command-line program:
-!>   beamstops run FILE.nml [-o OUT.h5]   run a scene, write its HDF5 file, print a summary
+!>   beamstops run FILE.nml [-o OUT.h5] [--restart]   run a scene (or resume it from its last
+!>                                        checkpoint), write its HDF5 file, print a summary
 !>   beamstops info FILE.nml              print the scene, its discretization and limits
 program beamstops_main
    use, intrinsic :: iso_c_binding, only: c_int
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use beamstops
+   use beamstops_checkpoint, only: checkpoint_path, read_checkpoint
    implicit none
 
    interface
@@ -21,11 +23,12 @@ program beamstops_main
 
    integer, parameter :: exit_input = 1, exit_usage = 2, exit_diverged = 3, exit_output = 4
    character(len=:), allocatable :: command, path, out
+   logical :: restart = .false.
    type(scene_type) :: scene
    type(model_type) :: model
    type(error_type), allocatable :: error
 
-   call parse_arguments(command, path, out)
+   call parse_arguments(command, path, out, restart)
    call read_scene(path, scene, error)
    call stop_on(error, exit_input)
    if (allocated(out)) scene%output_file = out
@@ -35,13 +38,14 @@ program beamstops_main
    case ('info')
       call print_info(scene, model)
    case ('run')
-      call run_to_file(scene, model)
+      call run_to_file(scene, model, restart)
    end select
 
 contains
 
-   subroutine parse_arguments(command, path, out)
+   subroutine parse_arguments(command, path, out, restart)
       character(len=:), allocatable, intent(out) :: command, path, out
+      logical, intent(inout) :: restart
       character(len=4096) :: arg
       integer :: i, n
       n = command_argument_count()
@@ -67,6 +71,9 @@ contains
             call get_command_argument(i + 1, arg)
             out = trim(arg)
             i = i + 1
+         case ('--restart')
+            if (command /= 'run') call usage("'--restart' goes with 'run'")
+            restart = .true.
          case default
             if (arg(1:1) == '-' .or. allocated(path)) call usage("unexpected argument '"//trim(arg)//"'")
             path = trim(arg)
@@ -84,7 +91,9 @@ contains
          unit = error_unit
          write (unit, '(a)') 'beamstops: '//problem
       end if
-      write (unit, '(a)') 'usage: beamstops run FILE.nml [-o OUT.h5]   run a scene, write its HDF5 output', &
+      write (unit, '(a)') 'usage: beamstops run FILE.nml [-o OUT.h5] [--restart]', &
+         & '           run a scene, write its HDF5 output; with --restart, continue from the last', &
+         & '           checkpoint (&output checkpoint_every) if there is one', &
          & '       beamstops info FILE.nml              print the scene, kappa_h, stability limits, cost', &
          & '       beamstops --version'
       if (present(problem)) call quit(exit_usage)
@@ -107,16 +116,37 @@ contains
       call c_exit(int(status, c_int))
    end subroutine quit
 
-   subroutine run_to_file(scene, model)
+   subroutine run_to_file(scene, model, restart)
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
+      logical, intent(in) :: restart
       type(hdf5_recorder) :: recorder
       type(run_summary) :: summary
+      type(state_type) :: state
       type(error_type), allocatable :: error, finish_error
-      call recorder%open(scene%output_file, scene, model, error)
-      call stop_on(error, exit_output)
+      integer(ik) :: records, snapshots
+      logical :: resume
+      resume = .false.
+      if (restart) then
+         inquire (file=checkpoint_path(scene%output_file), exist=resume)
+         if (.not. resume) write (error_unit, '(a)') 'beamstops: no checkpoint '// &
+            & checkpoint_path(scene%output_file)//': starting from t = 0'
+      end if
+      if (resume) then
+         call read_checkpoint(checkpoint_path(scene%output_file), scene, model, state, records, snapshots, error)
+         call stop_on(error, exit_input)
+         call recorder%reopen(scene%output_file, scene, model, records, snapshots, error)
+         call stop_on(error, exit_output)
+      else
+         call recorder%open(scene%output_file, scene, model, error)
+         call stop_on(error, exit_output)
+      end if
       recorder%show_progress = c_isatty(2_c_int) == 1
-      call simulate(scene, model, recorder, summary, error)
+      if (resume) then
+         call run_scheme(scene, model, state, recorder, summary)
+      else
+         call simulate(scene, model, recorder, summary, error)
+      end if
       if (allocated(error)) then
          summary%status = status_failed
          summary%message = error%message

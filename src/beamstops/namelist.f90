@@ -3,7 +3,7 @@
 !> all end in one message naming the file, the group and the key.
 module beamstops_namelist
    use, intrinsic :: iso_fortran_env, only: iostat_end
-   use beamstops_kinds, only: wp
+   use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
    use beamstops_scene, only: scene_type, validate_scene, tube_beam, law_code, law_compliance, fmt_real
    implicit none
@@ -16,7 +16,7 @@ module beamstops_namelist
    character(len=*), parameter :: group_keys(6) = [character(len=140) :: &
       & 'length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness', &
       & 'amplitude, omega', 'lower, upper, law, stiffness, stiffness_per_mass', 'elements', &
-      & 'dt, t_end, beta, load_rule, start, allow_unstable', 'file, record_every, snapshot_every, max_output_gb']
+      & 'dt, t_end, beta, load_rule, start, allow_unstable', 'file, record_every, snapshot_every, checkpoint_every, max_output_gb']
    real(wp), parameter :: unset = -huge(1.0_wp)
    integer, parameter :: text_len = 4096
 
@@ -48,12 +48,13 @@ contains
       character(len=text_len) :: file
       integer :: record_every, snapshot_every
       real(wp) :: max_output_gb
+      integer(ik) :: checkpoint_every
       namelist /beam/ length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness
       namelist /support/ amplitude, omega
       namelist /stops/ lower, upper, law, stiffness, stiffness_per_mass
       namelist /mesh/ elements
       namelist /time/ dt, t_end, beta, load_rule, start, allow_unstable
-      namelist /output/ file, record_every, snapshot_every, max_output_gb
+      namelist /output/ file, record_every, snapshot_every, checkpoint_every, max_output_gb
       character(len=text_len) :: groups_text(size(group_names))
       logical :: present(size(group_names))
       character(len=512) :: msg
@@ -72,6 +73,7 @@ contains
       allow_unstable = .false.
       file = default_output(path); record_every = scene%record_every; snapshot_every = scene%snapshot_every
       max_output_gb = scene%max_output_gb
+      checkpoint_every = scene%checkpoint_every
 
       do g = 1, size(group_names)
          if (.not. present(g)) cycle
@@ -149,6 +151,7 @@ contains
       scene%record_every = record_every
       scene%snapshot_every = snapshot_every
       scene%max_output_gb = max_output_gb
+      scene%checkpoint_every = checkpoint_every
       call validate_scene(scene, path, error)
    end subroutine read_scene
 

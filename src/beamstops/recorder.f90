@@ -3,6 +3,7 @@
 !> Implementations: the HDF5 file writer (program) and the array recorder (Python).
 module beamstops_recorder
    use beamstops_kinds, only: wp, ik
+   use beamstops_state, only: state_type
    implicit none
    private
    public :: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, col_work, col_dissipated
@@ -22,6 +23,8 @@ module beamstops_recorder
       procedure(snapshot_interface), deferred :: snapshot
       !> Told between blocks of steps how far the run is (default: nothing).
       procedure :: progress
+      !> Save what is recorded so far and the state, to resume from (default: nothing).
+      procedure :: checkpoint
    end type recorder_type
 
    abstract interface
@@ -49,4 +52,12 @@ contains
       !> Steps in the run.
       integer(ik), intent(in) :: steps
    end subroutine progress
+
+   !> Default checkpoint: none.
+   subroutine checkpoint(self, state)
+      !> Recorder.
+      class(recorder_type), intent(inout) :: self
+      !> State of the loop after the last step done.
+      type(state_type), intent(in) :: state
+   end subroutine checkpoint
 end module beamstops_recorder

@@ -54,6 +54,8 @@ module beamstops_scene
       character(len=:), allocatable :: output_file
       !> &output: refuse a run whose output would exceed this many gigabytes (1e9 bytes).
       real(wp) :: max_output_gb = 4.0_wp
+      !> &output: save a checkpoint every this many steps (0: never).
+      integer(ik) :: checkpoint_every = 0
       !> &output: record the tip and the energy every this many steps.
       integer :: record_every = 1
       !> &output: record the beam's shape every this many steps (0: never).
@@ -261,6 +263,10 @@ contains
       end if
       if (scene%snapshot_every < 0) then
          call say('output', 'snapshot_every', fmt_int(int(scene%snapshot_every, ik)), 'snapshot_every >= 0 (0: none)')
+         return
+      end if
+      if (scene%checkpoint_every < 0) then
+         call say('output', 'checkpoint_every', fmt_int(scene%checkpoint_every), 'checkpoint_every >= 0 (0: none)')
          return
       end if
       call within('output', 'max_output_gb', scene%max_output_gb, 0.0_wp, 1.0e6_wp); if (allocated(error)) return

@@ -12,6 +12,8 @@ module beamstops_scheme
    use beamstops_band_solve, only: band_solver, prepare_solver, forward_substitution, back_substitution, &
       & forward_substitution_energy, &
       & band_diagonals, prepare_diagonals, diagonal_matvec, dot
+   use beamstops_state, only: state_type
+   use beamstops_clock, only: thread_cpu_seconds
    use beamstops_forcing, only: load_average, support_position
    use beamstops_contact_tip_projection, only: project_tip
    use beamstops_contact_compliance, only: spring_force, solve_spring_tip
@@ -25,41 +27,6 @@ module beamstops_scheme
    !> Steps between progress reports and divergence checks.
    integer(ik), parameter :: block_steps = 8192_ik
 
-   !> Everything the loop carries from step n to step n+1: with it, a run can be resumed.
-   type :: state_type
-      !> Index n of the next step (the step that computes u^{n+1}).
-      integer(ik) :: step = 1
-      !> u^n (n).
-      real(wp), allocatable :: u(:)
-      !> d^{n-1} = u^n - u^{n-1} (n).
-      real(wp), allocatable :: d(:)
-      !> S u^n (n).
-      real(wp), allocatable :: su(:)
-      !> Scratch vectors (n) and the snapshot buffer (J+1).
-      real(wp), allocatable :: rhs(:), scratch(:), shape(:)
-      !> Load averages sigma_{n-1}, sigma_n.
-      real(wp) :: sigma_prev = 0, sigma_now = 0
-      !> g . d^{n-1}.
-      real(wp) :: gd_prev = 0
-      !> Spring forces p(u^{n-1}), p(u^n) at the tip (compliance).
-      real(wp) :: p_prev = 0, p_now = 0
-      !> Work of the load W_{n-1} and energy taken by the stops D_{n-1}, per unit mass.
-      real(wp) :: work = 0, dissipated = 0
-      !> Discrete energy E^{1/2} per unit mass (reference for the divergence check).
-      real(wp) :: energy0 = 0
-      !> Whether the previous step was in contact.
-      logical :: in_contact = .false.
-      !> Impacts so far.
-      integer(ik) :: impacts = 0
-      !> Largest violation of the stops so far (m).
-      real(wp) :: max_violation = 0
-      !> The factor of A in the form of the fused substitutions (from model%factor).
-      type(band_solver) :: solver
-      !> S and M by diagonals (for the vectorized products of the loop).
-      type(band_diagonals) :: stiffness, mass
-      !> Solve with LAPACK's dpbtrs and separate updates: the reference path of the tests.
-      logical :: lapack_solve = .false.
-   end type state_type
 
    !> The load averages sigma_k = f sin(omega c_k) (forcing's load_average; f = sinc(omega dt/2),
    !> c_k the centre of step k's interval) step after step by rotating (f sin, f cos)(omega c_k)
@@ -153,6 +120,8 @@ contains
    end function matmul_band
 
    !> Run from the state's step to the scene's last step, in blocks; fills the summary.
+   !> Between blocks: the divergence check, progress, and every scene%checkpoint_every
+   !> steps the recorder's checkpoint (blocks end on checkpoint steps).
    subroutine run_scheme(scene, model, state, recorder, summary)
       !> Scene.
       type(scene_type), intent(in) :: scene
@@ -164,14 +133,17 @@ contains
       class(recorder_type), intent(inout) :: recorder
       !> Outcome of the run.
       type(run_summary), intent(inout) :: summary
-      integer(ik) :: steps, last
-      real(wp) :: t0, t1, kinetic, cap
+      integer(ik) :: steps, last, every
+      real(wp) :: t0, kinetic, cap
       steps = steps_of(scene)
+      every = scene%checkpoint_every
       summary%status = status_running
-      call cpu_time(t0)
+      t0 = thread_cpu_seconds() - state%cpu_seconds
       do while (state%step <= steps)
          last = min(steps, state%step + block_steps - 1)
+         if (every > 0) last = min(last, ((state%step - 1)/every + 1)*every)
          call advance(scene, model, state, recorder, last)
+         state%cpu_seconds = thread_cpu_seconds() - t0
          if (recorder%failed) then
             summary%status = status_failed
             summary%message = 'the recorder could not write'
@@ -187,10 +159,12 @@ contains
                & 'before t = '//trim(real_text(real(state%step - 1, wp)*model%dt))//' s'
             exit
          end if
+         if (every > 0 .and. state%step <= steps) then
+            if (mod(state%step - 1, every) == 0) call recorder%checkpoint(state)
+         end if
          call recorder%progress(state%step - 1, steps)
       end do
-      call cpu_time(t1)
-      summary%cpu_seconds = summary%cpu_seconds + (t1 - t0)
+      summary%cpu_seconds = state%cpu_seconds
       summary%steps = state%step - 1
       summary%t_final = real(summary%steps, wp)*model%dt
       summary%impacts = state%impacts
@@ -239,7 +213,7 @@ contains
       integer(ik), intent(in) :: last
       integer(ik) :: step, next_record, next_snapshot
       integer :: tip
-      real(wp) :: sigma_next, weight, c, tip_value, trial, r_step, gd, d_tip_prev, u_tip_prev, u_old_su, dmd
+      real(wp) :: sigma_next, weight, c, tip_value, trial, r_step, r_prev, gd, d_tip_prev, u_tip_prev, u_old_su, dmd
       real(wp) :: row(n_columns)
       logical :: contact
 
@@ -257,14 +231,16 @@ contains
          call contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
          call update(state%rhs, c, model%z, state%d, state%u)
          gd = dot_product(model%load, state%d)
-         call close_step(scene, model, state, contact, tip_value, gd, weight, r_step, d_tip_prev, sigma_next)
+         r_prev = state%reaction
+         call close_step(scene, model, state, contact, tip_value, gd, weight, r_step, d_tip_prev, u_tip_prev, &
+            & sigma_next)
          if (step == next_record) u_old_su = dot_product(state%u, state%su) - dot_product(state%d, state%su)
          call band_matvec(model%stiffness, state%u, state%su)
          if (step == next_record) then
             next_record = next_record + scene%record_every
             call band_matvec(model%mass, state%d, state%scratch)
             dmd = dot_product(state%d, state%scratch)
-            call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_step, row)
+            call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_prev, row)
             row(col_energy) = scene%mass_per_length*energy(model, dmd, dot_product(state%u, state%su), &
                & dot_product(state%d, state%su), u_old_su)
             call recorder%record(row)
@@ -291,7 +267,7 @@ contains
       integer(ik) :: step, next_record, next_snapshot
       integer :: tip
       real(wp) :: sigma_next, weight, c, tip_value, trial, r_step, gd, d_tip_prev, u_tip_prev
-      real(wp) :: usu, dsu, u_old_su, dmd, row(n_columns)
+      real(wp) :: usu, dsu, u_old_su, dmd, r_prev, row(n_columns)
       logical :: contact, pending
       type(load_rotation) :: loads
 
@@ -323,10 +299,12 @@ contains
          call contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
          call update(state%rhs, c, model%z, state%d, state%u)
          gd = dot(model%load, state%d)
-         call close_step(scene, model, state, contact, tip_value, gd, weight, r_step, d_tip_prev, sigma_next)
+         r_prev = state%reaction
+         call close_step(scene, model, state, contact, tip_value, gd, weight, r_step, d_tip_prev, u_tip_prev, &
+            & sigma_next)
          if (step == next_record) then
             next_record = next_record + scene%record_every
-            call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_step, row)
+            call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_prev, row)
             pending = .true.
          end if
          if (step == next_snapshot) then
@@ -486,22 +464,29 @@ contains
       end select
    end subroutine contact_law
 
-   !> After the update: the exact tip value (Signorini), the violation (compliance), impacts,
+   !> After the update: the exact tip value (Signorini), the violation of the stops, impacts,
    !> the work of the load and the energy taken by the stops, the load averages moved on.
-   subroutine close_step(scene, model, state, contact, tip_value, gd, weight, r_step, d_tip_prev, sigma_next)
+   subroutine close_step(scene, model, state, contact, tip_value, gd, weight, r_step, d_tip_prev, u_tip_prev, &
+      & sigma_next)
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
       type(state_type), intent(inout) :: state
       logical, intent(in) :: contact
-      real(wp), intent(in) :: tip_value, gd, weight, r_step, d_tip_prev, sigma_next
+      real(wp), intent(in) :: tip_value, gd, weight, r_step, d_tip_prev, u_tip_prev, sigma_next
       integer :: tip
       tip = model%tip
-      if (scene%law == law_signorini .and. contact) state%u(tip) = tip_value
-      if (scene%law == law_compliance) state%max_violation = max(state%max_violation, violation(state%u(tip), scene))
+      if (scene%law == law_signorini .and. contact) then
+         ! The tip exactly on the stop, and d^n its exact increment (a tip resting on a stop
+         ! then has exactly zero velocity).
+         state%u(tip) = tip_value
+         state%d(tip) = tip_value - u_tip_prev
+      end if
+      if (scene%law /= law_none) state%max_violation = max(state%max_violation, violation(state%u(tip), scene))
       if (contact .and. .not. state%in_contact) state%impacts = state%impacts + 1
       state%in_contact = contact
       state%work = state%work + 0.5_wp*weight*(gd + state%gd_prev)
       state%dissipated = state%dissipated - 0.5_wp*r_step*(state%d(tip) + d_tip_prev)
+      state%reaction = r_step
       state%gd_prev = gd
       state%sigma_prev = state%sigma_now
       state%sigma_now = sigma_next

@@ -49,23 +49,22 @@ contains
          call check(error, rec%rows(col_u, j) >= scene%lower .and. rec%rows(col_u, j) <= scene%upper, &
             & 'tip u = '//real_text(rec%rows(col_u, j))//' within the stops'//where)
          if (allocated(error)) return
-         ! The reaction of step n is (A u^{n+1} - F^n)_tip/dt^2, an element of -d psi(u^{n+1}):
-         ! the row of t_n holds u^n and r^n, so r^n pairs with the next row's u.
-         if (j == rec%filled) exit
+         ! The reaction of step n-1 is (A u^n - F^{n-1})_tip/dt^2, an element of -d psi(u^n):
+         ! the row of t_n holds u^n and that reaction, so each row pairs with itself.
          r = rec%rows(col_reaction, j)
-         u_next = rec%rows(col_u, j + 1)
+         u_next = rec%rows(col_u, j)
          if (r < 0) then
             upper_contacts = upper_contacts + 1
-            call check(error, u_next, scene%upper, 'negative reaction '//real_text(r)//' needs u^{n+1} at the upper stop'// &
+            call check(error, u_next, scene%upper, 'negative reaction '//real_text(r)//' needs u^n at the upper stop'// &
                & where, thr=0.0_wp)
          else if (r > 0) then
             lower_contacts = lower_contacts + 1
-            call check(error, u_next, scene%lower, 'positive reaction '//real_text(r)//' needs u^{n+1} at the lower stop'// &
+            call check(error, u_next, scene%lower, 'positive reaction '//real_text(r)//' needs u^n at the lower stop'// &
                & where, thr=0.0_wp)
          end if
          if (allocated(error)) return
          if (u_next > scene%lower .and. u_next < scene%upper) then
-            call check(error, r, 0.0_wp, 'reaction with u^{n+1} strictly between the stops'//where, thr=0.0_wp)
+            call check(error, r, 0.0_wp, 'reaction with u^n strictly between the stops'//where, thr=0.0_wp)
             if (allocated(error)) return
          end if
       end do

@@ -60,7 +60,7 @@ contains
       real(wp), allocatable :: mm(:, :), ss(:, :), aa(:, :), g(:), bh(:), b1(:), z(:), &
          & u_old(:), u(:), u_new(:), d(:), d_new(:), f(:), a0(:), v0(:), e_tip(:)
       real(wp) :: me(4, 4), se(4, 4), h, dt, beta, weight, y, c, r, energy, x
-      real(wp) :: du_max, dv_max, dr_max, de_max, r_scale, e_scale, u_scale, v_scale
+      real(wp) :: du_max, dv_max, dr_max, de_max, r_scale, r_prev, e_scale, u_scale, v_scale
       integer(ik) :: k, steps, contacts
       integer :: n, tip, i
 
@@ -100,6 +100,7 @@ contains
       contacts = 0
       u_scale = maxval(abs(rec%rows(col_u, :rec%filled)))
       r_scale = max(maxval(abs(rec%rows(col_reaction, :rec%filled))), tiny(1.0_wp))
+      r_prev = 0
       e_scale = maxval(abs(rec%rows(col_energy, :rec%filled)))
       v_scale = maxval(abs(rec%rows(col_v, :rec%filled)))
       ! E^{1/2} at the record of t = 0
@@ -140,14 +141,15 @@ contains
          case default
             u_new = u + d_new
          end select
-         ! the engine's row of step k: t_k, u^k, reaction r^k, E^{k+1/2}
+         ! the engine's row of step k: t_k, u^k, the reaction r^{k-1} that gave u^k, E^{k+1/2}
          if (abs(rec%rows(col_t, k + 1) - k*dt) > 1e-9_wp*dt) then
             call test_failed(error, 'the record of step '//int_text(k)//' is at t = '//real_text(rec%rows(col_t, k + 1)))
             return
          end if
          du_max = max(du_max, abs(rec%rows(col_u, k + 1) - u(tip)))
          dv_max = max(dv_max, abs(rec%rows(col_v, k + 1) - (u_new(tip) - u_old(tip))/(2*dt)))
-         dr_max = max(dr_max, abs(rec%rows(col_reaction, k + 1) - scene%mass_per_length*r))
+         dr_max = max(dr_max, abs(rec%rows(col_reaction, k + 1) - scene%mass_per_length*r_prev))
+         r_prev = r
          de_max = max(de_max, abs(rec%rows(col_energy, k + 1) - scene%mass_per_length*discrete_energy(u, u_new)))
          u_old = u
          u = u_new

@@ -12,7 +12,10 @@ module beamstops_recorder_hdf5
    use beamstops_error, only: error_type, fatal_error
    use beamstops_scene, only: scene_type, law_name, law_compliance
    use beamstops_model, only: model_type
-   use beamstops_summary, only: run_summary, status_running
+   use beamstops_summary, only: run_summary, status_running, status_complete
+   use beamstops_state, only: state_type
+   use beamstops_checkpoint, only: write_checkpoint, checkpoint_path, remove_file
+   use beamstops_recorder_hdf5_vector, only: write_vector
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
       & col_work, col_dissipated
    use beamstops_version, only: version
@@ -20,8 +23,8 @@ module beamstops_recorder_hdf5
    private
    public :: hdf5_recorder
 
-   !> Rows buffered before a write.
-   integer, parameter :: buffer_rows = 4096
+   !> Rows buffered before a write (and rows of a chunk).
+   integer, parameter :: buffer_rows = 16384
    integer, parameter :: n_series = 8
    character(len=*), parameter :: group_names(3) = [character(len=9) :: 'tip', 'energy', 'snapshots']
    character(len=*), parameter :: series_path(n_series) = [character(len=18) :: '/tip/t', '/tip/u', '/tip/v', &
@@ -43,7 +46,10 @@ module beamstops_recorder_hdf5
       integer(hsize_t) :: written = 0, snaps_written = 0
       integer :: fill = 0
       integer :: nodes = 0
+      !> Buffered rows (buffer_rows, n_columns): each series a contiguous column.
       real(wp), allocatable :: buffer(:, :)
+      !> Scene of the run (for checkpoints).
+      type(scene_type) :: scene
       !> Buffered snapshots: times and shapes (nodes, snapshot_rows).
       real(wp), allocatable :: snap_t_buffer(:), snap_u_buffer(:, :)
       integer :: snap_fill = 0, snapshot_rows = 0
@@ -51,7 +57,9 @@ module beamstops_recorder_hdf5
       logical :: show_progress = .false.
    contains
       procedure :: open => open_file
+      procedure :: reopen
       procedure :: record
+      procedure :: checkpoint
       procedure :: snapshot
       procedure :: progress
       procedure :: finish
@@ -73,9 +81,12 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: hdferr, i
       integer(hid_t) :: group
+      logical :: ok
       self%path = path
+      self%scene = scene
       self%nodes = size(model%x)
-      allocate (self%buffer(n_columns, buffer_rows))
+      allocate (self%buffer(buffer_rows, n_columns))
+      call remove_file(checkpoint_path(path))
       call h5open_f(hdferr)
       call h5eset_auto_f(0, hdferr)
       call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%file, hdferr)
@@ -94,10 +105,10 @@ contains
       if (scene%snapshot_every > 0) then
          call create_series(self, '/snapshots/t', 's', 1, self%snap_t)
          call create_series(self, '/snapshots/u', 'm', self%nodes, self%snap_u)
-         self%snapshot_rows = max(1, min(buffer_rows, 2**20/self%nodes))
-         allocate (self%snap_t_buffer(self%snapshot_rows), self%snap_u_buffer(self%nodes, self%snapshot_rows))
       end if
-      call write_vector(self, '/snapshots/x', model%x)
+      call allocate_snapshot_buffer(self)
+      call write_vector(self%file, '/snapshots/x', model%x, ok)
+      if (.not. ok) call fail(self, 'cannot write dataset /snapshots/x')
       call attribute_text(self, 'status', status_running)
       call attribute_text(self, 'version', version)
       call attribute_real(self, 'length', scene%length)
@@ -136,7 +147,7 @@ contains
       class(hdf5_recorder), intent(inout) :: self
       real(wp), intent(in) :: row(n_columns)
       self%fill = self%fill + 1
-      self%buffer(:, self%fill) = row
+      self%buffer(self%fill, :) = row
       if (self%fill == buffer_rows) call write_buffer(self)
    end subroutine record
 
@@ -185,18 +196,96 @@ contains
       if (.not. self%failed) call attribute_text(self, 'status', summary%status)
       call h5fclose_f(self%file, hdferr)
       self%file = -1
+      if (summary%status == status_complete .and. .not. self%failed .and. hdferr == 0) &
+         & call remove_file(checkpoint_path(self%path))
       if (self%failed .or. hdferr /= 0) then
          if (.not. allocated(self%message)) self%message = self%path//': cannot close the HDF5 file'
          call fatal_error(error, self%message)
       end if
    end subroutine finish
 
+   !> Open the output of an interrupted run to continue it: its series are cut back to the
+   !> `records` and `snapshots` of the checkpoint, its status is 'incomplete' again.
+   subroutine reopen(self, path, scene, model, records, snapshots, error)
+      !> Recorder.
+      class(hdf5_recorder), intent(inout) :: self
+      !> Output file of the interrupted run.
+      character(len=*), intent(in) :: path
+      !> Scene of the run.
+      type(scene_type), intent(in) :: scene
+      !> Its model.
+      type(model_type), intent(in) :: model
+      !> Records and snapshots written before the checkpoint.
+      integer(ik), intent(in) :: records, snapshots
+      !> Set when the file cannot be opened or lacks a series.
+      type(error_type), allocatable, intent(out) :: error
+      integer :: hdferr, i
+      self%path = path
+      self%scene = scene
+      self%nodes = size(model%x)
+      allocate (self%buffer(buffer_rows, n_columns))
+      call h5open_f(hdferr)
+      call h5eset_auto_f(0, hdferr)
+      call h5fopen_f(path, H5F_ACC_RDWR_F, self%file, hdferr)
+      if (hdferr /= 0) then
+         self%failed = .true.
+         call fatal_error(error, path//': cannot reopen the output of the interrupted run')
+         return
+      end if
+      do i = 1, n_series
+         call reopen_series(trim(series_path(i)), self%series(i), [records])
+      end do
+      if (scene%snapshot_every > 0) then
+         call reopen_series('/snapshots/t', self%snap_t, [snapshots])
+         call reopen_series('/snapshots/u', self%snap_u, [int(self%nodes, ik), snapshots])
+      end if
+      call allocate_snapshot_buffer(self)
+      self%written = records
+      self%snaps_written = snapshots
+      call attribute_text(self, 'status', status_running)
+      if (self%failed) call fatal_error(error, self%message)
+
+   contains
+
+      subroutine reopen_series(name, dset, dims)
+         character(len=*), intent(in) :: name
+         integer(hid_t), intent(out) :: dset
+         integer(ik), intent(in) :: dims(:)
+         call h5dopen_f(self%file, name, dset, hdferr)
+         if (hdferr == 0) call h5dset_extent_f(dset, int(dims, hsize_t), hdferr)
+         if (hdferr /= 0) call fail(self, 'the output of the interrupted run has no series '//name)
+      end subroutine reopen_series
+   end subroutine reopen
+
+   !> Write what is buffered, flush the file, then the checkpoint (atomically).
+   subroutine checkpoint(self, state)
+      class(hdf5_recorder), intent(inout) :: self
+      type(state_type), intent(in) :: state
+      type(error_type), allocatable :: error
+      integer :: hdferr
+      if (self%failed) return
+      call write_buffer(self)
+      call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, hdferr)
+      if (hdferr /= 0) call fail(self, 'cannot flush the HDF5 file')
+      if (self%failed) return
+      call write_checkpoint(checkpoint_path(self%path), self%scene, state, int(self%written, ik), &
+         & int(self%snaps_written, ik), error)
+      if (allocated(error)) call fail(self, error%message)
+   end subroutine checkpoint
+
+   subroutine allocate_snapshot_buffer(self)
+      class(hdf5_recorder), intent(inout) :: self
+      if (self%scene%snapshot_every == 0) return
+      self%snapshot_rows = max(1, min(buffer_rows, 2**20/self%nodes))
+      allocate (self%snap_t_buffer(self%snapshot_rows), self%snap_u_buffer(self%nodes, self%snapshot_rows))
+   end subroutine allocate_snapshot_buffer
+
    !> Write the buffered records and snapshots.
    subroutine write_buffer(self)
       class(hdf5_recorder), intent(inout) :: self
       integer :: i
       do i = 1, n_series
-         call append(self, self%series(i), 1, self%written, self%fill, self%buffer(series_column(i), :self%fill))
+         call append(self, self%series(i), 1, self%written, self%fill, self%buffer(:, series_column(i)))
       end do
       self%written = self%written + self%fill
       self%fill = 0
@@ -261,24 +350,6 @@ contains
       call h5sclose_f(space, hdferr)
       call dataset_units(dset, units)
    end subroutine create_series
-
-   !> A fixed-size dataset.
-   subroutine write_vector(self, path, values)
-      class(hdf5_recorder), intent(inout) :: self
-      character(len=*), intent(in) :: path
-      real(wp), intent(in) :: values(:)
-      integer(hid_t) :: space, dset
-      integer(hsize_t) :: dims(1)
-      integer :: hdferr
-      dims = size(values)
-      call h5screate_simple_f(1, dims, space, hdferr)
-      call h5dcreate_f(self%file, path, H5T_NATIVE_DOUBLE, space, dset, hdferr)
-      call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, hdferr)
-      if (hdferr /= 0) call fail(self, 'cannot write dataset '//path)
-      call dataset_units(dset, 'm')
-      call h5dclose_f(dset, hdferr)
-      call h5sclose_f(space, hdferr)
-   end subroutine write_vector
 
    subroutine dataset_units(dset, units)
       integer(hid_t), intent(in) :: dset

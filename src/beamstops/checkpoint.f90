@@ -1,0 +1,179 @@
+!> Checkpoints: the loop's whole state, the number of records and snapshots already in the
+!> output, and the scene's signature, in a small HDF5 file written atomically (a temporary
+!> file, then rename), so that a killed run resumes exactly where its last checkpoint was.
+module beamstops_checkpoint
+   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+   use hdf5
+   use beamstops_kinds, only: wp, ik
+   use beamstops_error, only: error_type, fatal_error
+   use beamstops_scene, only: scene_type
+   use beamstops_model, only: model_type
+   use beamstops_state, only: state_type
+   use beamstops_recorder_hdf5_vector, only: write_vector, read_vector
+   implicit none
+   private
+   public :: write_checkpoint, read_checkpoint, checkpoint_path, scene_signature, remove_file
+
+   integer, parameter :: n_scalars = 16
+
+   interface
+      function c_rename(from, to) bind(c, name='rename') result(status)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: from(*), to(*)
+         integer(c_int) :: status
+      end function c_rename
+      function c_remove(path) bind(c, name='remove') result(status)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int) :: status
+      end function c_remove
+   end interface
+
+contains
+
+   !> The checkpoint file of an output file.
+   pure function checkpoint_path(output) result(path)
+      !> Output file.
+      character(len=*), intent(in) :: output
+      character(len=:), allocatable :: path
+      path = output//'.checkpoint'
+   end function checkpoint_path
+
+   !> Every value of a scene that shapes the records, as numbers (a restart must match them).
+   pure function scene_signature(scene) result(values)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      real(wp) :: values(18)
+      values = [scene%length, scene%k2, scene%mass_per_length, scene%amplitude, scene%omega, scene%lower, &
+         & scene%upper, real(scene%law, wp), scene%stiffness_per_mass, real(scene%elements, wp), scene%dt, &
+         & scene%t_end, scene%beta, merge(1.0_wp, 0.0_wp, scene%centered_load), &
+         & merge(1.0_wp, 0.0_wp, scene%taylor_start), real(scene%record_every, wp), &
+         & real(scene%snapshot_every, wp), real(scene%checkpoint_every, wp)]
+   end function scene_signature
+
+   !> Remove a file if it exists.
+   subroutine remove_file(path)
+      !> File.
+      character(len=*), intent(in) :: path
+      integer(c_int) :: status
+      status = c_remove(path//c_null_char)
+   end subroutine remove_file
+
+   !> Write the checkpoint `path` atomically.
+   subroutine write_checkpoint(path, scene, state, records, snapshots, error)
+      !> Checkpoint file.
+      character(len=*), intent(in) :: path
+      !> Scene of the run.
+      type(scene_type), intent(in) :: scene
+      !> State after the last step done.
+      type(state_type), intent(in) :: state
+      !> Records and snapshots already in the output file.
+      integer(ik), intent(in) :: records, snapshots
+      !> Set when the file cannot be written.
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: temporary
+      integer(hid_t) :: file
+      integer :: hdferr
+      logical :: ok(5)
+      temporary = path//'.tmp'
+      call h5open_f(hdferr)
+      call h5eset_auto_f(0, hdferr)
+      call h5fcreate_f(temporary, H5F_ACC_TRUNC_F, file, hdferr)
+      if (hdferr /= 0) then
+         call fatal_error(error, path//': cannot write the checkpoint')
+         return
+      end if
+      call write_vector(file, 'signature', scene_signature(scene), ok(1))
+      call write_vector(file, 'scalars', scalars_of(state, records, snapshots), ok(2))
+      call write_vector(file, 'u', state%u, ok(3))
+      call write_vector(file, 'd', state%d, ok(4))
+      call write_vector(file, 'su', state%su, ok(5))
+      call h5fclose_f(file, hdferr)
+      if (.not. all(ok) .or. hdferr /= 0) then
+         call fatal_error(error, path//': cannot write the checkpoint')
+         return
+      end if
+      if (c_rename(temporary//c_null_char, path//c_null_char) /= 0) &
+         & call fatal_error(error, path//': cannot move the new checkpoint in place')
+   end subroutine write_checkpoint
+
+   !> Read the checkpoint `path` of a run of `scene`: the state (with its work arrays) and
+   !> the records and snapshots the output held at that moment.
+   subroutine read_checkpoint(path, scene, model, state, records, snapshots, error)
+      !> Checkpoint file.
+      character(len=*), intent(in) :: path
+      !> Scene of the run to resume (must be the checkpoint's).
+      type(scene_type), intent(in) :: scene
+      !> Its model.
+      type(model_type), intent(in) :: model
+      !> State restored.
+      type(state_type), intent(out) :: state
+      !> Records and snapshots the output held at the checkpoint.
+      integer(ik), intent(out) :: records, snapshots
+      !> Set when the file is unreadable or belongs to another scene.
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: signature(size(scene_signature(scene))), scalars(n_scalars)
+      integer(hid_t) :: file
+      integer :: hdferr, n
+      logical :: ok(5)
+      records = 0
+      snapshots = 0
+      n = model%n
+      allocate (state%u(n), state%d(n), state%su(n), state%rhs(n), state%scratch(n), state%shape(size(model%x)))
+      call h5open_f(hdferr)
+      call h5eset_auto_f(0, hdferr)
+      call h5fopen_f(path, H5F_ACC_RDONLY_F, file, hdferr)
+      if (hdferr /= 0) then
+         call fatal_error(error, path//': cannot read the checkpoint')
+         return
+      end if
+      call read_vector(file, 'signature', signature, ok(1))
+      call read_vector(file, 'scalars', scalars, ok(2))
+      call read_vector(file, 'u', state%u, ok(3))
+      call read_vector(file, 'd', state%d, ok(4))
+      call read_vector(file, 'su', state%su, ok(5))
+      call h5fclose_f(file, hdferr)
+      if (.not. all(ok)) then
+         call fatal_error(error, path//': the checkpoint is damaged or of another mesh')
+         return
+      end if
+      if (any(signature /= scene_signature(scene))) then
+         call fatal_error(error, path//': the checkpoint belongs to another scene; allowed: the same '// &
+            & 'namelist values as the interrupted run (or run without --restart)')
+         return
+      end if
+      call restore_scalars(scalars, state, records, snapshots)
+   end subroutine read_checkpoint
+
+   !> The state's scalars, the record counts included, as one vector (integers are exact in it).
+   pure function scalars_of(state, records, snapshots) result(v)
+      type(state_type), intent(in) :: state
+      integer(ik), intent(in) :: records, snapshots
+      real(wp) :: v(n_scalars)
+      v = [real(state%step, wp), state%sigma_prev, state%sigma_now, state%gd_prev, state%p_prev, state%p_now, &
+         & state%work, state%dissipated, state%energy0, state%reaction, merge(1.0_wp, 0.0_wp, state%in_contact), &
+         & real(state%impacts, wp), state%cpu_seconds, state%max_violation, real(records, wp), real(snapshots, wp)]
+   end function scalars_of
+
+   pure subroutine restore_scalars(v, state, records, snapshots)
+      real(wp), intent(in) :: v(n_scalars)
+      type(state_type), intent(inout) :: state
+      integer(ik), intent(out) :: records, snapshots
+      state%step = nint(v(1), ik)
+      state%sigma_prev = v(2)
+      state%sigma_now = v(3)
+      state%gd_prev = v(4)
+      state%p_prev = v(5)
+      state%p_now = v(6)
+      state%work = v(7)
+      state%dissipated = v(8)
+      state%energy0 = v(9)
+      state%reaction = v(10)
+      state%in_contact = v(11) /= 0
+      state%impacts = nint(v(12), ik)
+      state%cpu_seconds = v(13)
+      state%max_violation = v(14)
+      records = nint(v(15), ik)
+      snapshots = nint(v(16), ik)
+   end subroutine restore_scalars
+end module beamstops_checkpoint

@@ -1,0 +1,122 @@
+"""Checkpoints: a run killed with SIGKILL at random moments and resumed with --restart
+gives the uninterrupted run's output bit for bit; an interrupted file says so."""
+
+from __future__ import annotations
+
+import os
+import random
+import shutil
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+import beamstops
+
+PROGRAM = os.environ.get("BEAMSTOPS_PROGRAM") or shutil.which("beamstops")
+pytestmark = pytest.mark.skipif(PROGRAM is None, reason="the beamstops program is not on PATH")
+
+SCENE = """&time dt=1e-6, t_end={t_end} /
+&output file='{file}', record_every=1, snapshot_every=997, checkpoint_every=40000 /
+"""
+
+
+def write_scene(folder: Path, name: str, t_end: float = 1.0) -> Path:
+    path = folder / f"{name}.nml"
+    path.write_text(SCENE.format(t_end=t_end, file=f"{name}.h5"))
+    return path
+
+
+def run(*args: str | Path, cwd: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([PROGRAM, *map(str, args)], cwd=cwd, capture_output=True, text=True, timeout=300)
+
+
+def datasets(path: Path) -> dict[str, np.ndarray]:
+    out: dict[str, np.ndarray] = {}
+    with h5py.File(path) as f:
+        f.visititems(lambda name, obj: out.__setitem__(name, obj[()]) if isinstance(obj, h5py.Dataset) else None)
+        out.update({f"@{k}": v for k, v in f.attrs.items() if k != "cpu_seconds"})
+    return out
+
+
+def assert_identical(a: Path, b: Path) -> None:
+    x, y = datasets(a), datasets(b)
+    assert sorted(x) == sorted(y)
+    for name in x:
+        if name.startswith("@"):
+            assert np.array_equal(x[name], y[name]), name
+        else:
+            assert x[name].shape == y[name].shape, name
+            assert np.array_equal(x[name].view(np.uint64), y[name].view(np.uint64)), name
+
+
+def test_killed_runs_resume_bit_for_bit(tmp_path: Path) -> None:
+    reference = write_scene(tmp_path, "reference")
+    assert run("run", reference, cwd=tmp_path).returncode == 0
+    scene = write_scene(tmp_path, "killed")
+    seed = int(time.time())
+    rng = random.Random(seed)
+    kills = 0
+    args: list[str | Path] = ["run", scene]
+    for _ in range(6):
+        process = subprocess.Popen([PROGRAM, *map(str, args)], cwd=tmp_path, stdout=subprocess.DEVNULL,
+                                   stderr=subprocess.DEVNULL)
+        time.sleep(rng.uniform(0.02, 0.3))
+        if process.poll() is None:
+            process.send_signal(signal.SIGKILL)
+            kills += 1
+        process.wait()
+        args = ["run", scene, "--restart"]
+    done = run(*args, cwd=tmp_path)
+    assert done.returncode == 0, f"seed {seed}: {done.stderr}"
+    assert kills > 0, "the run was never killed: make it longer"
+    assert not (tmp_path / "killed.h5.checkpoint").exists()
+    assert_identical(tmp_path / "killed.h5", tmp_path / "reference.h5")
+
+
+def test_interrupted_file_says_so_and_keeps_its_records(tmp_path: Path) -> None:
+    scene = write_scene(tmp_path, "cut", t_end=4.0)
+    process = subprocess.Popen([PROGRAM, "run", str(scene)], cwd=tmp_path, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+    checkpoint = tmp_path / "cut.h5.checkpoint"
+    deadline = time.time() + 60
+    while not checkpoint.exists() and time.time() < deadline:
+        time.sleep(0.01)
+    time.sleep(0.05)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    assert checkpoint.exists()
+    with pytest.raises(beamstops.IncompleteRunError):
+        beamstops.load(tmp_path / "cut.h5")
+    partial = beamstops.load(tmp_path / "cut.h5", allow_incomplete=True)
+    assert partial.status == "running"
+    # every record up to the checkpoint is there, on the time grid
+    assert partial.t.size >= 40000
+    np.testing.assert_allclose(partial.t[:40001], np.arange(40001) * 1e-6, rtol=0, atol=1e-12)
+
+
+def test_restart_refuses_a_changed_scene(tmp_path: Path) -> None:
+    scene = write_scene(tmp_path, "changed", t_end=4.0)
+    process = subprocess.Popen([PROGRAM, "run", str(scene)], cwd=tmp_path, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+    deadline = time.time() + 60
+    while not (tmp_path / "changed.h5.checkpoint").exists() and time.time() < deadline:
+        time.sleep(0.01)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    scene.write_text(scene.read_text().replace("dt=1e-6", "dt=2e-6"))
+    done = run("run", scene, "--restart", cwd=tmp_path)
+    assert done.returncode == 1
+    assert "another scene" in done.stderr and done.stderr.count("\n") == 1
+
+
+def test_restart_without_checkpoint_starts_over(tmp_path: Path) -> None:
+    scene = write_scene(tmp_path, "fresh", t_end=0.05)
+    done = run("run", scene, "--restart", cwd=tmp_path)
+    assert done.returncode == 0
+    assert "starting from t = 0" in done.stderr
+    assert beamstops.load(tmp_path / "fresh.h5").attrs["steps"] == 50000
