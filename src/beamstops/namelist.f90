@@ -298,12 +298,15 @@ contains
       subroutine append_text(g, piece)
          integer, intent(in) :: g
          character(len=*), intent(in) :: piece
-         if (used(g) + len(piece) > 200) return
-         if (piece == ' ' .and. used(g) > 0) then
+         character(len=len(piece)) :: text
+         text = piece
+         if (text == achar(9) .or. text == achar(13)) text = ' '
+         if (used(g) + len(text) > 200) return
+         if (text == ' ' .and. used(g) > 0) then
             if (texts(g)(used(g):used(g)) == ' ') return
          end if
-         texts(g)(used(g) + 1:used(g) + len(piece)) = piece
-         used(g) = used(g) + len(piece)
+         texts(g)(used(g) + 1:used(g) + len(text)) = text
+         used(g) = used(g) + len(text)
       end subroutine append_text
    end subroutine scan_groups
 
@@ -346,14 +349,14 @@ contains
       end do
    end function group_index
 
-   !> Whether a line holds control characters other than tab, line feed and carriage return.
+   !> Whether a line holds control characters other than tab and carriage return.
    pure logical function is_binary(s)
       character(len=*), intent(in) :: s
       integer :: i, code
       is_binary = .false.
       do i = 1, len(s)
          code = iachar(s(i:i))
-         if (code < 9 .or. (code > 13 .and. code < 32) .or. code == 127) is_binary = .true.
+         if ((code < 32 .and. code /= 9 .and. code /= 13) .or. code == 127) is_binary = .true.
       end do
    end function is_binary
 
