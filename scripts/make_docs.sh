@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Regenerate every figure and table the README shows, into docs/ (run after scripts/setup.sh).
+# Each is the output of a script of this repository on this machine; nothing is typed in.
+#   docs/paper/        scripts/paper_figures.py     the paper's Figures 2-8, report.md
+#   docs/bench.md      scripts/bench.py             speed tables
+#   docs/convergence/  scripts/convergence.py       convergence tables (markdown, CSV)
+#   docs/work_precision/, docs/stability_map/, docs/compliance/   the studies
+#   docs/bifurcation/  scripts/bifurcation.py       bifurcation diagram (sweep)
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+export PATH="$PWD/.venv/bin:$PATH" MPLBACKEND=Agg
+python scripts/paper_figures.py --out docs/paper
+python scripts/convergence.py -o docs/convergence --quiet
+python scripts/study_workprecision.py -o docs/work_precision --quiet
+python scripts/study_stability.py -o docs/stability_map --quiet
+python scripts/study_compliance.py -o docs/compliance --quiet
+python scripts/bifurcation.py -o out/bifurcation --png docs/bifurcation/bifurcation.png -q
+python scripts/bench.py --out docs/bench.md
+# keep the images and tables, not the HDF5 files of the runs
+find docs -name '*.h5' -delete
