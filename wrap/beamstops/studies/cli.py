@@ -1,10 +1,55 @@
 """Subcommands of the studies for ``python -m beamstops`` (appended to cli.COMMANDS):
-``converge``, ``work-precision``, ``stability-map``, ``compliance``."""
+``converge``, ``work-precision``, ``stability-map``, ``compliance``; and :class:`StudyCommand`,
+the command line every study shares (its subcommand and the ``main`` of its script)."""
 
 from __future__ import annotations
 
 import argparse
-from typing import Callable
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Optional
+
+from .common import out_dir
+
+
+@dataclass(frozen=True)
+class StudyCommand:
+    """The command line of a study: ``-o DIR`` (default out/<stem>), ``--quick``, the study's own
+    ``options``, ``--quiet``. ``run(folder, args)`` runs the study into ``folder`` and returns
+    the file the command prints. It is the subcommand ``name`` of ``python -m beamstops``
+    (``help``, ``description``) and the script ``prog`` (``script_description``)."""
+
+    stem: str
+    options: Callable[[argparse.ArgumentParser], None]
+    run: Callable[[Path, argparse.Namespace], Path]
+    name: str
+    help: str
+    description: str
+    prog: str
+    script_description: str
+
+    def arguments(self, parser: argparse.ArgumentParser) -> None:
+        parser.add_argument("-o", "--output", type=Path, help=f"output folder (default out/{self.stem})")
+        parser.add_argument("--quick", action="store_true", help="small sizes (seconds), for tests and CI")
+        self.options(parser)
+        parser.add_argument("--quiet", action="store_true", help="no progress bars")
+
+    def handler(self, args: argparse.Namespace) -> int:
+        print(self.run(out_dir(args.output, self.stem), args))
+        return 0
+
+    def register(self, subparsers: argparse._SubParsersAction) -> None:
+        """Add the study's subcommand to ``python -m beamstops``."""
+        parser = subparsers.add_parser(self.name, help=self.help, description=self.description)
+        self.arguments(parser)
+        parser.set_defaults(handler=self.handler)
+
+    def main(self, argv: Optional[Sequence[str]] = None) -> int:
+        """The study's script: parse ``argv`` (default sys.argv[1:]), run, print the file."""
+        parser = argparse.ArgumentParser(prog=self.prog, description=self.script_description)
+        self.arguments(parser)
+        return self.handler(parser.parse_args(argv))
 
 
 def register_converge(subparsers: argparse._SubParsersAction) -> None:

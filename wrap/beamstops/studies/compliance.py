@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import math
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Optional
 
@@ -27,6 +26,7 @@ import numpy as np
 from ..engine import run
 from ..result import Result
 from ..scene import Scene
+from .cli import StudyCommand
 from .common import Table, out_dir, progress
 
 __all__ = ["reversals", "hf_fraction", "study", "main", "register"]
@@ -128,29 +128,19 @@ def draw(table: Table, path: Path) -> Path:
     return path
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """``compliance [-o DIR] [--quick] [--cutoff HZ]``."""
-    parser = subparsers.add_parser("compliance", help="normal compliance: spurious oscillations and penetration",
-                                   description="Normal compliance against the Signorini scheme (PNG, md, CSV).")
-    _arguments(parser)
-    parser.set_defaults(handler=_handler)
-
-
-def _arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("-o", "--output", type=Path, help="output folder (default out/compliance)")
-    parser.add_argument("--quick", action="store_true", help="small sizes (seconds), for tests and CI")
+def _options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--cutoff", type=float, default=5000.0, help="cut-off frequency in Hz (default 5000)")
-    parser.add_argument("--quiet", action="store_true", help="no progress bars")
 
 
-def _handler(args: argparse.Namespace) -> int:
-    folder = out_dir(args.output, "compliance")
+def _run(folder: Path, args: argparse.Namespace) -> Path:
     study(folder, quick=args.quick, cutoff=args.cutoff, quiet=args.quiet)
-    print(folder / "compliance.png")
-    return 0
+    return folder / "compliance.png"
 
 
-def main(argv: Optional[Sequence[str]] = None) -> int:
-    parser = argparse.ArgumentParser(prog="study_compliance", description="Normal compliance study.")
-    _arguments(parser)
-    return _handler(parser.parse_args(argv))
+#: ``compliance [-o DIR] [--quick] [--cutoff HZ]``; ``main`` is scripts/study_compliance.py.
+COMMAND = StudyCommand("compliance", _options, _run, name="compliance",
+                       help="normal compliance: spurious oscillations and penetration",
+                       description="Normal compliance against the Signorini scheme (PNG, md, CSV).",
+                       prog="study_compliance", script_description="Normal compliance study.")
+register = COMMAND.register
+main = COMMAND.main

@@ -27,6 +27,7 @@ import numpy as np
 from ..engine import run, stability
 from ..result import IncompleteRunError, Result
 from ..scene import Scene
+from .cli import StudyCommand
 from .common import Table, out_dir, progress
 
 __all__ = ["classify", "energy_scale", "beta_map", "mesh_map", "answer", "study", "main", "register"]
@@ -182,29 +183,19 @@ def study(folder: Optional[Path] = None, *, quick: bool = False, threshold: floa
     return tables
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """``stability-map [-o DIR] [--quick] [--threshold X]``."""
-    parser = subparsers.add_parser("stability-map", help="stable/unstable maps in (β, Δt) and (J, Δt) (PNG, md, CSV)",
-                                   description="Classify runs over (β, Δt) and (J, Δt) from energy growth.")
-    _arguments(parser)
-    parser.set_defaults(handler=_handler)
-
-
-def _arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("-o", "--output", type=Path, help="output folder (default out/stability_map)")
-    parser.add_argument("--quick", action="store_true", help="small sizes (seconds), for tests and CI")
+def _options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--threshold", type=float, default=10.0, help="energy growth that means unstable (default 10)")
-    parser.add_argument("--quiet", action="store_true", help="no progress bars")
 
 
-def _handler(args: argparse.Namespace) -> int:
-    folder = out_dir(args.output, "stability_map")
+def _run(folder: Path, args: argparse.Namespace) -> Path:
     study(folder, quick=args.quick, threshold=args.threshold, quiet=args.quiet)
-    print(folder / "stability_map.png")
-    return 0
+    return folder / "stability_map.png"
 
 
-def main(argv: Optional[Sequence[str]] = None) -> int:
-    parser = argparse.ArgumentParser(prog="study_stability", description="Stability maps in (β, Δt) and (J, Δt).")
-    _arguments(parser)
-    return _handler(parser.parse_args(argv))
+#: ``stability-map [-o DIR] [--quick] [--threshold X]``; ``main`` is scripts/study_stability.py.
+COMMAND = StudyCommand("stability_map", _options, _run, name="stability-map",
+                       help="stable/unstable maps in (β, Δt) and (J, Δt) (PNG, md, CSV)",
+                       description="Classify runs over (β, Δt) and (J, Δt) from energy growth.",
+                       prog="study_stability", script_description="Stability maps in (β, Δt) and (J, Δt).")
+register = COMMAND.register
+main = COMMAND.main

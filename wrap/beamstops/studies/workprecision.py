@@ -21,6 +21,7 @@ from typing import Optional
 import numpy as np
 
 from ..scene import Scene
+from .cli import StudyCommand
 from .common import Table, out_dir, progress, run_tip, tip_error
 
 __all__ = ["Method", "methods", "study", "draw", "main", "register"]
@@ -110,31 +111,21 @@ def draw(table: Table, path: Path, windows: Sequence[float]) -> Path:
     return path
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """``work-precision [-o DIR] [--quick] [--window T]``."""
-    parser = subparsers.add_parser("work-precision", help="error against CPU time for every method (PNG, md, CSV)",
-                                   description="Work-precision chart: tip error against the engine's CPU time.")
-    _arguments(parser)
-    parser.set_defaults(handler=_handler)
-
-
-def _arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("-o", "--output", type=Path, help="output folder (default out/work_precision)")
-    parser.add_argument("--quick", action="store_true", help="small sizes (seconds), for tests and CI")
+def _options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--window", type=float, nargs="+", default=[0.08, 0.2],
                         help="compare on [0, W] s for each W (default 0.08 0.2: before the first impact, "
                              "the first contact period)")
-    parser.add_argument("--quiet", action="store_true", help="no progress bars")
 
 
-def _handler(args: argparse.Namespace) -> int:
-    folder = out_dir(args.output, "work_precision")
+def _run(folder: Path, args: argparse.Namespace) -> Path:
     study(folder, quick=args.quick, windows=tuple(args.window), quiet=args.quiet)
-    print(folder / "work_precision.png")
-    return 0
+    return folder / "work_precision.png"
 
 
-def main(argv: Optional[Sequence[str]] = None) -> int:
-    parser = argparse.ArgumentParser(prog="study_workprecision", description=__doc__.splitlines()[0])
-    _arguments(parser)
-    return _handler(parser.parse_args(argv))
+#: ``work-precision [-o DIR] [--quick] [--window T]``; ``main`` is scripts/study_workprecision.py.
+COMMAND = StudyCommand("work_precision", _options, _run, name="work-precision",
+                       help="error against CPU time for every method (PNG, md, CSV)",
+                       description="Work-precision chart: tip error against the engine's CPU time.",
+                       prog="study_workprecision", script_description=__doc__.splitlines()[0])
+register = COMMAND.register
+main = COMMAND.main
