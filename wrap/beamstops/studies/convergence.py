@@ -18,13 +18,16 @@ from __future__ import annotations
 import argparse
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Optional
 
 import numpy as np
 
+from ..result import Result
 from ..scene import Scene
-from .common import Table, energy_norm, observed_orders, out_dir, progress, prolong, run_three_level, run_tip, \
+from .cli import StudyCommand
+from .common import States, Table, energy_norm, observed_orders, out_dir, progress, prolong, run_three_level, run_tip, \
     states, tip_error
 
 __all__ = ["dt_table", "h_table", "study", "main", "register"]
@@ -56,6 +59,38 @@ def _columns(first: list[str], windows: Sequence[float], times: Sequence[float])
     return cols
 
 
+@dataclass(frozen=True)
+class _Reference:
+    """The reference run of a table: its scene, its tip record and its states at the table's times."""
+
+    scene: Scene
+    tip: Result
+    states: Optional[States]
+    windows: Sequence[float]
+    times: Sequence[float]
+
+    @classmethod
+    def of(cls, base: Scene, windows: Sequence[float], times: Sequence[float], grid: float,
+           **change: object) -> tuple[Scene, "_Reference"]:
+        """The base scene run up to the last window or time, and its reference: that scene with
+        ``change``, its tip recorded on ``grid``."""
+        base = base.replace(t_end=max(list(windows) + list(times)))
+        scene = base.replace(**change)
+        return base, cls(scene, run_tip(scene, grid), states(scene, times) if times else None, windows, times)
+
+    def errors(self, scene: Scene, result: Result) -> list[float]:
+        """A run's max and L2 tip errors on each window, then its energy errors at each time
+        (on the reference's mesh)."""
+        errs: list[float] = []
+        for w in self.windows:
+            e = tip_error(result, self.tip, w)
+            errs += [e.max, e.l2]
+        if self.states is not None:
+            errs += _energy_errors(states(scene, self.times), self.states, scene.elements, self.scene.elements,
+                                   scene.length)
+        return errs
+
+
 def _fill(rows: list[list[object]], sizes: Sequence[float], per_row: list[list[float]]) -> None:
     """Append each error series and its observed orders to the rows."""
     series = list(zip(*per_row)) if per_row else []
@@ -73,11 +108,7 @@ def dt_table(base: Scene, dts: Sequence[float], dt_ref: float, windows: Sequence
     and give its max tip error over [0, t_end] and its distance to the increment form.
     """
     grid = grid or max(dts)
-    t_end = max(list(windows) + list(times))
-    base = base.replace(t_end=t_end)
-    ref_scene = base.replace(dt=dt_ref)
-    ref = run_tip(ref_scene, grid)
-    ref_states = states(ref_scene, times) if times else None
+    base, reference = _Reference.of(base, windows, times, grid, dt=dt_ref)
     rows: list[list[object]] = []
     errors: list[list[float]] = []
     extra: list[list[float]] = []
@@ -85,19 +116,13 @@ def dt_table(base: Scene, dts: Sequence[float], dt_ref: float, windows: Sequence
         scene = base.replace(dt=dt)
         result = run_tip(scene, grid)
         row: list[object] = [dt, int(result.attrs["steps"]), result.attrs["cpu_seconds"]]
-        errs: list[float] = []
-        for w in windows:
-            e = tip_error(result, ref, w)
-            errs += [e.max, e.l2]
-        if ref_states is not None:
-            errs += _energy_errors(states(scene, times), ref_states, base.elements, base.elements, base.length)
+        errors.append(reference.errors(scene, result))
         if three_level:
             t3, u3, cpu3 = run_three_level(scene.replace(record_every=round(grid / dt)))
-            n = min(u3.size, ref.tip_u.size)
-            extra.append([float(np.abs(u3[:n] - ref.tip_u[:n]).max()),
+            n = min(u3.size, reference.tip.tip_u.size)
+            extra.append([float(np.abs(u3[:n] - reference.tip.tip_u[:n]).max()),
                           float(np.abs(u3[:n] - result.tip_u[:n]).max()), cpu3])
         rows.append(row)
-        errors.append(errs)
     table = Table(title or f"Δt convergence, J = {base.elements}", _columns(["Δt (s)", "steps", "CPU (s)"], windows,
                                                                            times), rows)
     _fill(rows, dts, errors)
@@ -116,24 +141,14 @@ def h_table(base: Scene, elements: Sequence[int], reference_elements: int, windo
             times: Sequence[float], *, grid: Optional[float] = None, title: str = "", quiet: bool = False) -> Table:
     """Errors in h = L/J at the base scene's (fine) Δt against a run on ``reference_elements``."""
     grid = grid or base.dt
-    t_end = max(list(windows) + list(times))
-    base = base.replace(t_end=t_end)
-    ref_scene = base.replace(elements=reference_elements)
-    ref = run_tip(ref_scene, grid)
-    ref_states = states(ref_scene, times) if times else None
+    base, reference = _Reference.of(base, windows, times, grid, elements=reference_elements)
     rows: list[list[object]] = []
     errors: list[list[float]] = []
     for j in progress(elements, "converge h", quiet=quiet):
         scene = base.replace(elements=j)
         result = run_tip(scene, grid)
         rows.append([j, base.length / j, int(result.attrs["steps"]), result.attrs["cpu_seconds"]])
-        errs: list[float] = []
-        for w in windows:
-            e = tip_error(result, ref, w)
-            errs += [e.max, e.l2]
-        if ref_states is not None:
-            errs += _energy_errors(states(scene, times), ref_states, j, reference_elements, base.length)
-        errors.append(errs)
+        errors.append(reference.errors(scene, result))
     table = Table(title or f"h convergence, Δt = {base.dt:g} s", _columns(["J", "h (m)", "steps", "CPU (s)"],
                                                                           windows, times), rows)
     _fill(rows, [base.length / j for j in elements], errors)
@@ -202,30 +217,20 @@ def study(folder: Optional[Path] = None, *, quick: bool = False, three_level: bo
     return tables
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """``converge [-o DIR] [--quick] [--no-three-level]``."""
-    parser = subparsers.add_parser("converge", help="convergence tables in Δt and h (markdown and CSV)",
-                                   description="Convergence tables in Δt and h against finer reference runs.")
-    _arguments(parser)
-    parser.set_defaults(handler=_handler)
-
-
-def _arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("-o", "--output", type=Path, help="output folder (default out/convergence)")
-    parser.add_argument("--quick", action="store_true", help="small sizes (seconds), for tests and CI")
+def _options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-three-level", action="store_true",
                         help="skip the three-level form in the round-off comparison")
-    parser.add_argument("--quiet", action="store_true", help="no progress bars")
 
 
-def _handler(args: argparse.Namespace) -> int:
-    folder = out_dir(args.output, "convergence")
+def _run(folder: Path, args: argparse.Namespace) -> Path:
     study(folder, quick=args.quick, three_level=not args.no_three_level, quiet=args.quiet)
-    print(folder / "convergence.md")
-    return 0
+    return folder / "convergence.md"
 
 
-def main(argv: Optional[Sequence[str]] = None) -> int:
-    parser = argparse.ArgumentParser(prog="convergence", description="Convergence tables in Δt and h.")
-    _arguments(parser)
-    return _handler(parser.parse_args(argv))
+#: ``converge [-o DIR] [--quick] [--no-three-level]``; ``main`` is scripts/convergence.py.
+COMMAND = StudyCommand("convergence", _options, _run, name="converge",
+                       help="convergence tables in Δt and h (markdown and CSV)",
+                       description="Convergence tables in Δt and h against finer reference runs.",
+                       prog="convergence", script_description="Convergence tables in Δt and h.")
+register = COMMAND.register
+main = COMMAND.main
