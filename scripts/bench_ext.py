@@ -4,10 +4,11 @@
   ``-Dpython=false -Dtests=false``, plus ``-Dbench=true`` for the Fortran microbenchmarks
   when asked), compiled; returns its directory.
 - ``step_extension(build_dir)``: the f2py module ``_bench_step`` (scripts/bench_step.f90,
-  plain subroutines; their derived types live in scripts/bench_step_state.f90), compiled
-  against the static library ``libbeamstops.a`` and the ``.mod`` files of that build, and
-  imported. It drives the engine one step per call from Python, and exposes the fused and
-  LAPACK band solves and whole runs on both paths for the tests.
+  plain subroutines; their derived types live in scripts/bench_step_state.f90, its recorder
+  in bench/null_recorder.f90), compiled against the static library ``libbeamstops.a`` and
+  the ``.mod`` files of that build, and imported. It drives the engine one step per call
+  from Python, and exposes the fused and LAPACK band solves and whole runs on both paths
+  for the tests.
 
 Nothing here is installed: the package's own extension (``beamstops._engine``) has no
 per-step entry point, so the per-step loop needs this small module of its own.
@@ -69,19 +70,21 @@ def step_extension(build_dir: Path) -> ModuleType:
     out.mkdir(exist_ok=True)
     suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
     target = out / f"{MODULE}{suffix}"
-    sources = [SCRIPTS / "bench_step_state.f90", SCRIPTS / "bench_step.f90", library]
+    modules = [REPO / "bench" / "null_recorder.f90", SCRIPTS / "bench_step_state.f90"]  # users after what they use
+    sources = [*modules, SCRIPTS / "bench_step.f90", library]
     if not target.exists() or target.stat().st_mtime < max(p.stat().st_mtime for p in sources):
         fc = os.environ.get("FC", "gfortran")
-        state_obj = out / "bench_step_state.o"
-        run([fc, "-O2", "-fPIC", "-ffree-line-length-none", "-I", str(mods), "-J", str(out),
-             "-c", str(SCRIPTS / "bench_step_state.f90"), "-o", str(state_obj)])
+        objects = [out / f"{source.stem}.o" for source in modules]
+        for source, obj in zip(modules, objects):
+            run([fc, "-O2", "-fPIC", "-ffree-line-length-none", "-I", str(mods), "-J", str(out),
+                 "-c", str(source), "-o", str(obj)])
         work = out / "f2py"
         shutil.rmtree(work, ignore_errors=True)
         work.mkdir()
         shutil.copy(SCRIPTS / "bench_step.f90", work / "bench_step.f90")
         run([sys.executable, "-m", "numpy.f2py", "-c", "bench_step.f90", "-m", MODULE,
              "--build-dir", str(work / "build"), f"-I{out}", f"-I{mods}",
-             str(state_obj), str(library), "-llapack", "-lblas"], cwd=work)
+             *map(str, objects), str(library), "-llapack", "-lblas"], cwd=work)
         built = sorted(work.glob(f"{MODULE}*{suffix}"))
         if not built:
             raise RuntimeError(f"f2py produced no {MODULE}{suffix} in {work}")
