@@ -1,6 +1,7 @@
 !> Helpers shared by the suites: LAPACK eigenvalues computed by the tests themselves,
 !> and a whole run of a scene into an array recorder.
 module test_support
+   use testing, only: int_text   ! public here too, for the suites that take it from this module
    use beamstops, only: wp, ik, error_type, fatal_error, scene_type, validate_scene, model_type, &
       & prepare_run, simulate, record_count, array_recorder, run_summary, status_complete
    implicit none
@@ -29,16 +30,6 @@ module test_support
    end interface
 
 contains
-
-   !> Text of an integer.
-   function int_text(i) result(s)
-      !> Value.
-      integer(ik), intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=24) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function int_text
 
    !> Coefficients c(0:3) in xi of the four Hermite functions on [0, 1] (element length h),
    !> ordered (value left, slope left, value right, slope right).

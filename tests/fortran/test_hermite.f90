@@ -205,7 +205,7 @@ contains
          x = [(sin(1.7_wp*i) + 0.3_wp*cos(5.1_wp*i), i=1, n)]
          call band_matvec(ab, x, y)
          call check(error, maxval(abs(y - matmul(dense, x))), 0.0_wp, 'max |band_matvec - matmul| for J = '// &
-            & int_str(sizes(k)), thr=1e-13_wp*maxval(abs(dense)))
+            & int_text(sizes(k)), thr=1e-13_wp*maxval(abs(dense)))
          if (allocated(error)) return
       end do
    end subroutine test_matvec
@@ -240,7 +240,7 @@ contains
       expected = scene%amplitude*(scene%omega**2*bh + 8*scene%k2/scene%length**4*b1)
       call check(error, size(model%load), size(expected), 'size of the load vector'); if (allocated(error)) return
       do i = 1, size(expected)
-         call check(error, model%load(i), expected(i), 'load row '//int_str(i), thr=1e-10_wp*maxval(abs(expected)))
+         call check(error, model%load(i), expected(i), 'load row '//int_text(i), thr=1e-10_wp*maxval(abs(expected)))
          if (allocated(error)) return
       end do
    end subroutine test_load
@@ -278,21 +278,13 @@ contains
       do i = 1, scene%elements
          x = i*scene%length/scene%elements
          call check(error, model%v0(2*i - 1), -scene%amplitude*scene%omega*lift(x, scene%length), &
-            & 'v0 value at node '//int_str(i), thr=1e-14_wp)
+            & 'v0 value at node '//int_text(i), thr=1e-14_wp)
          if (allocated(error)) return
          call check(error, model%v0(2*i), -scene%amplitude*scene%omega*lift_prime(x, scene%length), &
-            & 'v0 slope at node '//int_str(i), thr=1e-14_wp)
+            & 'v0 slope at node '//int_text(i), thr=1e-14_wp)
          if (allocated(error)) return
       end do
       ! h(L) = 0: the tip's homogeneous and physical displacements agree
       call check(error, model%v0(model%tip), 0.0_wp, 'v0 at the tip', thr=1e-14_wp)
    end subroutine test_initial_data
-
-   function int_str(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function int_str
 end module test_hermite

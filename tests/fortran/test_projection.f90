@@ -2,7 +2,7 @@
 !> paper's scene, and unit checks of the projection and of the compliance solve.
 module test_projection
    use testing
-   use test_support, only: run_recorded, int_text
+   use test_support, only: run_recorded
    use beamstops, only: ik, scene_type, array_recorder, run_summary, law_signorini
    use beamstops_recorder, only: col_t, col_u, col_reaction
    use beamstops_contact_tip_projection, only: project_tip

@@ -9,7 +9,7 @@
 !> warns of.)
 module test_scheme
    use testing
-   use test_support, only: run_recorded, int_text, exact_element, dense_assembly, lift, lift_prime, simpson_load, solve_spd
+   use test_support, only: run_recorded, exact_element, dense_assembly, lift, lift_prime, simpson_load, solve_spd
    use beamstops, only: ik, scene_type, array_recorder, run_summary, law_none, law_signorini, law_compliance, steps_of
    use beamstops_recorder, only: col_t, col_u, col_v, col_reaction, col_energy
    implicit none

@@ -4,11 +4,12 @@
 module testing
    use, intrinsic :: iso_fortran_env, only: output_unit
    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
-   use beamstops, only: wp, error_type, fatal_error
+   use beamstops, only: wp, ik, error_type, fatal_error
+   use beamstops_scene, only: fmt_int
    implicit none
    private
    public :: wp, error_type, fatal_error
-   public :: unittest_type, new_unittest, check, test_failed, run_suite, note, real_text
+   public :: unittest_type, new_unittest, check, test_failed, run_suite, note, real_text, int_text
 
    abstract interface
       !> A unit test: leaves `error` unallocated when it passes.
@@ -33,6 +34,11 @@ module testing
    interface check
       module procedure check_real, check_int, check_logical, check_condition
    end interface check
+
+   !> Text of an integer, default kind or ik (the engine's fmt_int).
+   interface int_text
+      module procedure int_text_default, fmt_int
+   end interface int_text
 
 contains
 
@@ -60,14 +66,13 @@ contains
       s = trim(adjustl(buf))
    end function real_text
 
-   !> Text of an integer.
-   function int_text(i) result(s)
+   !> Text of a default integer.
+   pure function int_text_default(i) result(s)
+      !> Value.
       integer, intent(in) :: i
       character(len=:), allocatable :: s
-      character(len=24) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function int_text
+      s = fmt_int(int(i, ik))
+   end function int_text_default
 
    !> Prefix of a failure message.
    function lead(message) result(s)
