@@ -11,7 +11,9 @@ from __future__ import annotations
 import os
 import shutil
 import sysconfig
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -44,3 +46,30 @@ def program() -> str:
 @pytest.fixture(scope="session")
 def repo_root() -> Path:
     return ROOT
+
+
+@pytest.fixture
+def write_spec(tmp_path: Path) -> Callable[..., Path]:
+    """``write_spec(text, name="spec.toml")``: a sweep specification written into the test's
+    tmp_path; gives its path."""
+
+    def write(text: str, name: str = "spec.toml") -> Path:
+        path = tmp_path / name
+        path.write_text(text)
+        return path
+
+    return write
+
+
+#: Columns of a sweep's summary that differ from one run of the same points to the next.
+TIMING = ("cpu_seconds", "wall_seconds")
+
+
+@pytest.fixture(scope="session")
+def without_timing() -> Callable[[list[dict[str, Any]]], list[dict[str, Any]]]:
+    """Summary rows without their timings, for comparing two runs of the same points."""
+
+    def strip(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+        return [{k: v for k, v in row.items() if k not in TIMING} for row in rows]
+
+    return strip

@@ -11,6 +11,7 @@ import os
 import shutil
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -60,16 +61,12 @@ def mpiexec(ranks: int, *args: str, timeout: float = 120) -> subprocess.Complete
                           text=True, timeout=timeout, env=env, stdin=subprocess.DEVNULL)
 
 
-def without_timing(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    return [{k: v for k, v in row.items() if k not in ("cpu_seconds", "wall_seconds")} for row in rows]
-
-
-def test_mpi_and_local_executors_give_identical_results(tmp_path: Path) -> None:
+def test_mpi_and_local_executors_give_identical_results(tmp_path: Path, write_spec: Callable[..., Path],
+                                                        without_timing: Callable[..., Any]) -> None:
     missing = _mpi4py()
     if missing:
         pytest.skip(f"mpi4py is not importable: {missing}")
-    spec_path = tmp_path / "spec.toml"
-    spec_path.write_text(SPEC)
+    spec_path = write_spec(SPEC)
     done = mpiexec(3, "-m", "mpi4py.futures", "-m", "beamstops", "sweep", str(spec_path), "-o", str(tmp_path / "mpi"))
     assert done.returncode == 0, done.stdout + done.stderr
     assert "to run on 2 MPI worker ranks" in done.stderr, done.stderr
@@ -87,9 +84,8 @@ def test_mpi_and_local_executors_give_identical_results(tmp_path: Path) -> None:
     assert again.returncode == 0 and "6 before" in again.stderr, again.stderr
 
 
-def test_plain_mpiexec_without_mpi4py_futures_is_refused(tmp_path: Path) -> None:
-    spec_path = tmp_path / "spec.toml"
-    spec_path.write_text(SPEC)
+def test_plain_mpiexec_without_mpi4py_futures_is_refused(tmp_path: Path, write_spec: Callable[..., Path]) -> None:
+    spec_path = write_spec(SPEC)
     done = mpiexec(2, "-m", "beamstops", "sweep", str(spec_path), "-o", str(tmp_path / "out"))
     assert done.returncode != 0
     assert "beamstops: error: started as one of several MPI ranks" in done.stderr, done.stderr

@@ -9,6 +9,7 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -20,7 +21,6 @@ import beamstops
 from beamstops.sweep import load_spec, read_summary, run_sweep
 
 ROOT = Path(__file__).resolve().parents[2]
-TIMING = ("cpu_seconds", "wall_seconds")
 
 SMALL = """
 [scene]
@@ -42,22 +42,13 @@ after_periods = 2
 """
 
 
-def write(tmp_path: Path, text: str, name: str = "spec.toml") -> Path:
-    path = tmp_path / name
-    path.write_text(text)
-    return path
-
-
-def without_timing(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    return [{k: v for k, v in row.items() if k not in TIMING} for row in rows]
-
-
 def mtimes(folder: Path) -> dict[str, int]:
     return {p.name: p.stat().st_mtime_ns for p in sorted((folder / "points").glob("*.h5"))}
 
 
-def test_every_point_writes_its_file_and_the_summary_gathers_them(tmp_path: Path) -> None:
-    spec = load_spec(write(tmp_path, SMALL))
+def test_every_point_writes_its_file_and_the_summary_gathers_them(tmp_path: Path,
+                                                                  write_spec: Callable[..., Path]) -> None:
+    spec = load_spec(write_spec(SMALL))
     outcome = run_sweep(spec, tmp_path / "out", jobs=2, stream=None)
     assert (outcome.total, outcome.complete, outcome.failed, outcome.ran) == (4, 4, 0, 4)
     rows = read_summary(tmp_path / "out")
@@ -84,8 +75,8 @@ def test_every_point_writes_its_file_and_the_summary_gathers_them(tmp_path: Path
     assert {"max_violation", "dissipated", "strobe", "strobe_offset", "strobe_period", "v_rms", "message"} <= set(header)
 
 
-def test_a_failed_point_is_recorded_and_the_sweep_goes_on(tmp_path: Path) -> None:
-    spec = load_spec(write(tmp_path, """
+def test_a_failed_point_is_recorded_and_the_sweep_goes_on(tmp_path: Path, write_spec: Callable[..., Path]) -> None:
+    spec = load_spec(write_spec("""
 [scene]
 elements = 4
 t_end = 0.05
@@ -103,8 +94,8 @@ dt = [1e-4, 1e-3, 2e-5]
     assert (again.ran, again.skipped, again.failed) == (1, 2, 1)
 
 
-def test_a_diverged_run_is_finished_and_kept(tmp_path: Path) -> None:
-    spec = load_spec(write(tmp_path, """
+def test_a_diverged_run_is_finished_and_kept(tmp_path: Path, write_spec: Callable[..., Path]) -> None:
+    spec = load_spec(write_spec("""
 [scene]
 elements = 4
 t_end = 0.5
@@ -122,8 +113,8 @@ dt = [1e-4, 1e-3]
     assert run_sweep(spec, tmp_path / "out", stream=None).ran == 0
 
 
-def test_a_point_over_its_time_limit_fails_alone(tmp_path: Path) -> None:
-    spec = load_spec(write(tmp_path, """
+def test_a_point_over_its_time_limit_fails_alone(tmp_path: Path, write_spec: Callable[..., Path]) -> None:
+    spec = load_spec(write_spec("""
 [sweep]
 timeout = 0.5
 [scene]
@@ -141,8 +132,9 @@ t_end = [0.01, 1000.0]
     assert rows[1]["message"].startswith("timed out after 0.5 s")
 
 
-def test_resume_skips_finished_points_and_reruns_interrupted_ones(tmp_path: Path) -> None:
-    spec = load_spec(write(tmp_path, SMALL))
+def test_resume_skips_finished_points_and_reruns_interrupted_ones(tmp_path: Path, write_spec: Callable[..., Path],
+                                                                  without_timing: Callable[..., Any]) -> None:
+    spec = load_spec(write_spec(SMALL))
     out = tmp_path / "out"
     run_sweep(spec, out, jobs=2, stream=None)
     first = read_summary(out)
@@ -165,7 +157,9 @@ def test_resume_skips_finished_points_and_reruns_interrupted_ones(tmp_path: Path
     assert without_timing(read_summary(out)) == without_timing(first)
 
 
-def test_resume_after_a_real_interruption_gives_the_uninterrupted_results(tmp_path: Path) -> None:
+def test_resume_after_a_real_interruption_gives_the_uninterrupted_results(tmp_path: Path,
+                                                                          write_spec: Callable[..., Path],
+                                                                          without_timing: Callable[..., Any]) -> None:
     text = """
 [scene]
 elements = 10
@@ -174,7 +168,7 @@ t_end = 12.0
 [axes]
 amplitude = { start = 0.10, stop = 0.15, step = 0.01 }
 """
-    spec_path = write(tmp_path, text)
+    spec_path = write_spec(text)
     out = tmp_path / "out"
     command = [sys.executable, "-m", "beamstops", "sweep", str(spec_path), "-o", str(out), "-j", "1", "--interval", "0.1"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
@@ -198,13 +192,14 @@ amplitude = { start = 0.10, stop = 0.15, step = 0.01 }
     assert without_timing(read_summary(tmp_path / "clean")) == without_timing(resumed)
 
 
-def test_a_folder_holds_one_specification(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_folder_holds_one_specification(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                          write_spec: Callable[..., Path]) -> None:
     from beamstops import cli
 
-    spec_path = write(tmp_path, SMALL)
+    spec_path = write_spec(SMALL)
     out = tmp_path / "out"
     assert cli.main(["sweep", str(spec_path), "-o", str(out), "-j", "2", "-q"]) == 0
-    other = write(tmp_path, SMALL.replace("t_end = 6", "t_end = 7"), "other.toml")
+    other = write_spec(SMALL.replace("t_end = 6", "t_end = 7"), "other.toml")
     assert cli.main(["sweep", str(other), "-o", str(out), "-q"]) == 1
     err = capsys.readouterr().err
     assert err.startswith(f"beamstops: error: {out}: holds the results of another specification") and "hash" in err
@@ -220,10 +215,10 @@ def test_a_folder_holds_one_specification(tmp_path: Path, capsys: pytest.Capture
     assert "4 complete" in capsys.readouterr().err
 
 
-def test_progress_lines_in_a_log(tmp_path: Path) -> None:
+def test_progress_lines_in_a_log(tmp_path: Path, write_spec: Callable[..., Path]) -> None:
     import io
 
-    spec = load_spec(write(tmp_path, SMALL))
+    spec = load_spec(write_spec(SMALL))
     log = io.StringIO()
     run_sweep(spec, tmp_path / "out", jobs=2, stream=log, interval=0.0)
     lines = log.getvalue().splitlines()
@@ -245,11 +240,12 @@ def test_bifurcation_script_quick(tmp_path: Path) -> None:
     assert len(rows) == 12 and all(r["status"] == "complete" and len(r["strobe"]) == 9 for r in rows)
 
 
-def test_resuming_with_another_build_of_the_engine_says_so(tmp_path: Path, program: str) -> None:
+def test_resuming_with_another_build_of_the_engine_says_so(tmp_path: Path, program: str,
+                                                           write_spec: Callable[..., Path]) -> None:
     import io
     import shutil
 
-    spec = load_spec(write(tmp_path, SMALL))
+    spec = load_spec(write_spec(SMALL))
     run_sweep(spec, tmp_path / "out", jobs=2, stream=None)
     (tmp_path / "out" / "points" / "00000.h5").unlink()
     rebuilt = tmp_path / "beamstops"

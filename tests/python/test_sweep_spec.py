@@ -7,6 +7,7 @@ import math
 import random
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -40,14 +41,8 @@ after = 0.05
 """
 
 
-def write(tmp_path: Path, text: str, name: str = "spec.toml") -> Path:
-    path = tmp_path / name
-    path.write_text(text)
-    return path
-
-
-def test_product_with_a_zip_group_and_decimal_steps(tmp_path: Path) -> None:
-    spec = load_spec(write(tmp_path, GOOD))
+def test_product_with_a_zip_group_and_decimal_steps(write_spec: Callable[..., Path]) -> None:
+    spec = load_spec(write_spec(GOOD))
     assert len(spec.points) == 6
     assert spec.axes["amplitude"] == [0.1, 0.2, 0.3]  # written numbers, not 0.30000000000000004
     assert [p.params for p in spec.points[:4]] == [
@@ -59,8 +54,8 @@ def test_product_with_a_zip_group_and_decimal_steps(tmp_path: Path) -> None:
     assert spec.reductions == {"u_max": {"kind": "max", "quantity": "tip_u", "after": 0.05, "after_periods": None}}
 
 
-def test_zip_mode_linspace_log_and_integer_axes(tmp_path: Path) -> None:
-    spec = load_spec(write(tmp_path, """
+def test_zip_mode_linspace_log_and_integer_axes(write_spec: Callable[..., Path]) -> None:
+    spec = load_spec(write_spec("""
 [sweep]
 mode = "zip"
 [axes]
@@ -74,8 +69,8 @@ elements = { start = 4, stop = 12, num = 3 }
     assert all(isinstance(p.params["elements"], int) for p in spec.points)
 
 
-def test_periods_lock_the_time_grid_to_the_forcing(tmp_path: Path) -> None:
-    spec = load_spec(write(tmp_path, """
+def test_periods_lock_the_time_grid_to_the_forcing(write_spec: Callable[..., Path]) -> None:
+    spec = load_spec(write_spec("""
 [scene]
 dt = 2e-5
 [axes]
@@ -94,19 +89,19 @@ records_per_period = 16
         assert round(s.t_end / s.dt) == 30 * 16 * s.record_every
 
 
-def test_the_hash_follows_what_runs_not_how_it_is_written(tmp_path: Path) -> None:
-    a = load_spec(write(tmp_path, GOOD, "a.toml"))
+def test_the_hash_follows_what_runs_not_how_it_is_written(write_spec: Callable[..., Path]) -> None:
+    a = load_spec(write_spec(GOOD, "a.toml"))
     reordered = GOOD.replace('description = "test"', 'description = "other words"  # a comment')
-    b = load_spec(write(tmp_path, reordered, "b.toml"))
+    b = load_spec(write_spec(reordered, "b.toml"))
     assert a.hash == b.hash
-    c = load_spec(write(tmp_path, GOOD, "c.toml"), overrides=["scene.t_end=0.2"])
+    c = load_spec(write_spec(GOOD, "c.toml"), overrides=["scene.t_end=0.2"])
     assert c.hash != a.hash and c.points[0].scene.t_end == 0.2
 
 
-def test_base_namelist_relative_to_the_spec(tmp_path: Path) -> None:
+def test_base_namelist_relative_to_the_spec(tmp_path: Path, write_spec: Callable[..., Path]) -> None:
     (tmp_path / "nml").mkdir()
     (tmp_path / "nml" / "base.nml").write_text("&support omega=12.5 /\n&mesh elements=6 /\n")
-    spec = load_spec(write(tmp_path, '[sweep]\nbase = "nml/base.nml"\n[axes]\namplitude = [0.1]\n'))
+    spec = load_spec(write_spec('[sweep]\nbase = "nml/base.nml"\n[axes]\namplitude = [0.1]\n'))
     assert spec.points[0].scene.omega == 12.5 and spec.points[0].scene.elements == 6
     (tmp_path / "nml" / "base.nml").write_text("&support omega=13.5 /\n&mesh elements=6 /\n")
     assert load_spec(tmp_path / "spec.toml").hash != spec.hash  # the base's values are in the hash
@@ -166,8 +161,8 @@ BAD: list[tuple[str, str, str]] = [
 
 
 @pytest.mark.parametrize("text, expected", [(t, e) for _, t, e in BAD], ids=[name for name, _, _ in BAD])
-def test_bad_specifications_say_what_is_wrong(tmp_path: Path, text: str, expected: str) -> None:
-    path = write(tmp_path, text)
+def test_bad_specifications_say_what_is_wrong(text: str, expected: str, write_spec: Callable[..., Path]) -> None:
+    path = write_spec(text)
     with pytest.raises(SpecError) as info:
         load_spec(path)
     message = str(info.value)
@@ -181,19 +176,20 @@ def test_missing_file(tmp_path: Path) -> None:
         load_spec(tmp_path / "nowhere.toml")
 
 
-def test_command_line_prints_one_line_and_exits_1(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    path = write(tmp_path, "[axes]\nomega = []\n")
+def test_command_line_prints_one_line_and_exits_1(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                  write_spec: Callable[..., Path]) -> None:
+    path = write_spec("[axes]\nomega = []\n")
     assert cli.main(["sweep", str(path), "-o", str(tmp_path / "out")]) == 1
     err = capsys.readouterr().err
     assert err == f"beamstops: error: {path}: axis omega is empty; give at least one value\n"
     assert not (tmp_path / "out").exists()
-    bad_set = write(tmp_path, GOOD, "good.toml")
+    bad_set = write_spec(GOOD, "good.toml")
     assert cli.main(["sweep", str(bad_set), "-o", str(tmp_path / "out"), "--set", "axes.omega"]) == 1
     assert "expected TABLE.KEY=VALUE" in capsys.readouterr().err
 
 
-def test_command_line_in_a_fresh_process_has_no_traceback(tmp_path: Path) -> None:
-    path = write(tmp_path, "[scene]\nelements = 'many'\n[axes]\nomega = [1.0]\n")
+def test_command_line_in_a_fresh_process_has_no_traceback(tmp_path: Path, write_spec: Callable[..., Path]) -> None:
+    path = write_spec("[scene]\nelements = 'many'\n[axes]\nomega = [1.0]\n")
     done = subprocess.run([sys.executable, "-m", "beamstops", "sweep", str(path), "-o", str(tmp_path / "o")],
                           capture_output=True, text=True, timeout=60)
     assert done.returncode == 1
@@ -201,8 +197,9 @@ def test_command_line_in_a_fresh_process_has_no_traceback(tmp_path: Path) -> Non
     assert "[scene] elements = 'many': not an integer" in done.stderr
 
 
-def test_dry_run_lists_points_and_flags_refused_ones(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    path = write(tmp_path, "[scene]\nt_end = 0.1\n[axes]\ndt = [1e-4, 0.5]\n")
+def test_dry_run_lists_points_and_flags_refused_ones(capsys: pytest.CaptureFixture[str],
+                                                     write_spec: Callable[..., Path]) -> None:
+    path = write_spec("[scene]\nt_end = 0.1\n[axes]\ndt = [1e-4, 0.5]\n")
     assert cli.main(["sweep", str(path), "--dry-run"]) == 0
     out = capsys.readouterr().out
     assert "2 points" in out and "00001: dt=0.5" in out and "REFUSED" in out
