@@ -6,6 +6,7 @@
 #   docs/convergence/  scripts/convergence.py       convergence tables (markdown, CSV)
 #   docs/work_precision/, docs/stability_map/, docs/compliance/   the studies
 #   docs/bifurcation/  scripts/bifurcation.py       bifurcation diagram (sweep)
+#   docs/stops/        input/tube_supports.nml, scripts/bench_stops.py   stops along the span
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export PATH="$PWD/.venv/bin:$PATH" MPLBACKEND=Agg
@@ -16,5 +17,9 @@ python scripts/study_stability.py -o docs/stability_map --quiet
 python scripts/study_compliance.py -o docs/compliance --quiet
 python scripts/bifurcation.py -o out/bifurcation --png docs/bifurcation/bifurcation.png -q
 python scripts/bench.py --out docs/bench.md
+mkdir -p out docs/stops
+beamstops run input/tube_supports.nml -o out/tube_supports.h5 >/dev/null
+python -m beamstops plot out/tube_supports.h5 --kind stops -o docs/stops/tube_supports_stops.png >/dev/null
+python scripts/bench_stops.py --out docs/stops/bench_stops.md
 # keep the images and tables, not the HDF5 files of the runs
 find docs -name '*.h5' -delete

@@ -5,7 +5,7 @@ module beamstops
    use beamstops_error, only: error_type, fatal_error
    use beamstops_scene, only: scene_type, validate_scene, steps_of, record_count, snapshot_count, output_bytes, &
       & law_none, law_signorini, law_compliance, &
-      & law_name, law_code
+      & law_name, law_code, stop_count, max_stops
    use beamstops_namelist, only: read_scene
    use beamstops_model, only: model_type, build_model, check_stability
    use beamstops_scheme, only: state_type, start_state, run_scheme
@@ -20,6 +20,7 @@ module beamstops
    private
    public :: wp, ik, error_type, fatal_error
    public :: scene_type, validate_scene, steps_of, law_none, law_signorini, law_compliance, law_name, law_code
+   public :: stop_count, max_stops
    public :: read_scene, model_type, build_model, check_stability
    public :: state_type, start_state, run_scheme
    public :: recorder_type, n_columns, array_recorder, hdf5_recorder

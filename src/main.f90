@@ -178,14 +178,23 @@ contains
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
       character(len=*), parameter :: f = '(a,t24,es13.6,1x,a)', fi = '(a,t24,i0,1x,a)', fa = '(a,t24,a)'
+      integer :: i
       write (output_unit, fa) 'file', path
       write (output_unit, f) '&beam length', scene%length, 'm'
       write (output_unit, f) '      k2', scene%k2, 'm^4/s^2'
       write (output_unit, f) '      mass_per_length', scene%mass_per_length, 'kg/m'
       write (output_unit, f) '&support amplitude', scene%amplitude, 'm'
       write (output_unit, f) '      omega', scene%omega, 'rad/s'
-      write (output_unit, f) '&stops lower', scene%lower, 'm'
-      write (output_unit, f) '      upper', scene%upper, 'm'
+      if (stop_count(scene) == 0) then
+         write (output_unit, f) '&stops lower', scene%lower, 'm'
+         write (output_unit, f) '      upper', scene%upper, 'm'
+      else
+         write (output_unit, fi) '&stops stops', stop_count(scene), 'along the span (node, x, lower, upper):'
+         do i = 1, stop_count(scene)
+            write (output_unit, '(t9,i8,3(1x,es13.6))') scene%stop_nodes(i), model%stops%x(i), scene%stop_lower(i), &
+               & scene%stop_upper(i)
+         end do
+      end if
       write (output_unit, fa) '      law', law_name(scene%law)
       if (scene%law == law_compliance) write (output_unit, f) '      stiffness_per_mass', scene%stiffness_per_mass, &
          & '1/s^2'

@@ -9,7 +9,11 @@
 !> Scene arguments, in this order everywhere:
 !>   length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass,
 !>   elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable,
-!>   record_every, snapshot_every, max_output_gb
+!>   record_every, snapshot_every, max_output_gb,
+!>   stop_count, stop_nodes(stop_count+1), stop_lower(stop_count+1), stop_upper(stop_count+1)
+!> (the stops along the span; stop_count = 0 for the tip-only form, lower and upper). The
+!> stops' arrays carry one padding value at the end: f2py refuses input arrays of size 0;
+!> from Python, stop_count is optional (the arrays' length minus one).
 
 !> Version of the engine.
 subroutine bs_version(text)
@@ -23,12 +27,15 @@ end subroutine bs_version
 !> Validate a scene; `source` (a file name or 'scene') starts the message.
 subroutine bs_validate(length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, &
    & elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, &
-   & max_output_gb, source, status, message)
+   & max_output_gb, stop_count, stop_nodes, stop_lower, stop_upper, source, status, message)
    use beamstops, only: error_type, scene_type, validate_scene
    use beamstops_wrap_support, only: make_scene, report
    implicit none
    real(8), intent(in) :: length, k2, mass_per_length, amplitude, omega, lower, upper, stiffness_per_mass
    real(8), intent(in) :: dt, t_end, beta, max_output_gb
+   integer(8), intent(in) :: stop_count
+   integer(8), intent(in) :: stop_nodes(stop_count + 1)
+   real(8), intent(in) :: stop_lower(stop_count + 1), stop_upper(stop_count + 1)
    integer(8), intent(in) :: law, elements, centered_load, taylor_start, allow_unstable, record_every, snapshot_every
    character(len=*), intent(in) :: source
    integer, intent(out) :: status
@@ -37,7 +44,8 @@ subroutine bs_validate(length, k2, mass_per_length, amplitude, omega, lower, upp
    type(error_type), allocatable :: error
    call make_scene(length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, &
       & elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, &
-      & max_output_gb, trim(source), scene, error)
+      & max_output_gb, stop_nodes(:stop_count), stop_lower(:stop_count), stop_upper(:stop_count), &
+      & trim(source), scene, error)
    if (.not. allocated(error)) call validate_scene(scene, trim(source), error)
    call report(error, status, message)
 end subroutine bs_validate
@@ -45,12 +53,15 @@ end subroutine bs_validate
 !> Sizes of the arrays of a run: records and snapshots of a complete run, nodes J+1.
 subroutine bs_sizes(length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, &
    & elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, &
-   & max_output_gb, records, snapshots, nodes, status, message)
+   & max_output_gb, stop_count, stop_nodes, stop_lower, stop_upper, records, snapshots, nodes, status, message)
    use beamstops, only: error_type, scene_type, validate_scene, record_count, snapshot_count
    use beamstops_wrap_support, only: make_scene, report
    implicit none
    real(8), intent(in) :: length, k2, mass_per_length, amplitude, omega, lower, upper, stiffness_per_mass
    real(8), intent(in) :: dt, t_end, beta, max_output_gb
+   integer(8), intent(in) :: stop_count
+   integer(8), intent(in) :: stop_nodes(stop_count + 1)
+   real(8), intent(in) :: stop_lower(stop_count + 1), stop_upper(stop_count + 1)
    integer(8), intent(in) :: law, elements, centered_load, taylor_start, allow_unstable, record_every, snapshot_every
    integer(8), intent(out) :: records, snapshots, nodes
    integer, intent(out) :: status
@@ -62,7 +73,8 @@ subroutine bs_sizes(length, k2, mass_per_length, amplitude, omega, lower, upper,
    nodes = 0
    call make_scene(length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, &
       & elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, &
-      & max_output_gb, 'scene', scene, error)
+      & max_output_gb, stop_nodes(:stop_count), stop_lower(:stop_count), stop_upper(:stop_count), &
+      & 'scene', scene, error)
    if (.not. allocated(error)) call validate_scene(scene, 'scene', error)
    if (.not. allocated(error)) then
       records = record_count(scene)
@@ -76,7 +88,7 @@ end subroutine bs_sizes
 !> whether the engine would refuse to run it (`refused` = 1, with its reason).
 subroutine bs_stability(length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, &
    & elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, &
-   & max_output_gb, kappa_h, kappa_bound, kappa_contact, dt_limit_newmark, dt_limit_paper, dt_limit_paper_bound, &
+   & max_output_gb, stop_count, stop_nodes, stop_lower, stop_upper, kappa_h, kappa_bound, kappa_contact, dt_limit_newmark, dt_limit_paper, dt_limit_paper_bound, &
    & kappa_method, refused, refusal, status, message)
    use beamstops, only: error_type, scene_type, validate_scene, model_type, build_model, check_stability
    use beamstops_wrap_support, only: make_scene, report
@@ -84,6 +96,9 @@ subroutine bs_stability(length, k2, mass_per_length, amplitude, omega, lower, up
    !f2py threadsafe
    real(8), intent(in) :: length, k2, mass_per_length, amplitude, omega, lower, upper, stiffness_per_mass
    real(8), intent(in) :: dt, t_end, beta, max_output_gb
+   integer(8), intent(in) :: stop_count
+   integer(8), intent(in) :: stop_nodes(stop_count + 1)
+   real(8), intent(in) :: stop_lower(stop_count + 1), stop_upper(stop_count + 1)
    integer(8), intent(in) :: law, elements, centered_load, taylor_start, allow_unstable, record_every, snapshot_every
    real(8), intent(out) :: kappa_h, kappa_bound, kappa_contact, dt_limit_newmark, dt_limit_paper, dt_limit_paper_bound
    character(len=32), intent(out) :: kappa_method
@@ -101,7 +116,8 @@ subroutine bs_stability(length, k2, mass_per_length, amplitude, omega, lower, up
    refusal = ''
    call make_scene(length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, &
       & elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, &
-      & max_output_gb, 'scene', scene, error)
+      & max_output_gb, stop_nodes(:stop_count), stop_lower(:stop_count), stop_upper(:stop_count), &
+      & 'scene', scene, error)
    if (.not. allocated(error)) call validate_scene(scene, 'scene', error)
    if (.not. allocated(error)) call build_model(scene, model, error)
    if (.not. allocated(error)) then
@@ -124,8 +140,9 @@ end subroutine bs_stability
 !> 2 failed (the recorder), with run_message; status/message report errors that prevent the run.
 subroutine bs_run(length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, &
    & elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, &
-   & max_output_gb, records, snapshots, nodes, t, tip_u, tip_v, reaction, energy, work, dissipated, &
-   & snapshot_t, snapshot_x, snapshot_u, filled, snaps, kappa_h, kappa_bound, dt_limit_newmark, dt_limit_paper, &
+   & max_output_gb, stop_count, stop_nodes, stop_lower, stop_upper, records, snapshots, nodes, t, tip_u, tip_v, reaction, energy, work, dissipated, &
+   & snapshot_t, snapshot_x, snapshot_u, stops_u, stops_reaction, filled, snaps, kappa_h, kappa_bound, &
+   & dt_limit_newmark, dt_limit_paper, &
    & dt_limit_paper_bound, steps, t_final, cpu_seconds, impacts, max_violation, run_status, run_message, &
    & status, message)
    use beamstops, only: error_type, fatal_error, scene_type, validate_scene, record_count, snapshot_count, &
@@ -137,11 +154,15 @@ subroutine bs_run(length, k2, mass_per_length, amplitude, omega, lower, upper, l
    !f2py threadsafe
    real(8), intent(in) :: length, k2, mass_per_length, amplitude, omega, lower, upper, stiffness_per_mass
    real(8), intent(in) :: dt, t_end, beta, max_output_gb
+   integer(8), intent(in) :: stop_count
+   integer(8), intent(in) :: stop_nodes(stop_count + 1)
+   real(8), intent(in) :: stop_lower(stop_count + 1), stop_upper(stop_count + 1)
    integer(8), intent(in) :: law, elements, centered_load, taylor_start, allow_unstable, record_every, snapshot_every
    integer(8), intent(in) :: records, snapshots, nodes
    real(8), intent(out) :: t(records), tip_u(records), tip_v(records), reaction(records)
    real(8), intent(out) :: energy(records), work(records), dissipated(records)
    real(8), intent(out) :: snapshot_t(snapshots), snapshot_x(nodes), snapshot_u(nodes, snapshots)
+   real(8), intent(out) :: stops_u(stop_count, records), stops_reaction(stop_count, records)
    integer(8), intent(out) :: filled, snaps, steps, impacts
    real(8), intent(out) :: kappa_h, kappa_bound, dt_limit_newmark, dt_limit_paper, dt_limit_paper_bound
    real(8), intent(out) :: t_final, cpu_seconds, max_violation
@@ -159,6 +180,7 @@ subroutine bs_run(length, k2, mass_per_length, amplitude, omega, lower, upper, l
 
    t = 0; tip_u = 0; tip_v = 0; reaction = 0; energy = 0; work = 0; dissipated = 0
    snapshot_t = 0; snapshot_x = 0; snapshot_u = 0
+   stops_u = 0; stops_reaction = 0
    filled = 0; snaps = 0; steps = 0; impacts = 0
    kappa_h = 0; kappa_bound = 0; dt_limit_newmark = 0; dt_limit_paper = 0; dt_limit_paper_bound = 0
    t_final = 0; cpu_seconds = 0; max_violation = 0
@@ -167,7 +189,8 @@ subroutine bs_run(length, k2, mass_per_length, amplitude, omega, lower, upper, l
 
    call make_scene(length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, &
       & elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, &
-      & max_output_gb, 'scene', scene, error)
+      & max_output_gb, stop_nodes(:stop_count), stop_lower(:stop_count), stop_upper(:stop_count), &
+      & 'scene', scene, error)
    if (.not. allocated(error)) call validate_scene(scene, 'scene', error)
    if (.not. allocated(error)) then
       if (records /= record_count(scene) .or. snapshots /= snapshot_count(scene) .or. &
@@ -178,10 +201,11 @@ subroutine bs_run(length, k2, mass_per_length, amplitude, omega, lower, upper, l
    if (.not. allocated(error)) then
       ! The array recorder's buffers, sized as its `reserve` would, but allocated with a status.
       allocate (recorder%rows(n_columns, records), recorder%snap_t(snapshots), recorder%snap_u(nodes, snapshots), &
-         & stat=stat)
+         & recorder%stops_u(stop_count, records), recorder%stops_reaction(stop_count, records), stat=stat)
       if (stat /= 0) call fatal_error(error, 'scene: not enough memory for the records of this run')
       recorder%filled = 0
       recorder%snaps = 0
+      recorder%stops_filled = 0
    end if
    if (.not. allocated(error)) call simulate(scene, model, recorder, summary, error)
    if (allocated(error)) then
@@ -205,6 +229,8 @@ subroutine bs_run(length, k2, mass_per_length, amplitude, omega, lower, upper, l
       work(k) = recorder%rows(col_work, k)
       dissipated(k) = recorder%rows(col_dissipated, k)
    end do
+   stops_u(:, :recorder%stops_filled) = recorder%stops_u(:, :recorder%stops_filled)
+   stops_reaction(:, :recorder%stops_filled) = recorder%stops_reaction(:, :recorder%stops_filled)
    snapshot_t(:snaps) = recorder%snap_t(:snaps)
    snapshot_u(:, :snaps) = recorder%snap_u(:, :snaps)
    snapshot_x = model%x
@@ -228,14 +254,15 @@ end subroutine bs_run
 !> The scene the program reads from a namelist file (the engine's own reader), flat.
 subroutine bs_read_scene(path, length, k2, mass_per_length, amplitude, omega, lower, upper, law, &
    & stiffness_per_mass, elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, &
-   & snapshot_every, max_output_gb, file, status, message)
-   use beamstops, only: error_type, scene_type, read_scene
+   & snapshot_every, max_output_gb, stop_count, file, status, message)
+   use beamstops, only: error_type, scene_type, read_scene, stop_count_of => stop_count
    use beamstops_wrap_support, only: report
    implicit none
    character(len=*), intent(in) :: path
    real(8), intent(out) :: length, k2, mass_per_length, amplitude, omega, lower, upper, stiffness_per_mass
    real(8), intent(out) :: dt, t_end, beta, max_output_gb
    integer(8), intent(out) :: law, elements, centered_load, taylor_start, allow_unstable, record_every, snapshot_every
+   integer(8), intent(out) :: stop_count
    character(len=4096), intent(out) :: file
    integer, intent(out) :: status
    character(len=1024), intent(out) :: message
@@ -261,10 +288,41 @@ subroutine bs_read_scene(path, length, k2, mass_per_length, amplitude, omega, lo
    record_every = scene%record_every
    snapshot_every = scene%snapshot_every
    max_output_gb = scene%max_output_gb
+   stop_count = stop_count_of(scene)
    file = ''
    if (allocated(scene%output_file)) file = scene%output_file
    call report(error, status, message)
 end subroutine bs_read_scene
+
+!> The stops along the span the program reads from a namelist file: `stop_count` from
+!> bs_read_scene; nodes (1..J), lower and upper stops (m).
+subroutine bs_read_stops(path, stop_count, stop_nodes, stop_lower, stop_upper, status, message)
+   use beamstops, only: error_type, fatal_error, scene_type, read_scene, stop_count_of => stop_count
+   use beamstops_wrap_support, only: report
+   implicit none
+   character(len=*), intent(in) :: path
+   integer(8), intent(in) :: stop_count
+   integer(8), intent(out) :: stop_nodes(stop_count)
+   real(8), intent(out) :: stop_lower(stop_count), stop_upper(stop_count)
+   integer, intent(out) :: status
+   character(len=1024), intent(out) :: message
+   type(scene_type) :: scene
+   type(error_type), allocatable :: error
+   stop_nodes = 0
+   stop_lower = 0
+   stop_upper = 0
+   call read_scene(trim(path), scene, error)
+   if (.not. allocated(error)) then
+      if (stop_count_of(scene) /= stop_count) then
+         call fatal_error(error, trim(path)//': bs_read_stops needs the stop_count of bs_read_scene')
+      else if (stop_count > 0) then
+         stop_nodes = scene%stop_nodes
+         stop_lower = scene%stop_lower
+         stop_upper = scene%stop_upper
+      end if
+   end if
+   call report(error, status, message)
+end subroutine bs_read_stops
 
 !> k2 = E I/(rho S) and the mass per length rho S of a tube, as the namelist reader derives them.
 subroutine bs_tube(youngs_modulus, density, outer_diameter, wall_thickness, k2, mass_per_length)
@@ -280,7 +338,7 @@ end subroutine bs_tube
 !> Only to measure the round-off floor that the engine's increment form removes (SPEC 4).
 subroutine bs_run_three_level(length, k2, mass_per_length, amplitude, omega, lower, upper, law, &
    & stiffness_per_mass, elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, &
-   & snapshot_every, max_output_gb, records, t, tip_u, cpu_seconds, status, message)
+   & snapshot_every, max_output_gb, stop_count, stop_nodes, stop_lower, stop_upper, records, t, tip_u, cpu_seconds, status, message)
    use beamstops, only: error_type, fatal_error, scene_type, validate_scene, record_count, model_type, &
       & prepare_run, run_three_level
    use beamstops_wrap_support, only: make_scene, report
@@ -288,6 +346,9 @@ subroutine bs_run_three_level(length, k2, mass_per_length, amplitude, omega, low
    !f2py threadsafe
    real(8), intent(in) :: length, k2, mass_per_length, amplitude, omega, lower, upper, stiffness_per_mass
    real(8), intent(in) :: dt, t_end, beta, max_output_gb
+   integer(8), intent(in) :: stop_count
+   integer(8), intent(in) :: stop_nodes(stop_count + 1)
+   real(8), intent(in) :: stop_lower(stop_count + 1), stop_upper(stop_count + 1)
    integer(8), intent(in) :: law, elements, centered_load, taylor_start, allow_unstable, record_every, snapshot_every
    integer(8), intent(in) :: records
    real(8), intent(out) :: t(records), tip_u(records), cpu_seconds
@@ -300,7 +361,8 @@ subroutine bs_run_three_level(length, k2, mass_per_length, amplitude, omega, low
    t = 0; tip_u = 0; cpu_seconds = 0
    call make_scene(length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, &
       & elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, &
-      & max_output_gb, 'scene', scene, error)
+      & max_output_gb, stop_nodes(:stop_count), stop_lower(:stop_count), stop_upper(:stop_count), &
+      & 'scene', scene, error)
    if (.not. allocated(error)) call validate_scene(scene, 'scene', error)
    if (.not. allocated(error)) then
       if (records /= record_count(scene)) call fatal_error(error, 'scene: the arrays given to '// &
@@ -322,7 +384,7 @@ end subroutine bs_run_three_level
 !> snapshots (nodal values) do not hold. `steps` ascending in 0..steps_of(scene); n = 2J.
 subroutine bs_states(length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, &
    & elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, &
-   & max_output_gb, count, steps, n, u, v, mass, stiffness, cpu_seconds, status, message)
+   & max_output_gb, stop_count, stop_nodes, stop_lower, stop_upper, count, steps, n, u, v, mass, stiffness, cpu_seconds, status, message)
    use beamstops, only: error_type, fatal_error, scene_type, validate_scene, steps_of, model_type, prepare_run, &
       & state_type, start_state, array_recorder
    use beamstops_scheme, only: advance
@@ -331,6 +393,9 @@ subroutine bs_states(length, k2, mass_per_length, amplitude, omega, lower, upper
    !f2py threadsafe
    real(8), intent(in) :: length, k2, mass_per_length, amplitude, omega, lower, upper, stiffness_per_mass
    real(8), intent(in) :: dt, t_end, beta, max_output_gb
+   integer(8), intent(in) :: stop_count
+   integer(8), intent(in) :: stop_nodes(stop_count + 1)
+   real(8), intent(in) :: stop_lower(stop_count + 1), stop_upper(stop_count + 1)
    integer(8), intent(in) :: law, elements, centered_load, taylor_start, allow_unstable, record_every, snapshot_every
    integer(8), intent(in) :: count, n
    integer(8), intent(in) :: steps(count)
@@ -348,7 +413,8 @@ subroutine bs_states(length, k2, mass_per_length, amplitude, omega, lower, upper
    u = 0; v = 0; mass = 0; stiffness = 0; cpu_seconds = 0
    call make_scene(length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, &
       & elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, &
-      & max_output_gb, 'scene', scene, error)
+      & max_output_gb, stop_nodes(:stop_count), stop_lower(:stop_count), stop_upper(:stop_count), &
+      & 'scene', scene, error)
    if (.not. allocated(error)) call validate_scene(scene, 'scene', error)
    if (.not. allocated(error)) then
       if (n /= 2*scene%elements) call fatal_error(error, 'scene: bs_states needs n = 2*elements')

@@ -13,7 +13,7 @@ contains
    !> logicals as integers 0/1); the scene is not validated here.
    subroutine make_scene(length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, &
       & elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, &
-      & max_output_gb, source, scene, error)
+      & max_output_gb, stop_nodes, stop_lower, stop_upper, source, scene, error)
       !> &beam, &support, &stops values (SI units, see scene_type).
       real(wp), intent(in) :: length, k2, mass_per_length, amplitude, omega, lower, upper, stiffness_per_mass
       !> &time values (s, s, -) and &output max_output_gb (1e9 bytes).
@@ -24,6 +24,12 @@ contains
       integer(ik), intent(in) :: elements, record_every, snapshot_every
       !> Flags: nonzero for .true.
       integer(ik), intent(in) :: centered_load, taylor_start, allow_unstable
+      !> Stops along the span: nodes (1..J) and their lower and upper stops (m); none: the tip form.
+      integer(ik), intent(in) :: stop_nodes(:)
+      !> Lower stops (m) of stop_nodes.
+      real(wp), intent(in) :: stop_lower(:)
+      !> Upper stops (m) of stop_nodes.
+      real(wp), intent(in) :: stop_upper(:)
       !> Where the scene came from, for messages.
       character(len=*), intent(in) :: source
       !> Scene filled.
@@ -49,6 +55,15 @@ contains
       call fit('output', 'record_every', record_every, scene%record_every); if (allocated(error)) return
       call fit('output', 'snapshot_every', snapshot_every, scene%snapshot_every); if (allocated(error)) return
       scene%max_output_gb = max_output_gb
+      if (size(stop_nodes) > 0) then
+         if (any(abs(stop_nodes) > huge(1))) then
+            call fatal_error(error, source//': &stops nodes is out of range; allowed: 1 <= nodes <= elements')
+            return
+         end if
+         scene%stop_nodes = int(stop_nodes)
+         scene%stop_lower = stop_lower
+         scene%stop_upper = stop_upper
+      end if
 
    contains
 

@@ -6,7 +6,7 @@ module beamstops_checkpoint
    use hdf5
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
-   use beamstops_scene, only: scene_type
+   use beamstops_scene, only: scene_type, stop_count
    use beamstops_model, only: model_type
    use beamstops_state, only: state_type
    use beamstops_recorder_hdf5_vector, only: write_vector, read_vector
@@ -39,16 +39,18 @@ contains
       path = output//'.checkpoint'
    end function checkpoint_path
 
-   !> Every value of a scene that shapes the records, as numbers (a restart must match them).
+   !> Every value of a scene that shapes the records, as numbers (a restart must match them);
+   !> the stops along the span (nodes, lower, upper) at the end.
    pure function scene_signature(scene) result(values)
       !> Scene.
       type(scene_type), intent(in) :: scene
-      real(wp) :: values(18)
+      real(wp), allocatable :: values(:)
       values = [scene%length, scene%k2, scene%mass_per_length, scene%amplitude, scene%omega, scene%lower, &
          & scene%upper, real(scene%law, wp), scene%stiffness_per_mass, real(scene%elements, wp), scene%dt, &
          & scene%t_end, scene%beta, merge(1.0_wp, 0.0_wp, scene%centered_load), &
          & merge(1.0_wp, 0.0_wp, scene%taylor_start), real(scene%record_every, wp), &
          & real(scene%snapshot_every, wp), real(scene%checkpoint_every, wp)]
+      if (stop_count(scene) > 0) values = [values, real(scene%stop_nodes, wp), scene%stop_lower, scene%stop_upper]
    end function scene_signature
 
    !> Remove a file if it exists.
@@ -74,7 +76,7 @@ contains
       character(len=:), allocatable :: temporary
       integer(hid_t) :: file
       integer :: hdferr
-      logical :: ok(5)
+      logical :: ok(6)
       temporary = path//'.tmp'
       call h5open_f(hdferr)
       call h5eset_auto_f(0, hdferr)
@@ -88,6 +90,8 @@ contains
       call write_vector(file, 'u', state%u, ok(3))
       call write_vector(file, 'd', state%d, ok(4))
       call write_vector(file, 'su', state%su, ok(5))
+      ok(6) = .true.
+      if (allocated(state%stop_reaction)) call write_vector(file, 'stop_reaction', state%stop_reaction, ok(6))
       call h5fclose_f(file, hdferr)
       if (.not. all(ok) .or. hdferr /= 0) then
          call fatal_error(error, path//': cannot write the checkpoint')
@@ -112,14 +116,17 @@ contains
       integer(ik), intent(out) :: records, snapshots
       !> Set when the file is unreadable or belongs to another scene.
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: signature(size(scene_signature(scene))), scalars(n_scalars)
+      real(wp), allocatable :: signature(:)
+      real(wp) :: scalars(n_scalars)
       integer(hid_t) :: file
       integer :: hdferr, n
-      logical :: ok(5)
+      logical :: ok(6)
       records = 0
       snapshots = 0
       n = model%n
+      signature = scene_signature(scene)
       allocate (state%u(n), state%d(n), state%su(n), state%rhs(n), state%scratch(n), state%shape(size(model%x)))
+      if (stop_count(scene) > 0) allocate (state%stop_reaction(stop_count(scene)))
       call h5open_f(hdferr)
       call h5eset_auto_f(0, hdferr)
       call h5fopen_f(path, H5F_ACC_RDONLY_F, file, hdferr)
@@ -132,6 +139,8 @@ contains
       call read_vector(file, 'u', state%u, ok(3))
       call read_vector(file, 'd', state%d, ok(4))
       call read_vector(file, 'su', state%su, ok(5))
+      ok(6) = .true.
+      if (allocated(state%stop_reaction)) call read_vector(file, 'stop_reaction', state%stop_reaction, ok(6))
       call h5fclose_f(file, hdferr)
       if (.not. all(ok)) then
          call fatal_error(error, path//': the checkpoint is damaged or of another mesh')

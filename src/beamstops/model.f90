@@ -1,15 +1,18 @@
 !> What a scene implies before time runs: assembled M and S, the load vector,
-!> the factor of A = M + dt^2 beta S, the tip column z = A^{-1} e_tip, the
-!> initial data, kappa_h and the stability limits. Built once.
+!> the factor of A = M + dt^2 beta S, the tip column z = A^{-1} e_tip, the stops along
+!> the span (their columns A^{-1} P and C = P^T A^{-1} P), the initial data, kappa_h and
+!> the stability limits. Built once.
 module beamstops_model
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_positive_inf
    use beamstops_kinds, only: wp
    use beamstops_error, only: error_type, fatal_error
-   use beamstops_scene, only: scene_type, law_compliance, fmt_real
+   use beamstops_scene, only: scene_type, law_compliance, fmt_real, stop_count
    use beamstops_hermite, only: element_mass, element_stiffness, hermite_basis, gauss_points, gauss_weights
    use beamstops_band, only: kd, assemble_band, cholesky_factor, cholesky_solve, &
       & largest_eigenvalue_exact, largest_eigenvalue_iterative
    use beamstops_forcing, only: lift_shape, lift_slope
+   use beamstops_contact_span_stops, only: span_stops_type, new_span_stops
+   use beamstops_contact_box_qp, only: box_qp_type, new_box_qp
    implicit none
    private
    public :: model_type, build_model, check_stability, kappa_bound_constant, exact_eigen_limit
@@ -41,6 +44,8 @@ module beamstops_model
       real(wp), allocatable :: load(:)
       !> Tip column z = A^{-1} e_tip (n).
       real(wp), allocatable :: z(:)
+      !> Stops along the span (SPEC 7): nodes, bounds, Z = A^{-1} P, C = P^T Z (m = 0: none).
+      type(span_stops_type) :: stops
       !> Initial displacement u0 and velocity v0 of the homogeneous unknown (n).
       real(wp), allocatable :: u0(:), v0(:)
       !> Node abscissae x_0 = 0, ..., x_J = L (J+1).
@@ -107,9 +112,28 @@ contains
       model%z = 0
       model%z(model%tip) = 1
       call cholesky_solve(model%factor, model%z)
+      if (stop_count(scene) > 0) then
+         call build_stops(scene, model, error)
+         if (allocated(error)) return
+      end if
 
       call spectrum(scene, model, error)
    end subroutine build_model
+
+   !> The stops along the span: Z = A^{-1} P by m solves, C = P^T Z, and C checked positive
+   !> definite (stops on distinct nodes make it so; round-off could not for nodes too close).
+   subroutine build_stops(scene, model, error)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(inout) :: model
+      type(error_type), allocatable, intent(out) :: error
+      type(box_qp_type) :: check
+      call new_span_stops(model%stops, scene%stop_nodes, scene%stop_lower, scene%stop_upper, model%x, model%lift, &
+         & model%factor, error)
+      if (allocated(error)) return
+      call new_box_qp(check, model%stops%c, error)
+      if (allocated(error)) error%message = '&stops: the stops along the span: '//error%message// &
+         & ' (stops too close together for this mesh and time step?)'
+   end subroutine build_stops
 
    !> Load shapes (h, phi_i) and (1, phi_i) by 4-point Gauss quadrature per element.
    pure subroutine load_shapes(elements, h, length, bh, b1)

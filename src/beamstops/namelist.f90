@@ -5,7 +5,7 @@ module beamstops_namelist
    use, intrinsic :: iso_fortran_env, only: iostat_end
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
-   use beamstops_scene, only: scene_type, validate_scene, tube_beam, law_code, law_compliance, fmt_real
+   use beamstops_scene, only: scene_type, validate_scene, tube_beam, law_code, law_compliance, fmt_real, max_stops
    implicit none
    private
    public :: read_scene, group_names
@@ -15,9 +15,10 @@ module beamstops_namelist
    !> Keys of each group, for messages.
    character(len=*), parameter :: group_keys(6) = [character(len=140) :: &
       & 'length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness', &
-      & 'amplitude, omega', 'lower, upper, law, stiffness, stiffness_per_mass', 'elements', &
+      & 'amplitude, omega', 'lower, upper, nodes, x, law, stiffness, stiffness_per_mass', 'elements', &
       & 'dt, t_end, beta, load_rule, start, allow_unstable', 'file, record_every, snapshot_every, checkpoint_every, max_output_gb']
    real(wp), parameter :: unset = -huge(1.0_wp)
+   integer, parameter :: unset_node = -huge(1)
    integer, parameter :: text_len = 4096
 
 contains
@@ -35,8 +36,9 @@ contains
       real(wp) :: length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness
       ! &support
       real(wp) :: amplitude, omega
-      ! &stops
-      real(wp) :: lower, upper, stiffness, stiffness_per_mass
+      ! &stops: lower, upper one value (the tip) or one per stop along the span (nodes or x)
+      real(wp) :: lower(max_stops), upper(max_stops), x(max_stops), stiffness, stiffness_per_mass
+      integer :: nodes(max_stops)
       character(len=64) :: law
       ! &mesh
       integer :: elements
@@ -51,7 +53,7 @@ contains
       integer(ik) :: checkpoint_every
       namelist /beam/ length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness
       namelist /support/ amplitude, omega
-      namelist /stops/ lower, upper, law, stiffness, stiffness_per_mass
+      namelist /stops/ lower, upper, nodes, x, law, stiffness, stiffness_per_mass
       namelist /mesh/ elements
       namelist /time/ dt, t_end, beta, load_rule, start, allow_unstable
       namelist /output/ file, record_every, snapshot_every, checkpoint_every, max_output_gb
@@ -67,7 +69,8 @@ contains
       length = scene%length; k2 = unset; mass_per_length = unset
       youngs_modulus = unset; density = unset; outer_diameter = unset; wall_thickness = unset
       amplitude = scene%amplitude; omega = scene%omega
-      lower = scene%lower; upper = scene%upper; law = 'signorini'; stiffness = unset; stiffness_per_mass = unset
+      lower = unset; upper = unset; nodes = unset_node; x = unset
+      law = 'signorini'; stiffness = unset; stiffness_per_mass = unset
       elements = scene%elements
       dt = scene%dt; t_end = scene%t_end; beta = scene%beta; load_rule = 'centered'; start = 'taylor'
       allow_unstable = .false.
@@ -97,8 +100,6 @@ contains
       if (allocated(error)) return
       scene%amplitude = amplitude
       scene%omega = omega
-      scene%lower = lower
-      scene%upper = upper
       scene%law = law_code(law)
       if (scene%law < 0) then
          call fatal_error(error, path//": &stops law = '"//trim(law)//"' is out of range; allowed: "// &
@@ -152,8 +153,124 @@ contains
       scene%snapshot_every = snapshot_every
       scene%max_output_gb = max_output_gb
       scene%checkpoint_every = checkpoint_every
+      call stops_from_lists(path, lower, upper, nodes, x, scene, error)
+      if (allocated(error)) return
       call validate_scene(scene, path, error)
    end subroutine read_scene
+
+   !> The stops of &stops: without nodes or x, lower and upper (one value each) are the tip stops;
+   !> with nodes (indices 1..J) or x (abscissae, each at a node to 1e-9 length), the stops along
+   !> the span, lower and upper one value for all or one per stop. Needs the scene's length and
+   !> elements.
+   subroutine stops_from_lists(path, lower, upper, nodes, x, scene, error)
+      character(len=*), intent(in) :: path
+      real(wp), intent(in) :: lower(:), upper(:), x(:)
+      integer, intent(in) :: nodes(:)
+      type(scene_type), intent(inout) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      integer :: n_lower, n_upper, n_nodes, n_x, m, i, node
+      real(wp) :: h, at
+      n_lower = given(lower == unset, 'lower'); if (allocated(error)) return
+      n_upper = given(upper == unset, 'upper'); if (allocated(error)) return
+      n_nodes = given(nodes == unset_node, 'nodes'); if (allocated(error)) return
+      n_x = given(x == unset, 'x'); if (allocated(error)) return
+      if (n_nodes > 0 .and. n_x > 0) then
+         call fatal_error(error, path//': &stops gives both nodes and x; allowed: one of them (node indices '// &
+            & '1..elements, or abscissae x = i*length/elements)')
+         return
+      end if
+      m = max(n_nodes, n_x)
+      if (m == 0) then
+         if (n_lower > 1 .or. n_upper > 1) then
+            call fatal_error(error, path//': &stops lower or upper has several values but no stops along the span '// &
+               & 'are given (nodes or x); allowed: one value each (the tip stops), or nodes or x with one value '// &
+               & 'per stop')
+            return
+         end if
+         if (n_lower == 1) scene%lower = lower(1)
+         if (n_upper == 1) scene%upper = upper(1)
+         return
+      end if
+      call per_stop(lower, n_lower, 'lower', scene%lower, scene%stop_lower); if (allocated(error)) return
+      call per_stop(upper, n_upper, 'upper', scene%upper, scene%stop_upper); if (allocated(error)) return
+      if (n_nodes > 0) then
+         scene%stop_nodes = nodes(:m)
+         return
+      end if
+      allocate (scene%stop_nodes(m))
+      h = scene%length/scene%elements
+      do i = 1, m
+         if (.not. (x(i) > 0 .and. x(i) <= scene%length*(1 + 1.0e-9_wp))) then
+            call fatal_error(error, path//': &stops x('//itoa(i)//') = '//fmt_real(x(i))//' is out of range; '// &
+               & 'allowed: 0 < x <= length = '//fmt_real(scene%length)//' (x = 0 is the clamp)')
+            return
+         end if
+         node = max(1, min(scene%elements, nint(x(i)/h)))
+         at = scene%length*node/scene%elements
+         if (abs(x(i) - at) > 1.0e-9_wp*scene%length) then
+            node = min(scene%elements - 1, int(x(i)/h))
+            call fatal_error(error, path//': &stops x('//itoa(i)//') = '//fmt_real(x(i))//' is not at a node; '// &
+               & 'allowed: x = i*length/elements to 1e-9*length (length = '//fmt_real(scene%length)// &
+               & ', elements = '//itoa(scene%elements)//'); the nearest nodes are '//node_text(node)//' and '// &
+               & node_text(node + 1))
+            return
+         end if
+         scene%stop_nodes(i) = node
+      end do
+
+   contains
+
+      !> Number of values given to a list key; a value after a missing one is an error.
+      integer function given(missing, key)
+         logical, intent(in) :: missing(:)
+         character(len=*), intent(in) :: key
+         integer :: j
+         given = size(missing)
+         do j = 1, size(missing)
+            if (missing(j)) then
+               given = j - 1
+               exit
+            end if
+         end do
+         do j = given + 1, size(missing)
+            if (.not. missing(j)) then
+               call fatal_error(error, path//': &stops '//key//'('//itoa(j)//') is given but '//key//'('// &
+                  & itoa(given + 1)//') is not; allowed: the values one after the other from '//key//'(1)')
+               return
+            end if
+         end do
+      end function given
+
+      !> Bounds of the m stops from a list with `count` values: none (the default), one for all, or m.
+      subroutine per_stop(values, count, key, default, bounds)
+         real(wp), intent(in) :: values(:)
+         integer, intent(in) :: count
+         character(len=*), intent(in) :: key
+         real(wp), intent(in) :: default
+         real(wp), allocatable, intent(out) :: bounds(:)
+         allocate (bounds(m))
+         select case (count)
+         case (0)
+            bounds = default
+         case (1)
+            bounds = values(1)
+         case default
+            if (count /= m) then
+               call fatal_error(error, path//': &stops '//key//' has '//itoa(count)//' values for '//itoa(m)// &
+                  & ' stops; allowed: one value (the same for every stop) or '//itoa(m))
+               return
+            end if
+            bounds = values(:m)
+         end select
+      end subroutine per_stop
+
+      !> "i (x = ...)" for a node.
+      function node_text(i) result(t)
+         integer, intent(in) :: i
+         character(len=:), allocatable :: t
+         t = itoa(i)//' (x = '//fmt_real(scene%length*i/scene%elements)//')'
+      end function node_text
+   end subroutine stops_from_lists
 
    !> k2 and the mass per length, given directly or derived from the tube's material and geometry.
    subroutine derive_beam(path, length, k2, mass_per_length, youngs_modulus, density, outer_diameter, &

@@ -1,5 +1,6 @@
 !> The recorder interface: the time loop hands every `record_every`-th step's
-!> tip and energy values, and every `snapshot_every`-th step's shape, to a recorder.
+!> tip and energy values (and those of the stops along the span, just before), and every
+!> `snapshot_every`-th step's shape, to a recorder.
 !> Implementations: the HDF5 file writer (program) and the array recorder (Python).
 module beamstops_recorder
    use beamstops_kinds, only: wp, ik
@@ -21,6 +22,9 @@ module beamstops_recorder
       procedure(record_interface), deferred :: record
       !> Take one snapshot of the physical displacement at the nodes x_0..x_J.
       procedure(snapshot_interface), deferred :: snapshot
+      !> Take the stops' values of the row that follows: u~ and reaction of each stop along the
+      !> span (default: nothing).
+      procedure :: record_stops
       !> Told between blocks of steps how far the run is (default: nothing).
       procedure :: progress
       !> Save what is recorded so far and the state, to resume from (default: nothing).
@@ -52,6 +56,16 @@ contains
       !> Steps in the run.
       integer(ik), intent(in) :: steps
    end subroutine progress
+
+   !> Default record of the stops along the span: none.
+   subroutine record_stops(self, u, reaction)
+      !> Recorder.
+      class(recorder_type), intent(inout) :: self
+      !> Physical displacement u~ at each stop (m) (m).
+      real(wp), intent(in) :: u(:)
+      !> Reaction of each stop in the step that brought u~ there (N) (m).
+      real(wp), intent(in) :: reaction(:)
+   end subroutine record_stops
 
    !> Default checkpoint: none.
    subroutine checkpoint(self, state)

@@ -9,12 +9,14 @@ module beamstops_scene
    public :: scene_type, validate_scene, steps_of, record_count, snapshot_count, output_bytes
    public :: tube_section, tube_beam, fmt_real, fmt_int
    public :: law_none, law_signorini, law_compliance, law_name, law_code
-   public :: max_elements
+   public :: max_elements, max_stops, stop_count
 
    !> Contact law codes.
    integer, parameter :: law_none = 0, law_signorini = 1, law_compliance = 2
    !> Largest mesh accepted (memory stays below a few GB).
    integer, parameter :: max_elements = 1000000
+   !> Most stops along the span (&stops nodes or x).
+   integer, parameter :: max_stops = 1000
 
    !> Every input of a run. Defaults reproduce the paper's scene (Figure 2).
    type :: scene_type
@@ -36,6 +38,13 @@ module beamstops_scene
       integer :: law = law_signorini
       !> &stops: normal-compliance stiffness per unit mass 1/epsilon (1/s^2).
       real(wp) :: stiffness_per_mass = 0.0_wp
+      !> &stops: nodes (1..J) of the stops along the span (SPEC 7), the tip (J) possibly among
+      !> them; unallocated or empty: the tip stops lower, upper only (stop_count).
+      integer, allocatable :: stop_nodes(:)
+      !> &stops: lower stop of each node of stop_nodes, < 0 (m): bounds the physical displacement.
+      real(wp), allocatable :: stop_lower(:)
+      !> &stops: upper stop of each node of stop_nodes, > 0 (m).
+      real(wp), allocatable :: stop_upper(:)
       !> &mesh: number of elements J.
       integer :: elements = 19
       !> &time: time step (s).
@@ -72,6 +81,15 @@ contains
       n = max(1_ik, nint(scene%t_end/scene%dt, ik))
    end function steps_of
 
+   !> Number m of stops along the span (0: the tip-only form, stops lower and upper at the tip).
+   pure function stop_count(scene) result(m)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      integer :: m
+      m = 0
+      if (allocated(scene%stop_nodes)) m = size(scene%stop_nodes)
+   end function stop_count
+
    !> Records a complete run writes (t = 0 included).
    pure function record_count(scene) result(n)
       !> Scene.
@@ -89,12 +107,14 @@ contains
       if (scene%snapshot_every > 0) n = steps_of(scene)/scene%snapshot_every + 1
    end function snapshot_count
 
-   !> Bytes of recorded data of a complete run: 8 series of records and the snapshots.
+   !> Bytes of recorded data of a complete run: 8 series of records, 2 per stop along the span,
+   !> and the snapshots.
    pure function output_bytes(scene) result(bytes)
       !> Scene.
       type(scene_type), intent(in) :: scene
       real(wp) :: bytes
-      bytes = 64*real(record_count(scene), wp) + 8*real(snapshot_count(scene), wp)*(scene%elements + 2)
+      bytes = 8*(8 + 2*stop_count(scene))*real(record_count(scene), wp) &
+         & + 8*real(snapshot_count(scene), wp)*(scene%elements + 2)
    end function output_bytes
 
    !> Cross-section area and second moment of a tube.
@@ -250,6 +270,7 @@ contains
          call say('mesh', 'elements', fmt_int(int(scene%elements, ik)), '1 <= elements <= '//fmt_int(int(max_elements, ik)))
          return
       end if
+      call span_stops_valid(); if (allocated(error)) return
       call within('time', 't_end', scene%t_end, tiny(1.0_wp), 1.0e9_wp, '0 < t_end <= 1e+09 s')
       if (allocated(error)) return
       call within('time', 'dt', scene%dt, tiny(1.0_wp), scene%t_end, '0 < dt <= t_end = '//fmt_real(scene%t_end)//' s')
@@ -274,16 +295,70 @@ contains
 
    contains
 
+      !> The stops along the span: as many bounds as nodes, nodes distinct in 1..J, lower < 0 < upper,
+      !> and the Signorini law (or none); the compliance spring is at the tip only.
+      subroutine span_stops_valid()
+         integer :: m, i, j
+         m = stop_count(scene)
+         if (m == 0) return
+         if (m > max_stops) then
+            call say('stops', 'nodes', fmt_int(int(m, ik))//' stops', 'at most '//fmt_int(int(max_stops, ik))//' stops')
+            return
+         end if
+         if (.not. allocated(scene%stop_lower)) then
+            call say('stops', 'lower', 'missing', 'one value per stop'); return
+         end if
+         if (.not. allocated(scene%stop_upper)) then
+            call say('stops', 'upper', 'missing', 'one value per stop'); return
+         end if
+         if (size(scene%stop_lower) /= m) then
+            call say('stops', 'lower', fmt_int(int(size(scene%stop_lower), ik))//' values', &
+               & 'one value per stop ('//fmt_int(int(m, ik))//')'); return
+         end if
+         if (size(scene%stop_upper) /= m) then
+            call say('stops', 'upper', fmt_int(int(size(scene%stop_upper), ik))//' values', &
+               & 'one value per stop ('//fmt_int(int(m, ik))//')'); return
+         end if
+         if (scene%law == law_compliance) then
+            call fatal_error(error, source//": &stops law = 'compliance' with stops along the span (nodes or x) is "// &
+               & "out of range; allowed: law = 'signorini' or 'none' with nodes or x (the compliance spring acts "// &
+               & 'at the tip only: give lower and upper alone)')
+            return
+         end if
+         do i = 1, m
+            if (scene%stop_nodes(i) < 1 .or. scene%stop_nodes(i) > scene%elements) then
+               call say('stops', 'nodes('//fmt_int(int(i, ik))//')', fmt_int(int(scene%stop_nodes(i), ik)), &
+                  & '1 <= nodes <= elements = '//fmt_int(int(scene%elements, ik))//' (node 0 is clamped)'); return
+            end if
+            do j = 1, i - 1
+               if (scene%stop_nodes(j) == scene%stop_nodes(i)) then
+                  call say('stops', 'nodes('//fmt_int(int(i, ik))//')', fmt_int(int(scene%stop_nodes(i), ik)), &
+                     & 'each node once (node '//fmt_int(int(scene%stop_nodes(i), ik))//' is given twice, as nodes('// &
+                     & fmt_int(int(j, ik))//') too)'); return
+               end if
+            end do
+            if (.not. (scene%stop_lower(i) >= -1.0e6_wp .and. scene%stop_lower(i) < 0)) then
+               call say('stops', 'lower('//fmt_int(int(i, ik))//')', fmt_real(scene%stop_lower(i)), &
+                  & '-1e+06 <= lower < 0 (the beam starts at rest at 0)'); return
+            end if
+            if (.not. (scene%stop_upper(i) > 0 .and. scene%stop_upper(i) <= 1.0e6_wp)) then
+               call say('stops', 'upper('//fmt_int(int(i, ik))//')', fmt_real(scene%stop_upper(i)), &
+                  & '0 < upper <= 1e+06 (the beam starts at rest at 0)'); return
+            end if
+         end do
+      end subroutine span_stops_valid
+
       !> Refuse an output larger than max_output_gb, saying which record_every (or snapshot_every) fits.
       subroutine output_fits()
-         real(wp) :: limit, snaps, per_record
+         real(wp) :: limit, snaps, per_record, row
          real(wp) :: fits
          limit = scene%max_output_gb*1.0e9_wp
          if (output_bytes(scene) <= limit) return
          snaps = 8*real(snapshot_count(scene), wp)*(scene%elements + 2)
-         per_record = 64*real(steps_of(scene), wp)
-         if (snaps < limit - 64) then
-            fits = per_record/(limit - snaps - 64)
+         row = 8*(8 + 2*stop_count(scene))
+         per_record = row*real(steps_of(scene), wp)
+         if (snaps < limit - row) then
+            fits = per_record/(limit - snaps - row)
             call fatal_error(error, source//': &output record_every = '//fmt_int(int(scene%record_every, ik))// &
                & ' gives '//fmt_real(output_bytes(scene)/1.0e9_wp, 3)//' GB of output, more than max_output_gb = '// &
                & fmt_real(scene%max_output_gb)//'; allowed: record_every >= '//fmt_int(ceiling(fits, ik))// &

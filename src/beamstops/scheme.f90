@@ -1,13 +1,14 @@
 !> The time loop of the paper's scheme in increment form (SPEC 4):
 !>   A (d^n - d^{n-1}) = dt^2 (G^n - S u^n),  u^{n+1} = u^n + d^n,
-!> followed by the contact law at the tip, with the energy bookkeeping of SPEC 6.
+!> followed by the contact law at the tip (or at the stops along the span, SPEC 7), with the
+!> energy bookkeeping of SPEC 6. The law is chosen once per call of advance.
 !> The loop allocates nothing and writes nothing: records go to a recorder.
 module beamstops_scheme
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_kinds, only: wp, ik
-   use beamstops_scene, only: scene_type, steps_of, law_none, law_signorini, law_compliance
+   use beamstops_scene, only: scene_type, steps_of, law_none, law_signorini, law_compliance, stop_count
    use beamstops_model, only: model_type
-   use beamstops_error, only: error_type
+   use beamstops_error, only: error_type, fatal_error
    use beamstops_band, only: band_matvec, cholesky_factor, cholesky_solve
    use beamstops_band_solve, only: band_solver, prepare_solver, forward_substitution, back_substitution, &
       & forward_substitution_energy, &
@@ -17,6 +18,8 @@ module beamstops_scheme
    use beamstops_forcing, only: load_average, support_position
    use beamstops_contact_tip_projection, only: project_tip
    use beamstops_contact_compliance, only: spring_force, solve_spring_tip
+   use beamstops_contact_span_stops, only: new_span_work, span_contact, span_correction, span_settle, span_energy
+   use beamstops_contact_box_qp, only: qp_solved, qp_message
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
       & col_work, col_dissipated
    use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running
@@ -80,7 +83,10 @@ contains
          call cholesky_solve(mfac, a0)
          state%u = state%u + 0.5_wp*model%dt2*a0
       end if
-      if (scene%law == law_signorini) then
+      if (model%stops%m > 0) then
+         call start_span(scene, model, state, error)
+         if (allocated(error)) return
+      else if (scene%law == law_signorini) then
          call project_tip(state%u(tip), scene%lower, scene%upper, model%z(tip), c, tip_value)
          state%u = state%u + c*model%z
          state%u(tip) = tip_value
@@ -94,8 +100,8 @@ contains
          state%p_prev = spring_force(model%u0(tip), scene%lower, scene%upper, scene%stiffness_per_mass)
          state%p_now = spring_force(state%u(tip), scene%lower, scene%upper, scene%stiffness_per_mass)
       end if
-      if (scene%law /= law_none) state%max_violation = violation(state%u(tip), scene)
-      call prepare_operators(model, state)
+      if (scene%law /= law_none .and. model%stops%m == 0) state%max_violation = violation(state%u(tip), scene)
+      if (state%solver%n /= model%n) call prepare_operators(model, state)
       call band_matvec(model%mass, state%d, state%scratch)
       state%energy0 = energy(model, dot_product(state%d, state%scratch), dot_product(state%u, state%su), &
          & dot_product(state%d, state%su), dot_product(model%u0, matmul_band(model, model%u0)))
@@ -103,6 +109,12 @@ contains
       r(col_u) = model%u0(tip)
       r(col_v) = model%v0(tip)
       r(col_energy) = scene%mass_per_length*state%energy0
+      if (model%stops%m > 0) then
+         state%span%record_u = model%u0(model%stops%unknown) + model%stops%lift*support_position(0.0_wp, &
+            & scene%amplitude, scene%omega)
+         state%span%record_reaction = 0
+         call recorder%record_stops(state%span%record_u, state%span%record_reaction)
+      end if
       call recorder%record(r)
       if (scene%snapshot_every > 0) then
          call physical_shape(model, model%u0, 0.0_wp, scene, state%shape)
@@ -110,6 +122,40 @@ contains
       end if
       state%step = 1
    end subroutine start_state
+
+   !> The stops along the span at the start: their work, and u^1 projected on the bounds of t_1
+   !> (the QP on the trial values u^1 at the stops; with one stop at the tip, the tip's projection).
+   subroutine start_span(scene, model, state, error)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: c, worst
+      integer :: col
+      allocate (state%stop_reaction(model%stops%m))
+      state%stop_reaction = 0
+      call new_span_work(state%span, model%stops, error)
+      if (allocated(error)) return
+      if (scene%law /= law_signorini) return
+      call prepare_operators(model, state)
+      state%scratch = 0
+      call span_contact(model%stops, state%span, state%u, state%scratch, state%scratch, &
+         & support_position(model%dt, scene%amplitude, scene%omega), .true., state%span%info)
+      if (state%span%info /= qp_solved) then
+         call fatal_error(error, 'the start u^1: '//qp_message(state%span%info))
+         return
+      end if
+      call span_correction(model%stops, state%span, state%solver, state%scratch, c, col)
+      if (col > 0) then
+         state%u = state%u + c*model%stops%z(:, col)
+      else
+         state%u = state%u + state%scratch
+      end if
+      worst = 0
+      state%rhs = 0
+      call span_settle(model%stops, state%span, state%u, state%rhs, worst)
+      state%max_violation = worst
+   end subroutine start_span
 
    !> S x as a new array (start-up only).
    function matmul_band(model, x) result(y)
@@ -149,6 +195,12 @@ contains
             summary%message = 'the recorder could not write'
             exit
          end if
+         if (state%span%info /= qp_solved) then
+            summary%status = status_failed
+            summary%message = qp_message(state%span%info)//' at t = '// &
+               & trim(real_text(real(state%step, wp)*model%dt))//' s'
+            exit
+         end if
          call band_matvec(model%mass, state%d, state%scratch)
          kinetic = 0.5_wp*dot_product(state%d, state%scratch)/model%dt2
          cap = 1.0e8_wp*(0.5_wp*scene%length*(scene%amplitude*scene%omega)**2 + abs(state%energy0) &
@@ -181,7 +233,8 @@ contains
 
    !> Advance from state%step through step `last` (computing u^{last+1}), recording on the way.
    !> The fused path (default) or, with state%lapack_solve, the reference path; both compute
-   !> the same step, to round-off.
+   !> the same step, to round-off. With stops along the span, advance_span (fused). A step whose
+   !> contact problem fails (state%span%info) ends the call before it.
    subroutine advance(scene, model, state, recorder, last)
       !> Scene.
       type(scene_type), intent(in) :: scene
@@ -193,13 +246,17 @@ contains
       class(recorder_type), intent(inout) :: recorder
       !> Last step to do.
       integer(ik), intent(in) :: last
+      integer(ik) :: done
       if (state%solver%n /= model%n) call prepare_operators(model, state)
-      if (state%lapack_solve) then
+      done = last
+      if (model%stops%m > 0) then
+         call advance_span(scene, model, state, recorder, last, done)
+      else if (state%lapack_solve) then
          call advance_reference(scene, model, state, recorder, last)
       else
          call advance_fused(scene, model, state, recorder, last)
       end if
-      state%step = last + 1
+      state%step = done + 1
    end subroutine advance
 
    !> The step as SPEC 4 writes it, one operation after the other: rhs = dt^2 (G^n - S u^n),
@@ -321,6 +378,118 @@ contains
          call recorder%record(row)
       end if
    end subroutine advance_fused
+
+   !> The fused step with stops along the span (SPEC 7; contact/span_stops.f90): the full back
+   !> substitution gives x = A^{-1} rhs; the trial values u^n + d^{n-1} + x at the stops against
+   !> the bounds of t_{n+1}; only when some are out, the QP on C; then the loop's update, with
+   !> one active stop the tip's rank-one update along its column (so that a single stop at the
+   !> tip is the tip-only path to the bit), with more the correction folded into x. Records as
+   !> advance_fused, the stops' values handed just before each row. `done` is the last step
+   !> done: `last`, unless the QP of a step fails (state%span%info), then the step before.
+   subroutine advance_span(scene, model, state, recorder, last, done)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      class(recorder_type), intent(inout) :: recorder
+      integer(ik), intent(in) :: last
+      integer(ik), intent(out) :: done
+      integer(ik) :: step, next_record, next_snapshot
+      integer :: tip, col
+      real(wp) :: sigma_next, weight, c, gd, d_tip_prev, u_tip_prev, r_tip
+      real(wp) :: usu, dsu, u_old_su, dmd, r_prev, phi_prev, phi_now, phi_next, row(n_columns)
+      logical :: contact, pending, enforce
+      type(load_rotation) :: loads
+
+      tip = model%tip
+      enforce = scene%law == law_signorini
+      if (.not. allocated(state%span%trial)) call resume_span(model, state)
+      call first_events(scene, state%step, next_record, next_snapshot)
+      pending = .false.
+      u_old_su = 0
+      dmd = 0
+      done = state%step - 1
+      phi_prev = support_position(real(state%step - 1, wp)*model%dt, scene%amplitude, scene%omega)
+      phi_now = support_position(real(state%step, wp)*model%dt, scene%amplitude, scene%omega)
+      call start_loads(loads, state%step + 1, scene, model)
+      do step = state%step, last
+         sigma_next = loads%sigma
+         call next_load(loads, scene, model)
+         phi_next = support_position(real(step + 1, wp)*model%dt, scene%amplitude, scene%omega)
+         weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
+         call forward_pass(state%stiffness, state%mass, state%solver, model%load, state%u, state%d, &
+            & model%dt2*weight, model%dt2, 0.0_wp, pending .or. step == next_record, &
+            & state%su, state%rhs, usu, dsu, dmd)
+         if (pending) then
+            row(col_energy) = scene%mass_per_length*energy(model, dmd, usu, dsu, u_old_su)
+            call recorder%record_stops(state%span%record_u, state%span%record_reaction)
+            call recorder%record(row)
+            pending = .false.
+         end if
+         u_old_su = usu
+         call back_substitution(state%solver, state%rhs)
+         d_tip_prev = state%d(tip)
+         u_tip_prev = state%u(tip)
+         call span_contact(model%stops, state%span, state%u, state%d, state%rhs, phi_next, enforce, state%span%info)
+         if (state%span%info /= qp_solved) exit
+         call span_correction(model%stops, state%span, state%solver, state%rhs, c, col)
+         if (col > 0) then
+            call update(state%rhs, c, model%stops%z(:, col), state%d, state%u)
+         else
+            call update(state%rhs, 0.0_wp, model%z, state%d, state%u)
+         end if
+         gd = dot(model%load, state%d)
+         contact = state%span%contact
+         ! The stops on their bounds, the energy they take and the work of the support through them.
+         if (enforce) call span_settle(model%stops, state%span, state%u, state%d, state%max_violation)
+         r_prev = state%reaction
+         r_tip = 0
+         if (model%stops%tip > 0) r_tip = state%span%lambda(model%stops%tip)/model%dt2
+         if (contact .and. .not. state%in_contact) state%impacts = state%impacts + 1
+         state%in_contact = contact
+         state%work = state%work + 0.5_wp*weight*(gd + state%gd_prev)
+         call span_energy(model%stops, state%span, state%d, model%dt2, phi_next - phi_prev, state%dissipated, &
+            & state%work)
+         state%reaction = r_tip
+         state%gd_prev = gd
+         state%sigma_prev = state%sigma_now
+         state%sigma_now = sigma_next
+         if (step == next_record) then
+            next_record = next_record + scene%record_every
+            call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_prev, row)
+            state%span%record_u = state%span%u_prev + model%stops%lift*phi_now
+            state%span%record_reaction = scene%mass_per_length*state%stop_reaction
+            pending = .true.
+         end if
+         state%stop_reaction = state%span%lambda/model%dt2
+         if (step == next_snapshot) then
+            next_snapshot = next_snapshot + scene%snapshot_every
+            call take_snapshot(scene, model, state, step, recorder)
+         end if
+         done = step
+         phi_prev = phi_now
+         phi_now = phi_next
+      end do
+      call diagonal_matvec(state%stiffness, state%u, state%su)
+      if (pending) then
+         call diagonal_matvec(state%mass, state%d, state%scratch)
+         row(col_energy) = scene%mass_per_length*energy(model, dot(state%d, state%scratch), dot(state%u, state%su), &
+            & dot(state%d, state%su), u_old_su)
+         call recorder%record_stops(state%span%record_u, state%span%record_reaction)
+         call recorder%record(row)
+      end if
+   end subroutine advance_span
+
+   !> The work of the stops along the span after a checkpoint (the state holds no QP).
+   subroutine resume_span(model, state)
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      type(error_type), allocatable :: error
+      call new_span_work(state%span, model%stops, error)
+      if (.not. allocated(state%stop_reaction)) then
+         allocate (state%stop_reaction(model%stops%m))
+         state%stop_reaction = 0
+      end if
+   end subroutine resume_span
 
    !> Forward pass of a step: su = S u, rhs = a g - b su plus `spring` in the tip row (n-1),
    !> both vectorized, then the forward substitution (rhs replaced by D^{-2} w); with `energy`,

@@ -3,6 +3,7 @@
 module beamstops_state
    use beamstops_kinds, only: wp, ik
    use beamstops_band_solve, only: band_solver, band_diagonals
+   use beamstops_contact_span_stops, only: span_work_type
    implicit none
    private
    public :: state_type
@@ -31,6 +32,11 @@ module beamstops_state
       real(wp) :: energy0 = 0
       !> Reaction per unit mass of the step that gave u^n (r_{n-1}; recorded with u^n).
       real(wp) :: reaction = 0
+      !> The same for each stop along the span (m; unallocated without them).
+      real(wp), allocatable :: stop_reaction(:)
+      !> Stops along the span: the program on C and its work arrays, built from the model
+      !> (start_state, or the loop itself after a checkpoint).
+      type(span_work_type) :: span
       !> Whether the previous step was in contact.
       logical :: in_contact = .false.
       !> Impacts so far.

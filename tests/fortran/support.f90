@@ -3,7 +3,7 @@
 module test_support
    use testing, only: int_text   ! public here too, for the suites that take it from this module
    use beamstops, only: wp, ik, error_type, fatal_error, scene_type, validate_scene, model_type, &
-      & prepare_run, simulate, record_count, array_recorder, run_summary, status_complete
+      & prepare_run, simulate, record_count, array_recorder, run_summary, status_complete, stop_count
    implicit none
    private
    public :: band_eigenvalues, dense_eigenvalues, run_recorded, int_text
@@ -259,7 +259,7 @@ contains
       if (allocated(error)) return
       call prepare_run(scene, 'test scene', model, error)
       if (allocated(error)) return
-      call rec%reserve(record_count(scene), 0_ik, scene%elements + 1)
+      call rec%reserve(record_count(scene), 0_ik, scene%elements + 1, stop_count(scene))
       call simulate(scene, model, rec, summary, error)
       if (allocated(error)) return
       if (summary%status /= status_complete) then

@@ -34,7 +34,8 @@ def register_plot(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("file", type=Path, help="HDF5 file written by `beamstops run`")
     parser.add_argument("-o", "--output", type=Path, help="image to write (default: FILE_KIND.png next to FILE)")
     parser.add_argument("--kind", choices=KINDS, default="tip",
-                        help="tip displacement, space-time shape, energy, phase portrait, reaction, or all (default: tip)")
+                        help="tip displacement, space-time shape, energy, phase portrait, reaction, the stops along "
+                             "the span (one panel each), or all (default: tip)")
     parser.add_argument("--dpi", type=int, default=120, help="resolution of raster images (default: 120)")
     parser.add_argument("--allow-incomplete", action="store_true",
                         help="plot a run that diverged or was interrupted")

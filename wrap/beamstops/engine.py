@@ -44,10 +44,21 @@ def _flat(scene: Scene) -> tuple[Any, ...]:
         if not -_INT64 < value < _INT64:
             group = "mesh" if key == "elements" else "output"
             raise ValueError(f"scene: &{group} {key} = {value} is out of range; allowed: |{key}| < 2**31")
-    return (scene.length, scene.k2, scene.mass_per_length, scene.amplitude, scene.omega, scene.lower,
-            scene.upper, LAWS[scene.law], scene.stiffness_per_mass, scene.elements, scene.dt, scene.t_end,
+    if any(not -_INT64 < node < _INT64 for node in scene.nodes):
+        raise ValueError("scene: &stops nodes is out of range; allowed: 1 <= nodes <= elements")
+    if scene.nodes:
+        tip_lower, tip_upper = Scene.lower, Scene.upper  # unused with stops along the span
+        lower, upper = scene.lower, scene.upper
+    else:
+        tip_lower, tip_upper = scene.lower, scene.upper
+        lower = upper = ()
+    # The stops' arrays carry one padding value (f2py refuses input arrays of size 0).
+    return (scene.length, scene.k2, scene.mass_per_length, scene.amplitude, scene.omega, tip_lower,
+            tip_upper, LAWS[scene.law], scene.stiffness_per_mass, scene.elements, scene.dt, scene.t_end,
             scene.beta, int(scene.load_rule == "centered"), int(scene.start == "taylor"),
-            int(scene.allow_unstable), scene.record_every, scene.snapshot_every, scene.max_output_gb)
+            int(scene.allow_unstable), scene.record_every, scene.snapshot_every, scene.max_output_gb,
+            np.array(list(scene.nodes) + [0], dtype=np.int64), np.array(list(lower) + [0.0]),
+            np.array(list(upper) + [0.0]))
 
 
 def _check(status: int, message: Any) -> None:
@@ -122,18 +133,23 @@ def run(scene: Scene, *, allow_incomplete: bool = False) -> Result:
     """
     flat = _flat(scene)
     records, snapshots, nodes = sizes(scene)
-    (t, tip_u, tip_v, reaction, energy, work, dissipated, snapshot_t, snapshot_x, snapshot_u, filled, snaps,
-     kappa_h, kappa_bound, dt_newmark, dt_paper, dt_paper_bound, steps, t_final, cpu_seconds, impacts,
-     max_violation, run_status, run_message, status, message) = _engine.bs_run(*flat, records, snapshots, nodes)
+    (t, tip_u, tip_v, reaction, energy, work, dissipated, snapshot_t, snapshot_x, snapshot_u, stops_u,
+     stops_reaction, filled, snaps, kappa_h, kappa_bound, dt_newmark, dt_paper, dt_paper_bound, steps, t_final,
+     cpu_seconds, impacts, max_violation, run_status, run_message, status, message) = _engine.bs_run(
+        *flat, records, snapshots, nodes)
     _check(status, message)
     filled, snaps = int(filled), int(snaps)
     attrs: dict[str, Any] = {
         "status": _RUN_STATUS.get(int(run_status), "failed"),
         "version": version(),
         "length": scene.length, "k2": scene.k2, "mass_per_length": scene.mass_per_length,
-        "amplitude": scene.amplitude, "omega": scene.omega, "lower": scene.lower, "upper": scene.upper,
-        "law": scene.law,
+        "amplitude": scene.amplitude, "omega": scene.omega,
     }
+    if scene.nodes:
+        attrs["stops"] = len(scene.nodes)
+    else:
+        attrs.update({"lower": scene.lower, "upper": scene.upper})
+    attrs["law"] = scene.law
     if scene.law == "compliance":
         attrs["stiffness_per_mass"] = scene.stiffness_per_mass
     attrs.update({
@@ -155,6 +171,11 @@ def run(scene: Scene, *, allow_incomplete: bool = False) -> Result:
         snapshot_t=snapshot_t[:snaps] if snaps == snapshots else snapshot_t[:snaps].copy(),
         snapshot_x=snapshot_x,
         snapshot_u=np.ascontiguousarray(snapshot_u.T[:snaps]),
+        stops_x=snapshot_x[list(scene.nodes)] if scene.nodes else np.empty(0),
+        stops_node=np.array(scene.nodes, dtype=np.float64),
+        stops_lower=np.array(scene.lower if scene.nodes else (), dtype=np.float64),
+        stops_upper=np.array(scene.upper if scene.nodes else (), dtype=np.float64),
+        stops_u=np.ascontiguousarray(stops_u.T[:filled]), stops_reaction=np.ascontiguousarray(stops_reaction.T[:filled]),
         attrs=attrs, source="memory")
     if attrs["status"] != "complete" and not allow_incomplete:
         raise IncompleteRunError(f"scene: run {attrs['status']}: {attrs.get('message', '')}", result)
@@ -164,11 +185,18 @@ def run(scene: Scene, *, allow_incomplete: bool = False) -> Result:
 def read_namelist(path: PathLike) -> Scene:
     """The scene the program itself (the engine's namelist reader) reads from a file."""
     (length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, elements, dt, t_end,
-     beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, max_output_gb, file,
-     status, message) = _engine.bs_read_scene(os.fsencode(path))
+     beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, max_output_gb, stop_count,
+     file, status, message) = _engine.bs_read_scene(os.fsencode(path))
     _check(status, message)
+    nodes: tuple[int, ...] = ()
+    if stop_count > 0:
+        stop_nodes, stop_lower, stop_upper, status, message = _engine.bs_read_stops(os.fsencode(path), stop_count)
+        _check(status, message)
+        nodes = tuple(int(n) for n in stop_nodes)
+        lower, upper = tuple(float(v) for v in stop_lower), tuple(float(v) for v in stop_upper)
     return Scene(length=length, k2=k2, mass_per_length=mass_per_length, amplitude=amplitude, omega=omega,
-                 lower=lower, upper=upper, law=_LAW_NAMES[int(law)], stiffness_per_mass=stiffness_per_mass,
+                 lower=lower, upper=upper, nodes=nodes, law=_LAW_NAMES[int(law)],
+                 stiffness_per_mass=stiffness_per_mass,
                  elements=int(elements), dt=dt, t_end=t_end, beta=beta,
                  load_rule="centered" if centered_load else "paper", start="taylor" if taylor_start else "euler",
                  allow_unstable=bool(allow_unstable), file=_text(file), record_every=int(record_every),

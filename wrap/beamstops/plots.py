@@ -6,7 +6,9 @@ Each ``plot_*`` function draws on a given Axes (or a new figure's) and returns t
 - :func:`plot_shape`: the beam's shape in space-time, a colour map of ũ(x, t);
 - :func:`plot_energy`: discrete energy with the work of the load and the energy the stops took;
 - :func:`plot_phase`: phase portrait (u, v) of the tip;
-- :func:`plot_reaction`: contact reaction at the tip.
+- :func:`plot_reaction`: contact reaction at the tip;
+- :func:`plot_stop`: displacement of one stop along the span between its stops, contacts marked
+  (kind ``'stops'``: one panel per stop).
 
 :func:`figure` builds a whole figure of one kind (or ``'all'``), :func:`save` writes it.
 Figures are :class:`matplotlib.figure.Figure` objects not attached to any GUI backend,
@@ -26,10 +28,11 @@ from matplotlib.figure import Figure
 
 from .result import Result
 
-__all__ = ["KINDS", "plot_tip", "plot_shape", "plot_energy", "plot_phase", "plot_reaction", "figure", "save"]
+__all__ = ["KINDS", "plot_tip", "plot_shape", "plot_energy", "plot_phase", "plot_reaction", "plot_stop", "figure",
+           "save"]
 
 #: Plot kinds understood by :func:`figure`, :func:`save` and ``python -m beamstops plot --kind``.
-KINDS = ("tip", "shape", "energy", "phase", "reaction", "all")
+KINDS = ("tip", "shape", "energy", "phase", "reaction", "stops", "all")
 
 _LINE = {"color": "k", "linewidth": 0.6}
 _STOP = {"color": "tab:red", "linewidth": 0.8, "linestyle": "--"}
@@ -71,8 +74,14 @@ def _title(result: Result) -> str:
 
 
 def _stops(result: Result) -> tuple[Optional[float], Optional[float]]:
+    """The tip's stops: the tip-only form's, or those of a stop along the span at the tip."""
     if result.attrs.get("law") == "none":
         return None, None
+    if result.stops_node.size:
+        at_tip = np.flatnonzero(result.stops_node == result.attrs.get("elements"))
+        if at_tip.size == 0:
+            return None, None
+        return float(result.stops_lower[at_tip[0]]), float(result.stops_upper[at_tip[0]])
     return result.attrs.get("lower"), result.attrs.get("upper")
 
 
@@ -163,6 +172,46 @@ def plot_reaction(result: Result, ax: Optional[Axes] = None) -> Axes:
     return ax
 
 
+def plot_stop(result: Result, index: int = 0, ax: Optional[Axes] = None) -> Axes:
+    """Physical displacement ũ at stop ``index`` (0-based) along the span against time, between
+    its stops; the records where the stop acts (a nonzero reaction) are marked."""
+    ax = _axes(ax)
+    if result.stops_node.size == 0:
+        ax.text(0.5, 0.5, "no stops along the span\n(&stops nodes or x)", ha="center", va="center",
+                transform=ax.transAxes)
+        ax.set_axis_off()
+        return ax
+    u = result.stops_u[:, index]
+    r = result.stops_reaction[:, index]
+    t, ud = _envelope(result.t, u)
+    ax.plot(t, 1e3 * ud, **_LINE)
+    if result.attrs.get("law") != "none":
+        for g in (result.stops_lower[index], result.stops_upper[index]):
+            ax.axhline(1e3 * g, **_STOP)
+        acting = r != 0
+        if acting.any():
+            ax.plot(result.t[acting], 1e3 * u[acting], ".", color="tab:red", markersize=1.5, label="stop acts")
+    ax.set_ylabel("ũ (mm)")
+    ax.set_xlim(0.0, float(result.attrs.get("t_end", result.t[-1] if result.t.size else 1.0)))
+    ax.set_title(f"stop {index + 1}: node {int(result.stops_node[index])}, x = {result.stops_x[index]:.4g} m, "
+                 f"{np.count_nonzero(r)} records with a reaction", fontsize="medium")
+    ax.grid(True, linewidth=0.3, alpha=0.5)
+    return ax
+
+
+def _stops_figure(result: Result) -> Figure:
+    """One panel per stop along the span, time shared, the tip at the bottom."""
+    m = max(1, result.stops_node.size)
+    fig = Figure(figsize=(9, 1.2 + 2.2 * m), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(m, 1, sharex=True))
+    order = np.argsort(result.stops_x) if result.stops_node.size else [0]
+    for ax, index in zip(axes, order):
+        plot_stop(result, int(index), ax)
+    axes[-1].set_xlabel("t (s)")
+    fig.suptitle(_title(result), fontsize="medium")
+    return fig
+
+
 _PLOTS: dict[str, Callable[..., Axes]] = {
     "tip": plot_tip, "shape": plot_shape, "energy": plot_energy, "phase": plot_phase, "reaction": plot_reaction,
 }
@@ -172,6 +221,8 @@ def figure(result: Result, kind: str = "tip", **options: Any) -> Figure:
     """A figure of one kind (see :data:`KINDS`); ``'all'`` puts every kind on one page."""
     if kind not in KINDS:
         raise ValueError(f"unknown plot kind {kind!r}; allowed: {', '.join(KINDS)}")
+    if kind == "stops":
+        return _stops_figure(result)
     if kind != "all":
         fig = Figure(figsize=(8, 4.5), layout="constrained")
         _PLOTS[kind](result, fig.add_subplot(), **options)

@@ -13,8 +13,17 @@ dissipated         /energy/dissipated     energy taken by the stops (J)
 snapshot_t         /snapshots/t           snapshot times (s)
 snapshot_x         /snapshots/x           node abscissae x_0..x_J (m)
 snapshot_u         /snapshots/u           physical displacement ũ(x, t), (snapshots, J+1) (m)
+stops_x            /stops/x               abscissae of the stops along the span (m) (m)
+stops_node         /stops/node            their node indices 1..J (m)
+stops_lower        /stops/lower           their lower stops (m) (m)
+stops_upper        /stops/upper           their upper stops (m) (m)
+stops_u            /stops/u               physical displacement ũ at each stop, (records, m) (m)
+stops_reaction     /stops/reaction        reaction of each stop, (records, m) (N)
 attrs              root attributes        scene, κ_h, limits, status, steps, cpu_seconds, …
 =================  =====================  =========================================
+
+Without stops along the span (the tip-only form) the ``stops_*`` arrays are empty
+(``stops_u`` and ``stops_reaction`` of shape (records, 0)).
 
 :func:`load` reads a file written by ``beamstops run``; :func:`beamstops.run` gives the
 same object from memory.
@@ -42,6 +51,12 @@ ARRAYS: dict[str, str] = {
     "snapshot_t": "snapshots/t",
     "snapshot_x": "snapshots/x",
     "snapshot_u": "snapshots/u",
+    "stops_x": "stops/x",
+    "stops_node": "stops/node",
+    "stops_lower": "stops/lower",
+    "stops_upper": "stops/upper",
+    "stops_u": "stops/u",
+    "stops_reaction": "stops/reaction",
 }
 
 
@@ -67,6 +82,12 @@ class Result:
     snapshot_t: np.ndarray
     snapshot_x: np.ndarray
     snapshot_u: np.ndarray
+    stops_x: np.ndarray = field(default_factory=lambda: np.empty(0))
+    stops_node: np.ndarray = field(default_factory=lambda: np.empty(0))
+    stops_lower: np.ndarray = field(default_factory=lambda: np.empty(0))
+    stops_upper: np.ndarray = field(default_factory=lambda: np.empty(0))
+    stops_u: np.ndarray = field(default_factory=lambda: np.empty((0, 0)))
+    stops_reaction: np.ndarray = field(default_factory=lambda: np.empty((0, 0)))
     attrs: dict[str, Any] = field(default_factory=dict)
     source: str = "memory"
     """'memory' for :func:`beamstops.run`, the file name for :func:`load`."""
@@ -88,6 +109,10 @@ class Result:
         keys = {f: self.attrs[f] for f in ("length", "k2", "mass_per_length", "amplitude", "omega", "lower", "upper",
                                            "law", "elements", "dt", "t_end", "beta", "load_rule", "start",
                                            "record_every", "snapshot_every", "max_output_gb") if f in self.attrs}
+        if self.stops_node.size:
+            keys["nodes"] = tuple(int(n) for n in self.stops_node)
+            keys["lower"] = tuple(float(v) for v in self.stops_lower)
+            keys["upper"] = tuple(float(v) for v in self.stops_upper)
         if "allow_unstable" in self.attrs:
             keys["allow_unstable"] = bool(self.attrs["allow_unstable"])
         if "stiffness_per_mass" in self.attrs:
@@ -142,6 +167,9 @@ def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result
     arrays.setdefault("snapshot_t", np.empty(0))
     arrays.setdefault("snapshot_x", np.empty(0))
     arrays.setdefault("snapshot_u", np.empty((0, nodes)))
+    records = arrays["t"].size if "t" in arrays else 0
+    arrays.setdefault("stops_u", np.empty((records, 0)))
+    arrays.setdefault("stops_reaction", np.empty((records, 0)))
     for name in ARRAYS:
         arrays.setdefault(name, np.empty(0))
     result = Result(**arrays, attrs=attrs, source=path)

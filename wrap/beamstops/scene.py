@@ -11,7 +11,13 @@ Two inputs of the namelist are not fields but routes to them, accepted by
 
 - ``youngs_modulus``, ``density``, ``outer_diameter``, ``wall_thickness`` (all four
   together) give ``k2`` and ``mass_per_length`` by the engine's own formulas;
-- ``stiffness`` (N/m) gives ``stiffness_per_mass = stiffness / mass_per_length`` (1/s²).
+- ``stiffness`` (N/m) gives ``stiffness_per_mass = stiffness / mass_per_length`` (1/s²);
+- ``x`` (abscissae of stops along the span, each at a node to 1e-9 length) gives ``nodes``,
+  with the (new) ``length`` and ``elements``.
+
+Stops along the span (issue 8): with ``nodes`` (node indices 1..J) the scene has a stop at
+each, and ``lower`` and ``upper`` are tuples, one value per stop (one value given is used
+for all); without, ``lower`` and ``upper`` are the tip stops (single values), as before.
 """
 
 from __future__ import annotations
@@ -50,13 +56,13 @@ MATERIAL_KEYS = ("youngs_modulus", "density", "outer_diameter", "wall_thickness"
 GROUPS: dict[str, tuple[str, ...]] = {
     "beam": ("length", "k2", "mass_per_length") + MATERIAL_KEYS,
     "support": ("amplitude", "omega"),
-    "stops": ("lower", "upper", "law", "stiffness", "stiffness_per_mass"),
+    "stops": ("lower", "upper", "nodes", "x", "law", "stiffness", "stiffness_per_mass"),
     "mesh": ("elements",),
     "time": ("dt", "t_end", "beta", "load_rule", "start", "allow_unstable"),
     "output": ("file", "record_every", "snapshot_every", "max_output_gb"),
 }
 _GROUP_OF = {key: group for group, keys in GROUPS.items() for key in keys}
-_ROUTES = MATERIAL_KEYS + ("stiffness",)
+_ROUTES = MATERIAL_KEYS + ("stiffness", "x")
 
 
 @dataclass(frozen=True)
@@ -76,10 +82,12 @@ class Scene:
     omega: float = 10.0
     """Angular frequency ω of the support (rad/s)."""
     # &stops
-    lower: float = -0.1
-    """Lower stop g1 < 0 (m)."""
-    upper: float = 0.1
-    """Upper stop g2 > 0 (m)."""
+    lower: Union[float, tuple[float, ...]] = -0.1
+    """Lower stop g1 < 0 (m): the tip's, or one per stop along the span (a tuple, with ``nodes``)."""
+    upper: Union[float, tuple[float, ...]] = 0.1
+    """Upper stop g2 > 0 (m): the tip's, or one per stop along the span (a tuple, with ``nodes``)."""
+    nodes: tuple[int, ...] = ()
+    """Nodes (1..J, J the tip) of the stops along the span; () for the tip stops alone."""
     law: Law = "signorini"
     """Contact law: 'signorini' (the paper's scheme), 'compliance' (a spring) or 'none'."""
     stiffness_per_mass: float = 0.0
@@ -114,6 +122,8 @@ class Scene:
         for field in dataclasses.fields(self):
             value = getattr(self, field.name)
             object.__setattr__(self, field.name, _coerce(field.name, value))
+        for key in ("lower", "upper"):
+            object.__setattr__(self, key, _per_stop(key, getattr(self, key), len(self.nodes)))
         _check_name("stops", "law", self.law, tuple(LAWS))
         _check_name("time", "load_rule", self.load_rule, LOAD_RULES)
         _check_name("time", "start", self.start, STARTS)
@@ -167,7 +177,8 @@ class Scene:
         """A copy with some keys changed: any field, the material route or ``stiffness`` (N/m).
 
         The material keys go together (all four) and exclude ``k2`` and ``mass_per_length``;
-        ``stiffness`` is converted with the (new) ``mass_per_length``.
+        ``stiffness`` is converted with the (new) ``mass_per_length``; ``x`` gives ``nodes`` with
+        the (new) ``length`` and ``elements``.
         """
         unknown = sorted(set(changes) - set(_GROUP_OF))
         if unknown:
@@ -187,6 +198,13 @@ class Scene:
                                  "allowed: stiffness > 0 (N/m)")
             mass = _coerce("mass_per_length", fields.get("mass_per_length", self.mass_per_length))
             fields["stiffness_per_mass"] = stiffness / mass
+        if "x" in changes:
+            if "nodes" in fields:
+                raise ValueError(f"{_source}: &stops gives both nodes and x; allowed: one of them (node indices "
+                                 "1..elements, or abscissae x = i*length/elements)")
+            length = _coerce("length", fields.get("length", self.length))
+            elements = _coerce("elements", fields.get("elements", self.elements))
+            fields["nodes"] = _nodes_of(_coerce("x", changes["x"]), length, elements, _source)
         return dataclasses.replace(self, **fields)
 
     # ------------------------------------------------------------------ output
@@ -200,6 +218,10 @@ class Scene:
                 continue
             if field.name == "stiffness_per_mass" and self.law != "compliance":
                 continue  # the program reads it only with law='compliance'
+            if field.name == "nodes" and not value:
+                continue  # the tip-only form
+            if isinstance(value, tuple):
+                value = list(value)
             out[_GROUP_OF[field.name]][field.name] = value
         return out
 
@@ -228,7 +250,11 @@ class Scene:
         out = []
         for field in dataclasses.fields(self):
             a, b = getattr(self, field.name), getattr(other, field.name)
-            same = (a == b) if not isinstance(a, float) else _same_float(a, b)
+            if isinstance(a, tuple) and isinstance(b, tuple):
+                same = len(a) == len(b) and all(_same_float(p, q) if isinstance(p, float) else p == q
+                                                 for p, q in zip(a, b))
+            else:
+                same = (a == b) if not isinstance(a, float) else _same_float(a, b)
             if not same:
                 out.append(f"{field.name}: {a!r} != {b!r}")
         return "; ".join(out)
@@ -236,8 +262,10 @@ class Scene:
 
 # ---------------------------------------------------------------------- helpers
 
-_FLOATS = {"length", "k2", "mass_per_length", "amplitude", "omega", "lower", "upper", "stiffness_per_mass", "dt",
+_FLOATS = {"length", "k2", "mass_per_length", "amplitude", "omega", "stiffness_per_mass", "dt",
            "t_end", "beta", "max_output_gb", "stiffness"} | set(MATERIAL_KEYS)
+_FLOAT_OR_LIST = {"lower", "upper"}
+_LISTS = {"nodes": "an integer", "x": "a real number"}
 _INTS = {"elements", "record_every", "snapshot_every"}
 _BOOLS = {"allow_unstable"}
 _TEXTS = {"law", "load_rule", "start", "file"}
@@ -245,6 +273,28 @@ _TEXTS = {"law", "load_rule", "start", "file"}
 
 def _coerce(key: str, value: Any) -> Any:
     """A value of the type its key holds; TypeError names the key otherwise."""
+    if key in _FLOAT_OR_LIST:
+        if isinstance(value, (list, tuple)) or (hasattr(value, "ndim") and getattr(value, "ndim", 0) > 0):
+            return tuple(_coerce(key + "[]", v) for v in value)
+        return _coerce(key + "[]", value)
+    if key in ("lower[]", "upper[]", "x[]"):
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
+            raise TypeError(f"scene key {key[:-2]} must hold real numbers, not {value!r}")
+        return float(value)
+    if key in _LISTS:
+        if not isinstance(value, (list, tuple)) and not (hasattr(value, "ndim") and getattr(value, "ndim", 0) > 0):
+            value = (value,)  # one stop
+        if key == "x":
+            return tuple(_coerce("x[]", v) for v in value)
+        out = []
+        for v in value:
+            if isinstance(v, bool):
+                raise TypeError(f"scene key nodes must hold integers, not {v!r}")
+            try:
+                out.append(operator.index(v))
+            except TypeError:
+                raise TypeError(f"scene key nodes must hold integers, not {v!r}") from None
+        return tuple(out)
     if key in _FLOATS:
         if isinstance(value, bool) or not isinstance(value, numbers.Real):
             raise TypeError(f"scene key {key} must be a real number, not {value!r}")
@@ -269,6 +319,42 @@ def _coerce(key: str, value: Any) -> Any:
             raise TypeError(f"scene key {key} must be a string, not {value!r}")
         return value
     raise TypeError(f"unknown scene key {key}")
+
+
+def _per_stop(key: str, value: Union[float, tuple[float, ...]], m: int) -> Union[float, tuple[float, ...]]:
+    """lower or upper for m stops along the span: a tuple of m values (one value given: for all);
+    without stops along the span (m = 0), the tip's single value."""
+    values = value if isinstance(value, tuple) else (value,)
+    if m == 0:
+        if len(values) != 1:
+            raise ValueError(f"scene: &stops {key} has {len(values)} values but no stops along the span are given "
+                             "(nodes or x); allowed: one value (the tip stop), or nodes or x with one value per stop")
+        return values[0]
+    if len(values) == 1:
+        return values * m
+    if len(values) != m:
+        raise ValueError(f"scene: &stops {key} has {len(values)} values for {m} stops; allowed: one value "
+                         f"(the same for every stop) or {m}")
+    return values
+
+
+def _nodes_of(x: tuple[float, ...], length: float, elements: int, source: str) -> tuple[int, ...]:
+    """Node indices of abscissae x, each at a node to 1e-9 length (the engine's namelist rule)."""
+    nodes = []
+    h = length / elements
+    for i, xi in enumerate(x, start=1):
+        if not (xi > 0 and xi <= length * (1 + 1e-9)):
+            raise ValueError(f"{source}: &stops x({i}) = {xi!r} is out of range; allowed: 0 < x <= length = "
+                             f"{length!r} (x = 0 is the clamp)")
+        node = max(1, min(elements, round(xi / h)))
+        if abs(xi - length * node / elements) > 1e-9 * length:
+            below = min(elements - 1, int(xi / h))
+            raise ValueError(f"{source}: &stops x({i}) = {xi!r} is not at a node; allowed: x = i*length/elements "
+                             f"to 1e-9*length (length = {length!r}, elements = {elements}); the nearest nodes are "
+                             f"{below} (x = {length * below / elements!r}) and {below + 1} "
+                             f"(x = {length * (below + 1) / elements!r})")
+        nodes.append(node)
+    return tuple(nodes)
 
 
 def _check_name(group: str, key: str, value: str, allowed: tuple[str, ...]) -> None:
@@ -319,7 +405,15 @@ def _keys_of(nml: f90nml.Namelist, source: str) -> dict[str, Any]:
             if isinstance(value, list):
                 # 'key = x,' or 'key = x,,' (nulls after one value); 'key = x;' (gfortran's separator)
                 value = [v for v in value if not (isinstance(v, str) and v == ";")] or [None]
-            if isinstance(value, list):
+            if isinstance(value, list) and key in ("nodes", "x", "lower", "upper"):
+                while value and value[-1] is None:
+                    value.pop()
+                if any(v is None for v in value):
+                    raise ValueError(f"{source}: &{group}: malformed value for {key}: {value!r}")
+                value = value if len(value) != 1 else value[0]
+                if isinstance(value, list) and not value:
+                    continue
+            elif isinstance(value, list):
                 if any(v is not None for v in value[1:]):
                     raise ValueError(f"{source}: &{group}: malformed value for {key}: {value!r}")
                 value = value[0]

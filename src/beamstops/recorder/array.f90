@@ -14,16 +14,23 @@ module beamstops_recorder_array
       real(wp), allocatable :: snap_t(:), snap_u(:, :)
       !> Rows and snapshots filled.
       integer(ik) :: filled = 0, snaps = 0
+      !> Stops along the span: u~ and reaction (N) of each stop at each record (m, capacity);
+      !> zero-sized unless reserved.
+      real(wp), allocatable :: stops_u(:, :), stops_reaction(:, :)
+      !> Records of the stops filled.
+      integer(ik) :: stops_filled = 0
    contains
       procedure :: reserve
       procedure :: record
+      procedure :: record_stops
       procedure :: snapshot
    end type array_recorder
 
 contains
 
-   !> Size the arrays for `rows` records and `snapshots` snapshots of `nodes` values.
-   subroutine reserve(self, rows, snapshots, nodes)
+   !> Size the arrays for `rows` records and `snapshots` snapshots of `nodes` values, and for
+   !> the records of `stops` stops along the span (default 0: not kept).
+   subroutine reserve(self, rows, snapshots, nodes, stops)
       !> Recorder.
       class(array_recorder), intent(inout) :: self
       !> Records expected.
@@ -32,10 +39,32 @@ contains
       integer(ik), intent(in) :: snapshots
       !> Nodes per snapshot (J+1).
       integer, intent(in) :: nodes
+      !> Stops along the span whose records are kept.
+      integer, intent(in), optional :: stops
+      integer :: m
+      m = 0
+      if (present(stops)) m = stops
       allocate (self%rows(n_columns, rows), self%snap_t(snapshots), self%snap_u(nodes, snapshots))
+      allocate (self%stops_u(m, rows), self%stops_reaction(m, rows))
       self%filled = 0
       self%snaps = 0
+      self%stops_filled = 0
    end subroutine reserve
+
+   subroutine record_stops(self, u, reaction)
+      class(array_recorder), intent(inout) :: self
+      real(wp), intent(in) :: u(:)
+      real(wp), intent(in) :: reaction(:)
+      if (.not. allocated(self%stops_u)) return
+      if (size(self%stops_u, 1) /= size(u)) return
+      if (self%stops_filled >= size(self%stops_u, 2, ik)) then
+         self%failed = .true.
+         return
+      end if
+      self%stops_filled = self%stops_filled + 1
+      self%stops_u(:, self%stops_filled) = u
+      self%stops_reaction(:, self%stops_filled) = reaction
+   end subroutine record_stops
 
    subroutine record(self, row)
       class(array_recorder), intent(inout) :: self

@@ -5,12 +5,14 @@
 !>   /tip/t, /tip/u, /tip/v, /tip/reaction
 !>   /energy/t, /energy/E, /energy/work, /energy/dissipated
 !>   /snapshots/t, /snapshots/x, /snapshots/u   (u: snapshots x (J+1))
+!>   /stops/x, /stops/node, /stops/lower, /stops/upper, /stops/u, /stops/reaction
+!>                                              (stops along the span; u, reaction: records x m)
 module beamstops_recorder_hdf5
    use, intrinsic :: iso_c_binding, only: c_loc, c_ptr
    use hdf5
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
-   use beamstops_scene, only: scene_type, law_name, law_compliance
+   use beamstops_scene, only: scene_type, law_name, law_compliance, stop_count
    use beamstops_model, only: model_type
    use beamstops_summary, only: run_summary, status_running, status_complete
    use beamstops_state, only: state_type
@@ -55,10 +57,17 @@ module beamstops_recorder_hdf5
       integer :: snap_fill = 0, snapshot_rows = 0
       !> Print a progress line on stderr.
       logical :: show_progress = .false.
+      !> Stops along the span m, their two series (records x m) and buffers (m, stops_rows).
+      integer :: stops = 0
+      integer(hid_t) :: stops_u = -1, stops_reaction = -1
+      real(wp), allocatable :: stops_u_buffer(:, :), stops_r_buffer(:, :)
+      integer :: stops_fill = 0, stops_rows = 0
+      integer(hsize_t) :: stops_written = 0
    contains
       procedure :: open => open_file
       procedure :: reopen
       procedure :: record
+      procedure :: record_stops
       procedure :: checkpoint
       procedure :: snapshot
       procedure :: progress
@@ -107,8 +116,10 @@ contains
          call create_series(self, '/snapshots/u', 'm', self%nodes, self%snap_u)
       end if
       call allocate_snapshot_buffer(self)
+      call allocate_stops_buffer(self)
       call write_vector(self%file, '/snapshots/x', model%x, ok)
       if (.not. ok) call fail(self, 'cannot write dataset /snapshots/x')
+      if (stop_count(scene) > 0) call create_stops(self, scene, model)
       call attribute_text(self, 'status', status_running)
       call attribute_text(self, 'version', version)
       call attribute_real(self, 'length', scene%length)
@@ -116,8 +127,12 @@ contains
       call attribute_real(self, 'mass_per_length', scene%mass_per_length)
       call attribute_real(self, 'amplitude', scene%amplitude)
       call attribute_real(self, 'omega', scene%omega)
-      call attribute_real(self, 'lower', scene%lower)
-      call attribute_real(self, 'upper', scene%upper)
+      if (stop_count(scene) == 0) then
+         call attribute_real(self, 'lower', scene%lower)
+         call attribute_real(self, 'upper', scene%upper)
+      else
+         call attribute_int(self, 'stops', int(stop_count(scene), ik))
+      end if
       call attribute_text(self, 'law', law_name(scene%law))
       if (scene%law == law_compliance) call attribute_real(self, 'stiffness_per_mass', scene%stiffness_per_mass)
       call attribute_int(self, 'elements', int(scene%elements, ik))
@@ -150,6 +165,46 @@ contains
       self%buffer(self%fill, :) = row
       if (self%fill == buffer_rows) call write_buffer(self)
    end subroutine record
+
+   !> Buffer the stops' values of the row that follows; write the buffers when full.
+   subroutine record_stops(self, u, reaction)
+      class(hdf5_recorder), intent(inout) :: self
+      real(wp), intent(in) :: u(:)
+      real(wp), intent(in) :: reaction(:)
+      if (self%stops == 0) return
+      self%stops_fill = self%stops_fill + 1
+      self%stops_u_buffer(:, self%stops_fill) = u
+      self%stops_r_buffer(:, self%stops_fill) = reaction
+      if (self%stops_fill == self%stops_rows) call write_buffer(self)
+   end subroutine record_stops
+
+   !> The group /stops: positions and bounds of the stops along the span, and their two series.
+   subroutine create_stops(self, scene, model)
+      class(hdf5_recorder), intent(inout) :: self
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      integer(hid_t) :: group
+      integer :: hdferr
+      logical :: ok(4)
+      call h5gcreate_f(self%file, 'stops', group, hdferr)
+      call h5gclose_f(group, hdferr)
+      call write_vector(self%file, '/stops/x', model%stops%x, ok(1))
+      call write_vector(self%file, '/stops/node', real(scene%stop_nodes, wp), ok(2))
+      call write_vector(self%file, '/stops/lower', scene%stop_lower, ok(3))
+      call write_vector(self%file, '/stops/upper', scene%stop_upper, ok(4))
+      if (.not. all(ok)) call fail(self, 'cannot write the datasets of /stops')
+      call create_series(self, '/stops/u', 'm', stop_count(scene), self%stops_u, matrix=.true.)
+      call create_series(self, '/stops/reaction', 'N', stop_count(scene), self%stops_reaction, matrix=.true.)
+   end subroutine create_stops
+
+   !> Buffers of the stops' series (when the scene has stops along the span).
+   subroutine allocate_stops_buffer(self)
+      class(hdf5_recorder), intent(inout) :: self
+      self%stops = stop_count(self%scene)
+      if (self%stops == 0) return
+      self%stops_rows = max(1, min(buffer_rows, 2**19/self%stops))
+      allocate (self%stops_u_buffer(self%stops, self%stops_rows), self%stops_r_buffer(self%stops, self%stops_rows))
+   end subroutine allocate_stops_buffer
 
    !> Buffer one snapshot; write the buffer when full.
    subroutine snapshot(self, t, u)
@@ -240,8 +295,14 @@ contains
          call reopen_series('/snapshots/u', self%snap_u, [int(self%nodes, ik), snapshots])
       end if
       call allocate_snapshot_buffer(self)
+      call allocate_stops_buffer(self)
+      if (self%stops > 0) then
+         call reopen_series('/stops/u', self%stops_u, [int(self%stops, ik), records])
+         call reopen_series('/stops/reaction', self%stops_reaction, [int(self%stops, ik), records])
+      end if
       self%written = records
       self%snaps_written = snapshots
+      self%stops_written = records
       call attribute_text(self, 'status', status_running)
       if (self%failed) call fatal_error(error, self%message)
 
@@ -289,6 +350,14 @@ contains
       end do
       self%written = self%written + self%fill
       self%fill = 0
+      if (self%stops_fill > 0) then
+         call append(self, self%stops_u, self%stops, self%stops_written, self%stops_fill, self%stops_u_buffer, &
+            & matrix=.true.)
+         call append(self, self%stops_reaction, self%stops, self%stops_written, self%stops_fill, self%stops_r_buffer, &
+            & matrix=.true.)
+         self%stops_written = self%stops_written + self%stops_fill
+         self%stops_fill = 0
+      end if
       if (self%snap_fill > 0) then
          call append(self, self%snap_t, 1, self%snaps_written, self%snap_fill, self%snap_t_buffer)
          call append(self, self%snap_u, self%nodes, self%snaps_written, self%snap_fill, self%snap_u_buffer)
@@ -297,18 +366,21 @@ contains
       end if
    end subroutine write_buffer
 
-   !> Append `rows` rows of `width` values (stored row after row in `values`) at row `offset`.
-   subroutine append(self, dset, width, offset, rows, values)
+   !> Append `rows` rows of `width` values (stored row after row in `values`) at row `offset`;
+   !> a series of one value per row is 1-D unless `matrix`.
+   subroutine append(self, dset, width, offset, rows, values, matrix)
       class(hdf5_recorder), intent(inout) :: self
       integer(hid_t), intent(in) :: dset
       integer, intent(in) :: width, rows
       integer(hsize_t), intent(in) :: offset
       real(wp), intent(in) :: values(*)
+      logical, intent(in), optional :: matrix
       integer(hid_t) :: filespace, memspace
       integer(hsize_t) :: dims(2), start(2), count(2)
       integer :: hdferr, rank
       if (self%failed .or. rows == 0) return
       rank = merge(1, 2, width == 1)
+      if (present(matrix)) rank = merge(2, rank, matrix)
       if (rank == 1) then
          dims(1) = offset + rows; start(1) = offset; count(1) = rows
       else
@@ -325,16 +397,18 @@ contains
       call h5sclose_f(filespace, hdferr)
    end subroutine append
 
-   !> An extendable, chunked dataset of rows of `width` doubles.
-   subroutine create_series(self, path, units, width, dset)
+   !> An extendable, chunked dataset of rows of `width` doubles (1-D for width 1 unless `matrix`).
+   subroutine create_series(self, path, units, width, dset, matrix)
       class(hdf5_recorder), intent(inout) :: self
       character(len=*), intent(in) :: path, units
       integer, intent(in) :: width
       integer(hid_t), intent(out) :: dset
+      logical, intent(in), optional :: matrix
       integer(hid_t) :: space, plist
       integer(hsize_t) :: dims(2), maxdims(2), chunk(2)
       integer :: hdferr, rank
       rank = merge(1, 2, width == 1)
+      if (present(matrix)) rank = merge(2, rank, matrix)
       if (rank == 1) then
          dims(1) = 0; maxdims(1) = H5S_UNLIMITED_F; chunk(1) = buffer_rows
       else

@@ -77,12 +77,17 @@ FORMAT = 1
 DEFAULT_MAX_POINTS = 10_000
 #: [sweep] max_points cannot go beyond this.
 HARD_MAX_POINTS = 10_000_000
-#: Keys a sweep may set: every namelist key but the output file, which the sweep names.
-SCENE_KEYS: tuple[str, ...] = tuple(key for keys in GROUPS.values() for key in keys if key != "file")
+#: Keys a sweep may set: every namelist key but the output file, which the sweep names, and the
+#: positions of stops along the span (lists).
+SCENE_KEYS: tuple[str, ...] = tuple(key for keys in GROUPS.values() for key in keys
+                                    if key not in ("file", "nodes", "x"))
 _INT_KEYS = {f.name for f in dataclasses.fields(Scene) if f.type in ("int", int)}
 _KIND = {f.name: {"float": "real", "int": "integer", "bool": "boolean"}.get(str(f.type), "text")
          for f in dataclasses.fields(Scene)}
 _KIND.update({key: "real" for key in ("stiffness", "youngs_modulus", "density", "outer_diameter", "wall_thickness")})
+# Stops along the span (issue 8): the Scene holds lower and upper as tuples then; a sweep sets one
+# value, for every stop. Their positions (nodes, x) are lists: give them in the base namelist.
+_KIND.update({"lower": "real", "upper": "real"})
 
 _TABLES = ("sweep", "scene", "axes", "periods", "reductions")
 _SWEEP_KEYS = ("base", "mode", "zip", "max_points", "timeout", "description")
