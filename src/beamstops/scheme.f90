@@ -270,9 +270,8 @@ contains
       integer(ik), intent(in) :: last
       integer(ik) :: step, next_record, next_snapshot
       integer :: tip
-      real(wp) :: sigma_next, weight, c, tip_value, trial, r_step, r_prev, gd, d_tip_prev, u_tip_prev, u_old_su, dmd
+      real(wp) :: sigma_next, weight, r_prev, d_tip_prev, u_tip_prev, u_old_su, dmd
       real(wp) :: row(n_columns)
-      logical :: contact
 
       tip = model%tip
       call first_events(scene, state%step, next_record, next_snapshot)
@@ -282,15 +281,7 @@ contains
          state%rhs = model%dt2*(weight*model%load - state%su)
          state%rhs(tip) = state%rhs(tip) + spring_term(scene, model, state)
          call cholesky_solve(model%factor, state%rhs)
-         d_tip_prev = state%d(tip)
-         u_tip_prev = state%u(tip)
-         trial = u_tip_prev + (d_tip_prev + state%rhs(tip))
-         call contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
-         call update(state%rhs, c, model%z, state%d, state%u)
-         gd = dot_product(model%load, state%d)
-         r_prev = state%reaction
-         call close_step(scene, model, state, contact, tip_value, gd, weight, r_step, d_tip_prev, u_tip_prev, &
-            & sigma_next)
+         call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
          if (step == next_record) u_old_su = dot_product(state%u, state%su) - dot_product(state%d, state%su)
          call band_matvec(model%stiffness, state%u, state%su)
          if (step == next_record) then
@@ -323,9 +314,9 @@ contains
       integer(ik), intent(in) :: last
       integer(ik) :: step, next_record, next_snapshot
       integer :: tip
-      real(wp) :: sigma_next, weight, c, tip_value, trial, r_step, gd, d_tip_prev, u_tip_prev
+      real(wp) :: sigma_next, weight, d_tip_prev, u_tip_prev
       real(wp) :: usu, dsu, u_old_su, dmd, r_prev, row(n_columns)
-      logical :: contact, pending
+      logical :: pending
       type(load_rotation) :: loads
 
       tip = model%tip
@@ -350,15 +341,7 @@ contains
          end if
          u_old_su = usu
          call back_substitution(state%solver, state%rhs)
-         d_tip_prev = state%d(tip)
-         u_tip_prev = state%u(tip)
-         trial = u_tip_prev + (d_tip_prev + state%rhs(tip))
-         call contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
-         call update(state%rhs, c, model%z, state%d, state%u)
-         gd = dot(model%load, state%d)
-         r_prev = state%reaction
-         call close_step(scene, model, state, contact, tip_value, gd, weight, r_step, d_tip_prev, u_tip_prev, &
-            & sigma_next)
+         call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
          if (step == next_record) then
             next_record = next_record + scene%record_every
             call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_prev, row)
@@ -632,6 +615,27 @@ contains
          contact = .false.
       end select
    end subroutine contact_law
+
+   !> The rest of a step once state%rhs holds A^{-1} rhs: the contact law at the tip, the
+   !> update d^n = d^{n-1} + A^{-1} rhs + c z, u^{n+1} = u^n + d^n, and close_step. Returns
+   !> u^n_tip, d^{n-1}_tip and the reaction r_{n-1} recorded with u^n.
+   subroutine tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      real(wp), intent(in) :: weight, sigma_next
+      real(wp), intent(out) :: u_tip_prev, d_tip_prev, r_prev
+      real(wp) :: trial, c, tip_value, r_step
+      logical :: contact
+      d_tip_prev = state%d(model%tip)
+      u_tip_prev = state%u(model%tip)
+      trial = u_tip_prev + (d_tip_prev + state%rhs(model%tip))
+      call contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
+      call update(state%rhs, c, model%z, state%d, state%u)
+      r_prev = state%reaction
+      call close_step(scene, model, state, contact, tip_value, dot(model%load, state%d), weight, r_step, &
+         & d_tip_prev, u_tip_prev, sigma_next)
+   end subroutine tip_step
 
    !> After the update: the exact tip value (Signorini), the violation of the stops, impacts,
    !> the work of the load and the energy taken by the stops, the load averages moved on.
