@@ -91,12 +91,7 @@ contains
             b = b*inv_d2
             return
          end if
-         xa = b(1)
-         xb = b(2) - off(3, 2)*xa
-         xc = b(3) - off(2, 3)*xa - off(3, 3)*xb
-         b(1) = xa*inv_d2(1)
-         b(2) = xb*inv_d2(2)
-         b(3) = xc*inv_d2(3)
+         call first_rows(off, inv_d2, b, xa, xb, xc)
          do j = kd + 1, n - 2, 3
             xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
             b(j) = xa*inv_d2(j)
@@ -105,13 +100,7 @@ contains
             xc = row(b(j + 2), off(1, j + 2), off(2, j + 2), off(3, j + 2), xc, xa, xb)
             b(j + 2) = xc*inv_d2(j + 2)
          end do
-         ! The last rows (fewer than three): xa, xb, xc hold w_{j-3}, w_{j-2}, w_{j-1}.
-         if (j <= n) then
-            xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
-            b(j) = xa*inv_d2(j)
-         end if
-         if (j + 1 <= n) b(j + 1) = row(b(j + 1), off(1, j + 1), off(2, j + 1), off(3, j + 1), xb, xc, xa) &
-            & *inv_d2(j + 1)
+         call last_rows(off, inv_d2, j, n, b, xa, xb, xc)
       end associate
    end subroutine forward_substitution
 
@@ -148,12 +137,7 @@ contains
             end do
             return
          end if
-         xa = b(1)
-         xb = b(2) - off(3, 2)*xa
-         xc = b(3) - off(2, 3)*xa - off(3, 3)*xb
-         b(1) = xa*inv_d2(1)
-         b(2) = xb*inv_d2(2)
-         b(3) = xc*inv_d2(3)
+         call first_rows(off, inv_d2, b, xa, xb, xc)
          usu = u(1)*su(1) + u(2)*su(2) + u(3)*su(3)
          dsu = d(1)*su(1) + d(2)*su(2) + d(3)*su(3)
          dmd = d(1)*m(1, 0)*d(1) + d(2)*(m(2, 0)*d(2) + 2*m(2, 1)*d(1)) &
@@ -185,12 +169,7 @@ contains
             db = d2
             dc = d3
          end do
-         if (j <= n) then
-            xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
-            b(j) = xa*inv_d2(j)
-         end if
-         if (j + 1 <= n) b(j + 1) = row(b(j + 1), off(1, j + 1), off(2, j + 1), off(3, j + 1), xb, xc, xa) &
-            & *inv_d2(j + 1)
+         call last_rows(off, inv_d2, j, n, b, xa, xb, xc)
          do i = j, n
             usu = usu + u(i)*su(i)
             dsu = dsu + d(i)*su(i)
@@ -198,6 +177,35 @@ contains
          end do
       end associate
    end subroutine forward_substitution_energy
+
+   !> The first three rows of the forward substitution (n >= 3): b(1:3) replaced by
+   !> D^{-2} w(1:3), and w(1:3) returned in xa, xb, xc for the rows that follow.
+   pure subroutine first_rows(off, inv_d2, b, xa, xb, xc)
+      real(wp), intent(in) :: off(:, :), inv_d2(:)
+      real(wp), intent(inout) :: b(:)
+      real(wp), intent(out) :: xa, xb, xc
+      xa = b(1)
+      xb = b(2) - off(3, 2)*xa
+      xc = b(3) - off(2, 3)*xa - off(3, 3)*xb
+      b(1) = xa*inv_d2(1)
+      b(2) = xb*inv_d2(2)
+      b(3) = xc*inv_d2(3)
+   end subroutine first_rows
+
+   !> The rows j and j+1 (those of them <= n) left after the forward substitution's loop by
+   !> three; xa, xb, xc hold w_{j-3}, w_{j-2}, w_{j-1}.
+   pure subroutine last_rows(off, inv_d2, j, n, b, xa, xb, xc)
+      real(wp), intent(in) :: off(:, :), inv_d2(:)
+      integer, intent(in) :: j, n
+      real(wp), intent(inout) :: b(:)
+      real(wp), intent(inout) :: xa, xb, xc
+      if (j <= n) then
+         xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
+         b(j) = xa*inv_d2(j)
+      end if
+      if (j + 1 <= n) b(j + 1) = row(b(j + 1), off(1, j + 1), off(2, j + 1), off(3, j + 1), xb, xc, xa) &
+         & *inv_d2(j + 1)
+   end subroutine last_rows
 
    !> Back substitution (I + N) x = b in place (b from forward_substitution):
    !> x_i = b_i - N(i,i+3) x_{i+3} - N(i,i+2) x_{i+2} - N(i,i+1) x_{i+1}.
