@@ -91,13 +91,8 @@ contains
       integer :: hdferr, i
       integer(hid_t) :: group
       logical :: ok
-      self%path = path
-      self%scene = scene
-      self%nodes = size(model%x)
-      allocate (self%buffer(buffer_rows, n_columns))
+      call prepare(self, path, scene, model)
       call remove_file(checkpoint_path(path))
-      call h5open_f(hdferr)
-      call h5eset_auto_f(0, hdferr)
       call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%file, hdferr)
       if (hdferr /= 0) then
          call fatal_error(error, path//': cannot create the HDF5 file')
@@ -115,7 +110,6 @@ contains
          call create_series(self, '/snapshots/t', 's', 1, self%snap_t)
          call create_series(self, '/snapshots/u', 'm', self%nodes, self%snap_u)
       end if
-      call allocate_snapshot_buffer(self)
       call allocate_stops_buffer(self)
       call write_vector(self%file, '/snapshots/x', model%x, ok)
       if (.not. ok) call fail(self, 'cannot write dataset /snapshots/x')
@@ -275,12 +269,7 @@ contains
       !> Set when the file cannot be opened or lacks a series.
       type(error_type), allocatable, intent(out) :: error
       integer :: hdferr, i
-      self%path = path
-      self%scene = scene
-      self%nodes = size(model%x)
-      allocate (self%buffer(buffer_rows, n_columns))
-      call h5open_f(hdferr)
-      call h5eset_auto_f(0, hdferr)
+      call prepare(self, path, scene, model)
       call h5fopen_f(path, H5F_ACC_RDWR_F, self%file, hdferr)
       if (hdferr /= 0) then
          self%failed = .true.
@@ -294,7 +283,6 @@ contains
          call reopen_series('/snapshots/t', self%snap_t, [snapshots])
          call reopen_series('/snapshots/u', self%snap_u, [int(self%nodes, ik), snapshots])
       end if
-      call allocate_snapshot_buffer(self)
       call allocate_stops_buffer(self)
       if (self%stops > 0) then
          call reopen_series('/stops/u', self%stops_u, [int(self%stops, ik), records])
@@ -334,12 +322,25 @@ contains
       if (allocated(error)) call fail(self, error%message)
    end subroutine checkpoint
 
-   subroutine allocate_snapshot_buffer(self)
+   !> What opening and reopening share: the run's names and sizes, the buffers, the HDF5
+   !> library (its own error printing off: failures become messages).
+   subroutine prepare(self, path, scene, model)
       class(hdf5_recorder), intent(inout) :: self
-      if (self%scene%snapshot_every == 0) return
-      self%snapshot_rows = max(1, min(buffer_rows, 2**20/self%nodes))
-      allocate (self%snap_t_buffer(self%snapshot_rows), self%snap_u_buffer(self%nodes, self%snapshot_rows))
-   end subroutine allocate_snapshot_buffer
+      character(len=*), intent(in) :: path
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      integer :: hdferr
+      self%path = path
+      self%scene = scene
+      self%nodes = size(model%x)
+      allocate (self%buffer(buffer_rows, n_columns))
+      if (scene%snapshot_every > 0) then
+         self%snapshot_rows = max(1, min(buffer_rows, 2**20/self%nodes))
+         allocate (self%snap_t_buffer(self%snapshot_rows), self%snap_u_buffer(self%nodes, self%snapshot_rows))
+      end if
+      call h5open_f(hdferr)
+      call h5eset_auto_f(0, hdferr)
+   end subroutine prepare
 
    !> Write the buffered records and snapshots.
    subroutine write_buffer(self)
