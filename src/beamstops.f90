@@ -5,8 +5,8 @@ module beamstops
    use beamstops_error, only: error_type, fatal_error
    use beamstops_scene, only: scene_type, validate_scene, steps_of, record_count, snapshot_count, output_bytes, &
       & law_none, law_signorini, law_compliance, &
-      & law_name, law_code, stop_count, max_stops
-   use beamstops_namelist, only: read_scene
+      & law_name, law_code, stop_count, max_stops, scene_table, canonical_text
+   use beamstops_namelist, only: read_scene, scene_from_text
    use beamstops_model, only: model_type, build_model, check_stability
    use beamstops_scheme, only: state_type, start_state, run_scheme
    use beamstops_recorder, only: recorder_type, n_columns
@@ -21,6 +21,7 @@ module beamstops
    public :: wp, ik, error_type, fatal_error
    public :: scene_type, validate_scene, steps_of, law_none, law_signorini, law_compliance, law_name, law_code
    public :: stop_count, max_stops
+   public :: scene_table, canonical_text, scene_from_text
    public :: read_scene, model_type, build_model, check_stability
    public :: state_type, start_state, run_scheme
    public :: recorder_type, n_columns, array_recorder, hdf5_recorder

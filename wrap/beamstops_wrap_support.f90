@@ -1,95 +1,26 @@
-!> Support of the f2py layer (wrap/beamstops_wrap.f90), which f2py parses alone:
-!> a scene from flat scalars, and error objects turned into (status, message).
-!> f2py never reads this file; it is compiled into the extension with the wrapper.
+!> Helpers of the f2py routines (beamstops_wrap.f90): a scene from the text Python wrote,
+!> and errors as a status and a message. f2py never sees this module.
 module beamstops_wrap_support
-   use beamstops, only: wp, ik, error_type, fatal_error, scene_type
+   use beamstops, only: error_type, scene_type, scene_from_text
    implicit none
    private
-   public :: make_scene, report, law_as_int
+   public :: scene_of, report
 
 contains
 
-   !> Fill a scene from the flat scalars the wrapper receives (integers as 64-bit,
-   !> logicals as integers 0/1); the scene is not validated here.
-   subroutine make_scene(length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, &
-      & elements, dt, t_end, beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, &
-      & max_output_gb, stop_nodes, stop_lower, stop_upper, source, scene, error)
-      !> &beam, &support, &stops values (SI units, see scene_type).
-      real(wp), intent(in) :: length, k2, mass_per_length, amplitude, omega, lower, upper, stiffness_per_mass
-      !> &time values (s, s, -) and &output max_output_gb (1e9 bytes).
-      real(wp), intent(in) :: dt, t_end, beta, max_output_gb
-      !> Contact-law code (law_none, law_signorini, law_compliance).
-      integer(ik), intent(in) :: law
-      !> &mesh elements, &output record_every and snapshot_every.
-      integer(ik), intent(in) :: elements, record_every, snapshot_every
-      !> Flags: nonzero for .true.
-      integer(ik), intent(in) :: centered_load, taylor_start, allow_unstable
-      !> Stops along the span: nodes (1..J) and their lower and upper stops (m); none: the tip form.
-      integer(ik), intent(in) :: stop_nodes(:)
-      !> Lower stops (m) of stop_nodes.
-      real(wp), intent(in) :: stop_lower(:)
-      !> Upper stops (m) of stop_nodes.
-      real(wp), intent(in) :: stop_upper(:)
-      !> Where the scene came from, for messages.
+   !> The scene of namelist `text` (Scene.to_namelist's text), read, derived and validated by the
+   !> engine's one reader; `source` starts the messages.
+   subroutine scene_of(text, source, scene, error)
+      !> Namelist text.
+      character(len=*), intent(in) :: text
+      !> Where the text came from ('scene', a file name).
       character(len=*), intent(in) :: source
-      !> Scene filled.
+      !> Scene read.
       type(scene_type), intent(out) :: scene
-      !> Set when an integer does not fit the scene's default integers.
+      !> Set on any bad input.
       type(error_type), allocatable, intent(out) :: error
-      scene%length = length
-      scene%k2 = k2
-      scene%mass_per_length = mass_per_length
-      scene%amplitude = amplitude
-      scene%omega = omega
-      scene%lower = lower
-      scene%upper = upper
-      scene%law = law_as_int(law)
-      scene%stiffness_per_mass = stiffness_per_mass
-      call fit('mesh', 'elements', elements, scene%elements); if (allocated(error)) return
-      scene%dt = dt
-      scene%t_end = t_end
-      scene%beta = beta
-      scene%centered_load = centered_load /= 0
-      scene%taylor_start = taylor_start /= 0
-      scene%allow_unstable = allow_unstable /= 0
-      call fit('output', 'record_every', record_every, scene%record_every); if (allocated(error)) return
-      call fit('output', 'snapshot_every', snapshot_every, scene%snapshot_every); if (allocated(error)) return
-      scene%max_output_gb = max_output_gb
-      if (size(stop_nodes) > 0) then
-         if (any(abs(stop_nodes) > huge(1))) then
-            call fatal_error(error, source//': &stops nodes is out of range; allowed: 1 <= nodes <= elements')
-            return
-         end if
-         scene%stop_nodes = int(stop_nodes)
-         scene%stop_lower = stop_lower
-         scene%stop_upper = stop_upper
-      end if
-
-   contains
-
-      subroutine fit(group, key, wide, narrow)
-         character(len=*), intent(in) :: group, key
-         integer(ik), intent(in) :: wide
-         integer, intent(out) :: narrow
-         character(len=24) :: text
-         if (abs(wide) <= huge(narrow)) then
-            narrow = int(wide)
-            return
-         end if
-         narrow = 0
-         write (text, '(i0)') wide
-         call fatal_error(error, source//': &'//group//' '//key//' = '//trim(text)// &
-            & ' is out of range; allowed: |'//key//'| < 2**31')
-      end subroutine fit
-   end subroutine make_scene
-
-   !> A law code as a default integer; codes that do not fit become -1 (unknown).
-   pure integer function law_as_int(law)
-      !> Law code.
-      integer(ik), intent(in) :: law
-      law_as_int = -1
-      if (abs(law) <= huge(law_as_int)) law_as_int = int(law)
-   end function law_as_int
+      call scene_from_text(text, trim(source), scene, error)
+   end subroutine scene_of
 
    !> Turn an error object into status (0: none, 1: error) and a fixed-length message.
    subroutine report(error, status, message)

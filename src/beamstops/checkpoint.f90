@@ -6,7 +6,8 @@ module beamstops_checkpoint
    use hdf5
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
-   use beamstops_scene, only: scene_type, stop_count
+   use beamstops_scene, only: scene_type, scene_table, stop_count
+   use beamstops_attributes, only: attribute_list, kind_real, kind_text
    use beamstops_model, only: model_type
    use beamstops_state, only: state_type
    use beamstops_recorder_hdf5_vector, only: write_vector, read_vector
@@ -39,18 +40,29 @@ contains
       path = output//'.checkpoint'
    end function checkpoint_path
 
-   !> Every value of a scene that shapes the records, as numbers (a restart must match them);
-   !> the stops along the span (nodes, lower, upper) at the end.
-   pure function scene_signature(scene) result(values)
+   !> Every value of a scene that a restart must find unchanged, as numbers: the items of the
+   !> scene table marked `signature` (texts as their character codes), in the table's order.
+   function scene_signature(scene) result(values)
       !> Scene.
       type(scene_type), intent(in) :: scene
       real(wp), allocatable :: values(:)
-      values = [scene%length, scene%k2, scene%mass_per_length, scene%amplitude, scene%omega, scene%lower, &
-         & scene%upper, real(scene%law, wp), scene%stiffness_per_mass, real(scene%elements, wp), scene%dt, &
-         & scene%t_end, scene%beta, merge(1.0_wp, 0.0_wp, scene%centered_load), &
-         & merge(1.0_wp, 0.0_wp, scene%taylor_start), real(scene%record_every, wp), &
-         & real(scene%snapshot_every, wp), real(scene%checkpoint_every, wp)]
-      if (stop_count(scene) > 0) values = [values, real(scene%stop_nodes, wp), scene%stop_lower, scene%stop_upper]
+      type(attribute_list) :: table
+      integer :: i, j
+      table = scene_table(scene)
+      allocate (values(0))
+      do i = 1, table%count
+         associate (item => table%items(i))
+            if (.not. item%signature) cycle
+            select case (item%kind)
+            case (kind_real)
+               values = [values, item%reals]
+            case (kind_text)
+               values = [values, [(real(iachar(item%text(j:j)), wp), j=1, len(item%text))]]
+            case default
+               values = [values, real(item%ints, wp)]
+            end select
+         end associate
+      end do
    end function scene_signature
 
    !> Remove a file if it exists.

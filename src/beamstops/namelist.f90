@@ -1,14 +1,17 @@
-!> Scene from a namelist file: groups &beam, &support, &stops, &mesh, &time, &output.
-!> Unknown or repeated groups, unknown keys, malformed and out-of-range values
-!> all end in one message naming the file, the group and the key.
+!> Scene from namelist text: groups &beam, &support, &stops, &mesh, &time, &output.
+!> The one reader of every input: the program reads a file into text (read_scene), Python
+!> hands the text it wrote (scene_from_text). Unknown or repeated groups, text outside any
+!> group, unknown keys, malformed and out-of-range values all end in one message naming the
+!> source, the group and the key.
 module beamstops_namelist
    use, intrinsic :: iso_fortran_env, only: iostat_end
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
-   use beamstops_scene, only: scene_type, validate_scene, tube_beam, law_code, law_compliance, fmt_real, max_stops
+   use beamstops_scene, only: scene_type, validate_scene, tube_beam, law_code, law_compliance, max_stops
+   use beamstops_strings, only: fmt_real, itoa, lower, squeeze
    implicit none
    private
-   public :: read_scene, group_names
+   public :: read_scene, scene_from_text, read_text_file, default_output, group_names, group_keys
 
    !> Groups a scene file may hold, each at most once.
    character(len=*), parameter :: group_names(6) = ['beam   ', 'support', 'stops  ', 'mesh   ', 'time   ', 'output ']
@@ -32,6 +35,69 @@ contains
       type(scene_type), intent(out) :: scene
       !> Set on any bad input.
       type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: text
+      call read_text_file(path, text, error)
+      if (allocated(error)) return
+      call scene_from_text(text, path, scene, error, default_output(path))
+   end subroutine read_scene
+
+   !> The whole of a text file (lines separated by new_line('a')).
+   subroutine read_text_file(path, text, error)
+      !> File.
+      character(len=*), intent(in) :: path
+      !> Its content.
+      character(len=:), allocatable, intent(out) :: text
+      !> Set when the file cannot be read.
+      type(error_type), allocatable, intent(out) :: error
+      integer :: unit, stat, size_bytes
+      character(len=512) :: msg
+      logical :: exists, is_dir
+      text = ''
+      inquire (file=path, exist=exists)
+      if (.not. exists) then
+         call fatal_error(error, path//': cannot open: no such file')
+         return
+      end if
+      inquire (file=path//'/.', exist=is_dir)
+      if (is_dir) then
+         call fatal_error(error, path//': cannot open: a directory, not a namelist file')
+         return
+      end if
+      open (newunit=unit, file=path, status='old', action='read', access='stream', form='unformatted', &
+         & iostat=stat, iomsg=msg)
+      if (stat /= 0) then
+         call fatal_error(error, path//': cannot open: '//trim(msg))
+         return
+      end if
+      inquire (unit=unit, size=size_bytes)
+      if (size_bytes > 64*1024*1024) then
+         call fatal_error(error, path//': '//itoa(size_bytes)//' bytes; allowed: a namelist file of at most 64 MB')
+         close (unit)
+         return
+      end if
+      if (size_bytes > 0) then
+         deallocate (text)
+         allocate (character(len=size_bytes) :: text)
+         read (unit, iostat=stat, iomsg=msg) text
+         if (stat /= 0) call fatal_error(error, path//': cannot read: '//trim(msg))
+      end if
+      close (unit)
+   end subroutine read_text_file
+
+   !> Read, derive and validate a scene from namelist text; `source` (a file name, or 'scene'
+   !> for Python's text) starts every message. Missing groups and keys keep the paper's values;
+   !> the output file is `default_file` when the text names none (unset when not given either).
+   subroutine scene_from_text(text, source, scene, error, default_file)
+      !> Namelist text.
+      character(len=*), intent(in) :: text
+      !> Where the text came from, for messages.
+      character(len=*), intent(in) :: source
+      !> Scene read.
+      type(scene_type), intent(out) :: scene
+      !> Set on any bad input.
+      type(error_type), allocatable, intent(out) :: error
+      !> Output file when the text names none.
+      character(len=*), intent(in), optional :: default_file
       ! &beam
       real(wp) :: length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness
       ! &support
@@ -58,12 +124,13 @@ contains
       namelist /time/ dt, t_end, beta, load_rule, start, allow_unstable
       namelist /output/ file, record_every, snapshot_every, checkpoint_every, max_output_gb
       character(len=text_len) :: groups_text(size(group_names))
-      logical :: present(size(group_names))
+      logical :: has_group(size(group_names))
       character(len=512) :: msg
-      character(len=:), allocatable :: text
+      character(len=:), allocatable :: cleaned
+      character(len=*), parameter :: no_file = achar(1)
       integer :: stat, g
 
-      call scan_groups(path, present, groups_text, text, error)
+      call scan_groups(text, source, has_group, groups_text, cleaned, error)
       if (allocated(error)) return
 
       length = scene%length; k2 = unset; mass_per_length = unset
@@ -74,47 +141,47 @@ contains
       elements = scene%elements
       dt = scene%dt; t_end = scene%t_end; beta = scene%beta; load_rule = 'centered'; start = 'taylor'
       allow_unstable = .false.
-      file = default_output(path); record_every = scene%record_every; snapshot_every = scene%snapshot_every
+      file = no_file; record_every = scene%record_every; snapshot_every = scene%snapshot_every
       max_output_gb = scene%max_output_gb
       checkpoint_every = scene%checkpoint_every
 
       do g = 1, size(group_names)
-         if (.not. present(g)) cycle
+         if (.not. has_group(g)) cycle
          select case (g)
-         case (1); read (text, nml=beam, iostat=stat, iomsg=msg)
-         case (2); read (text, nml=support, iostat=stat, iomsg=msg)
-         case (3); read (text, nml=stops, iostat=stat, iomsg=msg)
-         case (4); read (text, nml=mesh, iostat=stat, iomsg=msg)
-         case (5); read (text, nml=time, iostat=stat, iomsg=msg)
-         case (6); read (text, nml=output, iostat=stat, iomsg=msg)
+         case (1); read (cleaned, nml=beam, iostat=stat, iomsg=msg)
+         case (2); read (cleaned, nml=support, iostat=stat, iomsg=msg)
+         case (3); read (cleaned, nml=stops, iostat=stat, iomsg=msg)
+         case (4); read (cleaned, nml=mesh, iostat=stat, iomsg=msg)
+         case (5); read (cleaned, nml=time, iostat=stat, iomsg=msg)
+         case (6); read (cleaned, nml=output, iostat=stat, iomsg=msg)
          end select
          if (stat /= 0) then
-            call fatal_error(error, path//': &'//trim(group_names(g))//': '//trim(explain(stat, msg, groups_text(g)))// &
+            call fatal_error(error, source//': &'//trim(group_names(g))//': '//trim(explain(stat, msg, groups_text(g)))// &
                & ' in `'//trim(groups_text(g))//'`; keys of &'//trim(group_names(g))//': '//trim(group_keys(g)))
             return
          end if
       end do
 
-      call derive_beam(path, length, k2, mass_per_length, youngs_modulus, density, outer_diameter, &
+      call derive_beam(source, length, k2, mass_per_length, youngs_modulus, density, outer_diameter, &
          & wall_thickness, scene, error)
       if (allocated(error)) return
       scene%amplitude = amplitude
       scene%omega = omega
       scene%law = law_code(law)
       if (scene%law < 0) then
-         call fatal_error(error, path//": &stops law = '"//trim(law)//"' is out of range; allowed: "// &
+         call fatal_error(error, source//": &stops law = '"//trim(law)//"' is out of range; allowed: "// &
             & "'signorini', 'compliance' or 'none'")
          return
       end if
       if (scene%law == law_compliance) then
          if ((stiffness == unset) .eqv. (stiffness_per_mass == unset)) then
-            call fatal_error(error, path//": &stops law = 'compliance' needs exactly one of stiffness (N/m) "// &
+            call fatal_error(error, source//": &stops law = 'compliance' needs exactly one of stiffness (N/m) "// &
                & 'or stiffness_per_mass (1/s^2), both > 0')
             return
          end if
          if (stiffness /= unset) then
             if (.not. stiffness > 0) then
-               call fatal_error(error, path//': &stops stiffness = '//fmt_real(stiffness)// &
+               call fatal_error(error, source//': &stops stiffness = '//fmt_real(stiffness)// &
                   & ' is out of range; allowed: stiffness > 0 (N/m)')
                return
             end if
@@ -131,7 +198,7 @@ contains
       case ('centered'); scene%centered_load = .true.
       case ('paper'); scene%centered_load = .false.
       case default
-         call fatal_error(error, path//": &time load_rule = '"//trim(load_rule)//"' is out of range; "// &
+         call fatal_error(error, source//": &time load_rule = '"//trim(load_rule)//"' is out of range; "// &
             & "allowed: 'centered' or 'paper'")
          return
       end select
@@ -139,24 +206,27 @@ contains
       case ('taylor'); scene%taylor_start = .true.
       case ('euler'); scene%taylor_start = .false.
       case default
-         call fatal_error(error, path//": &time start = '"//trim(start)//"' is out of range; "// &
+         call fatal_error(error, source//": &time start = '"//trim(start)//"' is out of range; "// &
             & "allowed: 'taylor' or 'euler'")
          return
       end select
       scene%allow_unstable = allow_unstable
-      if (len_trim(file) == 0) then
-         call fatal_error(error, path//": &output file = '' is out of range; allowed: a file name")
+      if (file == no_file) then
+         if (present(default_file)) scene%output_file = default_file
+      else if (len_trim(file) == 0) then
+         call fatal_error(error, source//": &output file = '' is out of range; allowed: a file name")
          return
+      else
+         scene%output_file = trim(file)
       end if
-      scene%output_file = trim(file)
       scene%record_every = record_every
       scene%snapshot_every = snapshot_every
       scene%max_output_gb = max_output_gb
       scene%checkpoint_every = checkpoint_every
-      call stops_from_lists(path, lower, upper, nodes, x, scene, error)
+      call stops_from_lists(source, lower, upper, nodes, x, scene, error)
       if (allocated(error)) return
-      call validate_scene(scene, path, error)
-   end subroutine read_scene
+      call validate_scene(scene, source, error)
+   end subroutine scene_from_text
 
    !> The stops of &stops: without nodes or x, lower and upper (one value each) are the tip stops;
    !> with nodes (indices 1..J) or x (abscissae, each at a node to 1e-9 length), the stops along
@@ -315,44 +385,45 @@ contains
       call tube_beam(youngs_modulus, density, outer_diameter, wall_thickness, scene%k2, scene%mass_per_length)
    end subroutine derive_beam
 
-   !> Which groups the file holds (and their text, for messages); unknown or repeated groups are errors.
-   !> `cleaned` is the whole file without comments, its lines joined: gfortran reads namelists
-   !> from it whatever the file's last line ends with.
-   subroutine scan_groups(path, present, texts, cleaned, error)
-      character(len=*), intent(in) :: path
+   !> Which groups the text holds (and their text, for messages); unknown or repeated groups,
+   !> binary characters, text outside any group that is not a comment (a forgotten `&`) and a
+   !> text without any group are errors. `cleaned` is the whole text without comments, its lines
+   !> joined: gfortran reads namelists from it whatever the last line ends with.
+   subroutine scan_groups(text, source, present, texts, cleaned, error)
+      character(len=*), intent(in) :: text, source
       logical, intent(out) :: present(:)
       character(len=*), intent(out) :: texts(:)
       character(len=:), allocatable, intent(out) :: cleaned
       type(error_type), allocatable, intent(out) :: error
-      character(len=text_len) :: line
-      character(len=512) :: msg
-      character(len=:), allocatable :: name
-      integer :: unit, stat, i, j, g, current, line_no, used(size(present))
+      character(len=:), allocatable :: line, name
+      integer :: i, j, g, current, line_no, used(size(present)), first, last
       logical :: quoted
       character :: quote
       present = .false.
       texts = ''
       used = 0
       cleaned = ''
-      open (newunit=unit, file=path, status='old', action='read', iostat=stat, iomsg=msg)
-      if (stat /= 0) then
-         call fatal_error(error, path//': cannot open: '//trim(msg))
-         return
-      end if
       current = 0
       line_no = 0
-      do
-         read (unit, '(a)', iostat=stat) line
-         if (stat == iostat_end) exit
-         line_no = line_no + 1
-         if (stat /= 0) then
-            call fatal_error(error, path//': line '//itoa(line_no)//' cannot be read as text')
-            exit
+      first = 1
+      do while (first <= len(text))
+         last = index(text(first:), new_line('a'))
+         if (last == 0) then
+            last = len(text)
+            line = text(first:last)
+         else
+            last = first + last - 1
+            line = text(first:last - 1)
          end if
-         if (is_binary(line(1:len_trim(line)))) then
-            call fatal_error(error, path//': line '//itoa(line_no)//' holds binary characters; '// &
+         first = last + 1
+         line_no = line_no + 1
+         if (len(line) > 0) then
+            if (line(len(line):) == achar(13)) line = line(:len(line) - 1)
+         end if
+         if (is_binary(line)) then
+            call fatal_error(error, source//': line '//itoa(line_no)//' holds binary characters; '// &
                & 'allowed: a namelist text file')
-            exit
+            return
          end if
          quoted = .false.
          quote = ' '
@@ -361,6 +432,7 @@ contains
             if (quoted) then
                if (line(i:i) == quote) quoted = .false.
             else if (line(i:i) == '"' .or. line(i:i) == "'") then
+               if (current == 0) call outside(); if (allocated(error)) return
                quoted = .true.
                quote = line(i:i)
             else if (line(i:i) == '!') then
@@ -383,14 +455,14 @@ contains
                end if
                g = group_index(name)
                if (g == 0) then
-                  call fatal_error(error, path//': line '//itoa(line_no)//': unknown group &'//name// &
+                  call fatal_error(error, source//': line '//itoa(line_no)//': unknown group &'//name// &
                      & '; allowed groups: &beam, &support, &stops, &mesh, &time, &output')
-                  exit
+                  return
                end if
                if (present(g)) then
-                  call fatal_error(error, path//': line '//itoa(line_no)//': group &'//name// &
+                  call fatal_error(error, source//': line '//itoa(line_no)//': group &'//name// &
                      & ' appears twice; allowed: each group once')
-                  exit
+                  return
                end if
                present(g) = .true.
                current = g
@@ -399,17 +471,29 @@ contains
                call append_text(g, '&'//name)
                i = j
                cycle
+            else if (current == 0 .and. line(i:i) /= ' ' .and. line(i:i) /= achar(9)) then
+               call outside()
+               return
             end if
             if (current > 0) call append_text(current, line(i:i))
             i = i + 1
          end do
-         if (allocated(error)) exit
          if (i > len_trim(line)) cleaned = cleaned//trim(line)//' '
          if (current > 0) call append_text(current, ' ')
       end do
-      close (unit)
+      if (.not. any(present)) then
+         call fatal_error(error, source//': no namelist group; allowed: groups &beam, &support, &stops, '// &
+            & '&mesh, &time, &output (e.g. `&time dt = 1e-5 /`), each at most once, and comments after !')
+      end if
 
    contains
+
+      !> Text outside any group: a forgotten `&` or a stray word, quoted with its line.
+      subroutine outside()
+         call fatal_error(error, source//': line '//itoa(line_no)//': text outside any group: `'// &
+            & trim(adjustl(line(:min(len(line), 200))))//'`; allowed outside groups: blanks and comments '// &
+            & 'after ! (a group starts with &name, e.g. `&time dt = 1e-5 /`)')
+      end subroutine outside
 
       !> Append to a group's text (kept short for messages; runs of blanks folded).
       subroutine append_text(g, piece)
@@ -447,16 +531,6 @@ contains
       end if
    end function explain
 
-   !> A string without its blanks.
-   pure function squeeze(s) result(t)
-      character(len=*), intent(in) :: s
-      character(len=:), allocatable :: t
-      integer :: i
-      t = ''
-      do i = 1, len(s)
-         if (s(i:i) /= ' ') t = t//s(i:i)
-      end do
-   end function squeeze
 
    !> Index of a group name in group_names (0 when unknown).
    pure integer function group_index(name)
@@ -477,23 +551,9 @@ contains
       end do
    end function is_binary
 
-   pure function lower(s) result(t)
-      character(len=*), intent(in) :: s
-      character(len=len(s)) :: t
-      integer :: i
-      t = s
-      do i = 1, len(s)
-         if (s(i:i) >= 'A' .and. s(i:i) <= 'Z') t(i:i) = achar(iachar(s(i:i)) + 32)
-      end do
-   end function lower
 
-   pure function itoa(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function itoa
+
+
 
    !> Base name of the input with '.h5' in place of its extension.
    pure function default_output(path) result(file)

@@ -4,12 +4,14 @@ module beamstops_scene
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
+   use beamstops_strings, only: fmt_real, fmt_int
+   use beamstops_attributes, only: attribute_list, namelist_text
    implicit none
    private
    public :: scene_type, validate_scene, steps_of, record_count, snapshot_count, output_bytes
    public :: tube_section, tube_beam, fmt_real, fmt_int
    public :: law_none, law_signorini, law_compliance, law_name, law_code
-   public :: max_elements, max_stops, stop_count
+   public :: max_elements, max_stops, stop_count, scene_table, canonical_text
 
    !> Contact law codes.
    integer, parameter :: law_none = 0, law_signorini = 1, law_compliance = 2
@@ -179,64 +181,71 @@ contains
       end select
    end function law_code
 
-   !> Shortest text that reads back as the same real (e.g. 2e-05, 0.25, 1.501, 2.6035e+10).
-   function fmt_real(x, digits) result(s)
-      !> Value.
-      real(wp), intent(in) :: x
-      !> At most this many significant digits (default: as many as needed to read back x).
-      integer, intent(in), optional :: digits
-      character(len=:), allocatable :: s
-      character(len=40) :: buf, fmt
-      character(len=:), allocatable :: mantissa
-      real(wp) :: y
-      integer :: p, e, stat
-      if (.not. ieee_is_finite(x)) then
-         write (buf, '(g0)') x
-         s = trim(adjustl(buf))
-         return
-      end if
-      do p = 0, 16
-         write (fmt, '(a,i0,a)') '(es30.', p, 'e3)'
-         write (buf, fmt) x
-         read (buf, *, iostat=stat) y
-         if (stat == 0 .and. y == x) exit
-         if (present(digits)) then
-            if (p + 1 >= digits) exit
-         end if
-      end do
-      buf = adjustl(buf)
-      mantissa = buf(:index(buf, 'E') - 1)
-      read (buf(index(buf, 'E') + 1:), *) e
-      if (index(mantissa, '.') > 0) then
-         mantissa = mantissa(:verify(mantissa, '0', back=.true.))
-         if (mantissa(len(mantissa):) == '.') mantissa = mantissa(:len(mantissa) - 1)
-      end if
-      if (e >= -4 .and. e < 6) then
-         write (fmt, '(a,i0,a)') '(f0.', max(0, p - e), ')'
-         write (buf, fmt) x
-         s = trim(adjustl(buf))
-         if (index(s, '.') > 0) then
-            s = s(:verify(s, '0', back=.true.))
-            if (s(len(s):) == '.') s = s(:len(s) - 1)
-         end if
-         if (s(1:1) == '.') s = '0'//s
-         if (s(1:2) == '-.') s = '-0'//s(2:)
-         if (s == '' .or. s == '-') s = '0'
+   !> The one table of a scene's keys: every namelist key with its value (defaults filled in,
+   !> the material route resolved into k2 and mass_per_length, x into nodes, stiffness into
+   !> stiffness_per_mass), and whether each is a root attribute of the output and part of a
+   !> checkpoint's signature. The canonical text, the output's attributes, Python's scene and
+   !> the restart check all read it. A new scene key is one line here.
+   function scene_table(scene) result(list)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      type(attribute_list) :: list
+      integer :: m
+      m = stop_count(scene)
+      call list%add_real('beam', 'length', scene%length)
+      call list%add_real('beam', 'k2', scene%k2)
+      call list%add_real('beam', 'mass_per_length', scene%mass_per_length)
+      call list%add_real('support', 'amplitude', scene%amplitude)
+      call list%add_real('support', 'omega', scene%omega)
+      if (m == 0) then
+         call list%add_real('stops', 'lower', scene%lower)
+         call list%add_real('stops', 'upper', scene%upper)
       else
-         write (buf, '(sp,i3.2)') e
-         s = mantissa//'e'//trim(adjustl(buf))
+         call list%add_int('stops', 'nodes', 0_ik, values=int(scene%stop_nodes, ik), attribute=.false.)
+         call list%add_real('stops', 'lower', 0.0_wp, values=scene%stop_lower, attribute=.false.)
+         call list%add_real('stops', 'upper', 0.0_wp, values=scene%stop_upper, attribute=.false.)
+         call list%add_int('', 'stops', int(m, ik))
       end if
-   end function fmt_real
+      call list%add_text('stops', 'law', law_name(scene%law))
+      if (scene%law == law_compliance) call list%add_real('stops', 'stiffness_per_mass', scene%stiffness_per_mass)
+      call list%add_int('mesh', 'elements', int(scene%elements, ik))
+      call list%add_real('time', 'dt', scene%dt)
+      call list%add_real('time', 't_end', scene%t_end)
+      call list%add_real('time', 'beta', scene%beta)
+      call list%add_text('time', 'load_rule', trim(merge('centered', 'paper   ', scene%centered_load)))
+      call list%add_text('time', 'start', trim(merge('taylor', 'euler ', scene%taylor_start)))
+      call list%add_logical('time', 'allow_unstable', scene%allow_unstable, signature=.false.)
+      if (allocated(scene%output_file)) call list%add_text('output', 'file', scene%output_file, attribute=.false., &
+         & signature=.false.)
+      call list%add_int('output', 'record_every', int(scene%record_every, ik))
+      call list%add_int('output', 'snapshot_every', int(scene%snapshot_every, ik))
+      call list%add_int('output', 'checkpoint_every', scene%checkpoint_every, attribute=.false.)
+      call list%add_real('output', 'max_output_gb', scene%max_output_gb, signature=.false.)
+   end function scene_table
 
-   !> Text of an integer.
-   pure function fmt_int(i) result(s)
-      !> Value.
-      integer(ik), intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=24) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function fmt_int
+   !> The scene as namelist text: every key, defaults filled in, values that read back exactly
+   !> (reading it gives the same scene); the output file only when `with_file` (default .true.).
+   function canonical_text(scene, with_file) result(text)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      !> Include &output file.
+      logical, intent(in), optional :: with_file
+      character(len=:), allocatable :: text
+      type(attribute_list) :: list
+      logical, allocatable :: keep(:)
+      integer :: i
+      list = scene_table(scene)
+      allocate (keep(list%count))
+      keep = .true.
+      if (present(with_file)) then
+         if (.not. with_file) then
+            do i = 1, list%count
+               if (list%items(i)%name == 'file') keep(i) = .false.
+            end do
+         end if
+      end if
+      text = namelist_text(list, keep)
+   end function canonical_text
 
    !> Check every value of a scene; `source` (a file name or 'scene') starts the message.
    subroutine validate_scene(scene, source, error)

@@ -86,8 +86,8 @@ BAD = [
     ("lower stop", dict(lower=0.05), "scene: &stops lower"),
     ("upper stop", dict(upper=-0.05), "scene: &stops upper"),
     ("no elements", dict(elements=0), "scene: &mesh elements = 0"),
-    ("huge elements", dict(elements=2**40), "scene: &mesh elements = 1099511627776"),
-    ("huger elements", dict(elements=2**80), "scene: &mesh elements"),
+    ("huge elements", dict(elements=2**40), "scene: &mesh: malformed value (Integer overflow"),
+    ("huger elements", dict(elements=2**80), "scene: &mesh: malformed value"),
     ("compliance without stiffness", dict(law="compliance"), "scene: &stops stiffness_per_mass = 0"),
     ("record_every", dict(record_every=0), "scene: &output record_every = 0"),
     ("snapshot_every", dict(snapshot_every=-1), "scene: &output snapshot_every = -1"),
@@ -99,11 +99,12 @@ BAD = [
 
 @pytest.mark.parametrize(("label", "changes", "needle"), BAD, ids=[b[0] for b in BAD])
 def test_bad_scenes_raise_value_error_with_the_engines_message(label: str, changes: dict, needle: str) -> None:
-    scene = SHORT.replace(**changes)
+    # The engine's one reader refuses a bad value as the scene is made; a time step beyond the
+    # stability limit is refused when the run is prepared.
     with pytest.raises(ValueError) as caught:
-        beamstops.run(scene)
+        beamstops.run(SHORT.replace(**changes))
     assert needle in str(caught.value)
-    assert "allowed" in str(caught.value)
+    assert "allowed" in str(caught.value) or "keys of &" in str(caught.value)
 
 
 def test_bad_scenes_never_crash_the_interpreter() -> None:

@@ -1,8 +1,8 @@
 """The engine, through the f2py extension ``beamstops._engine``.
 
-Every number here comes from the Fortran engine: the scene is passed as flat scalars
-to plain wrapper subroutines (wrap/beamstops_wrap.f90), which validate it with the
-engine's ``validate_scene``, build the model and run the same time loop as the
+Every routine of the extension (wrap/beamstops_wrap.f90) takes a scene as namelist text —
+the exact text of :meth:`Scene.to_text` — and a source for its messages; the engine's one
+reader reads and validates it, builds the model and runs the same time loop as the
 ``beamstops`` program, recording into memory instead of an HDF5 file. An engine error
 (status /= 0) becomes a :class:`ValueError` carrying the engine's message.
 """
@@ -10,21 +10,19 @@ engine's ``validate_scene``, build the model and run the same time loop as the
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass
-from typing import Any, Callable, Optional
+from typing import TYPE_CHECKING, Any, Callable, Optional
 
 import numpy as np
 
 from . import _engine
 from .result import IncompleteRunError, Result
-from .scene import LAWS, PathLike, Scene
 
-__all__ = ["run", "stability", "validate", "sizes", "read_namelist", "tube", "version", "Stability"]
+if TYPE_CHECKING:
+    from .scene import PathLike, Scene
 
-_LAW_NAMES = {code: name for name, code in LAWS.items()}
-_RUN_STATUS = {0: "complete", 1: "diverged", 2: "failed"}
-# A flag for integers beyond what the wrapper's integer(8) arguments hold.
-_INT64 = 2**63
+__all__ = ["run", "stability", "sizes", "canonical", "validate", "read_file", "read_namelist", "keys", "version", "Stability"]
 
 
 def _text(value: Any) -> str:
@@ -35,35 +33,17 @@ def _text(value: Any) -> str:
     return str(value).rstrip(" \x00")
 
 
-def _flat(scene: Scene) -> tuple[Any, ...]:
-    """The scene as the wrapper's flat arguments (see wrap/beamstops_wrap.f90)."""
-    if not isinstance(scene, Scene):
-        raise TypeError(f"expected a beamstops.Scene, not {type(scene).__name__}")
-    for key in ("elements", "record_every", "snapshot_every"):
-        value = getattr(scene, key)
-        if not -_INT64 < value < _INT64:
-            group = "mesh" if key == "elements" else "output"
-            raise ValueError(f"scene: &{group} {key} = {value} is out of range; allowed: |{key}| < 2**31")
-    if any(not -_INT64 < node < _INT64 for node in scene.nodes):
-        raise ValueError("scene: &stops nodes is out of range; allowed: 1 <= nodes <= elements")
-    if scene.nodes:
-        tip_lower, tip_upper = Scene.lower, Scene.upper  # unused with stops along the span
-        lower, upper = scene.lower, scene.upper
-    else:
-        tip_lower, tip_upper = scene.lower, scene.upper
-        lower = upper = ()
-    # The stops' arrays carry one padding value (f2py refuses input arrays of size 0).
-    return (scene.length, scene.k2, scene.mass_per_length, scene.amplitude, scene.omega, tip_lower,
-            tip_upper, LAWS[scene.law], scene.stiffness_per_mass, scene.elements, scene.dt, scene.t_end,
-            scene.beta, int(scene.load_rule == "centered"), int(scene.start == "taylor"),
-            int(scene.allow_unstable), scene.record_every, scene.snapshot_every, scene.max_output_gb,
-            np.array(list(scene.nodes) + [0], dtype=np.int64), np.array(list(lower) + [0.0]),
-            np.array(list(upper) + [0.0]))
-
-
 def _check(status: int, message: Any) -> None:
     if status != 0:
         raise ValueError(_text(message))
+
+
+def _scene_text(scene: Scene) -> bytes:
+    from .scene import Scene
+
+    if not isinstance(scene, Scene):
+        raise TypeError(f"expected a beamstops.Scene, not {type(scene).__name__}")
+    return scene.to_text().encode("utf-8")
 
 
 def version() -> str:
@@ -71,16 +51,52 @@ def version() -> str:
     return _text(_engine.bs_version())
 
 
-def validate(scene: Scene, source: str = "scene") -> None:
-    """Check a scene with the engine's ``validate_scene``; ValueError names group, key and range."""
-    _check(*_engine.bs_validate(*_flat(scene), os.fsencode(source)))
+def keys() -> dict[str, tuple[str, ...]]:
+    """The namelist groups and the keys the engine's reader accepts in each."""
+    out: dict[str, tuple[str, ...]] = {}
+    for line in _text(_engine.bs_keys()).splitlines():
+        group, _, names = line.partition(":")
+        out[group.strip()] = tuple(name.strip() for name in names.split(",") if name.strip())
+    return out
 
 
-def sizes(scene: Scene) -> tuple[int, int, int]:
-    """Records and snapshots of a complete run, and nodes J+1 per snapshot."""
-    records, snapshots, nodes, status, message = _engine.bs_sizes(*_flat(scene))
+def canonical(text: str, source: str = "scene") -> str:
+    """The engine's canonical text of namelist text (every key, defaults filled in)."""
+    result, status, message = _engine.bs_scene(text.encode("utf-8"), os.fsencode(source))
     _check(status, message)
-    return int(records), int(snapshots), int(nodes)
+    return _text(result)
+
+
+def validate(scene: Scene, source: str = "scene") -> None:
+    """Whether the program would run the scene: its text read again with messages starting with
+    ``source``, and its time step against the stability limit (ValueError when refused)."""
+    canonical(_scene_text(scene).decode("utf-8"), source)
+    refusal = stability(scene).refusal
+    if refusal is not None:
+        raise ValueError(refusal.replace("scene:", f"{source}:", 1))
+
+
+def read_file(path: PathLike) -> str:
+    """The canonical text of the scene of a namelist file, read as the program reads it."""
+    result, status, message = _engine.bs_read_file(os.fsencode(os.fspath(path)))
+    if status != 0 and not os.path.exists(path):
+        raise FileNotFoundError(_text(message))
+    _check(status, message)
+    return _text(result)
+
+
+def read_namelist(path: PathLike) -> Scene:
+    """The scene the program itself reads from a file (same as :meth:`Scene.from_namelist`)."""
+    from .scene import Scene
+
+    return Scene.from_namelist(path)
+
+
+def sizes(scene: Scene) -> tuple[int, int, int, int]:
+    """Records and snapshots of a complete run, nodes J+1 per snapshot, stops along the span."""
+    records, snapshots, nodes, stops, status, message = _engine.bs_sizes(_scene_text(scene), b"scene")
+    _check(status, message)
+    return int(records), int(snapshots), int(nodes), int(stops)
 
 
 @dataclass(frozen=True)
@@ -115,12 +131,23 @@ class Stability:
 def stability(scene: Scene) -> Stability:
     """κ_h, the paper's κ̃ and the time-step limits of a scene (builds the model, does not run)."""
     (kappa_h, kappa_bound, kappa_contact, dt_newmark, dt_paper, dt_paper_bound, method, refused, refusal,
-     status, message) = _engine.bs_stability(*_flat(scene))
+     status, message) = _engine.bs_stability(_scene_text(scene), b"scene")
     _check(status, message)
     return Stability(kappa_h=float(kappa_h), kappa_bound=float(kappa_bound), kappa_contact=float(kappa_contact),
                      kappa_method=_text(method), dt_limit_newmark=float(dt_newmark),
                      dt_limit_paper=float(dt_paper), dt_limit_paper_bound=float(dt_paper_bound),
                      dt=scene.dt, refusal=_text(refusal) if refused else None)
+
+
+# `name = value` at the start of a line; a quoted value may span lines (the scene's text).
+_ATTRIBUTE = re.compile(r"^(\w+) = ('(?:[^']|'')*'|[^\n]*)$", re.M)
+
+
+def attributes_of(lines: str) -> dict[str, Any]:
+    """The engine's attribute lines `name = value` as a dictionary (the output file's root attributes)."""
+    from .scene import parse_value
+
+    return {match.group(1): parse_value(match.group(2)) for match in _ATTRIBUTE.finditer(lines)}
 
 
 def run(scene: Scene, *, allow_incomplete: bool = False) -> Result:
@@ -131,39 +158,14 @@ def run(scene: Scene, *, allow_incomplete: bool = False) -> Result:
     A run that does not complete (it diverged) raises :class:`IncompleteRunError`
     (a ValueError holding the partial result) unless ``allow_incomplete``.
     """
-    flat = _flat(scene)
-    records, snapshots, nodes = sizes(scene)
-    (t, tip_u, tip_v, reaction, energy, work, dissipated, snapshot_t, snapshot_x, snapshot_u, stops_u,
-     stops_reaction, filled, snaps, kappa_h, kappa_bound, dt_newmark, dt_paper, dt_paper_bound, steps, t_final,
-     cpu_seconds, impacts, max_violation, run_status, run_message, status, message) = _engine.bs_run(
-        *flat, records, snapshots, nodes)
+    text = _scene_text(scene)
+    records, snapshots, nodes, stops = sizes(scene)
+    (t, tip_u, tip_v, reaction, energy, work, dissipated, snapshot_t, snapshot_x, snapshot_u, stops_x, stops_u,
+     stops_reaction, filled, snaps, attribute_text, status, message) = _engine.bs_run(
+        text, b"scene", records, snapshots, nodes, stops)
     _check(status, message)
     filled, snaps = int(filled), int(snaps)
-    attrs: dict[str, Any] = {
-        "status": _RUN_STATUS.get(int(run_status), "failed"),
-        "version": version(),
-        "length": scene.length, "k2": scene.k2, "mass_per_length": scene.mass_per_length,
-        "amplitude": scene.amplitude, "omega": scene.omega,
-    }
-    if scene.nodes:
-        attrs["stops"] = len(scene.nodes)
-    else:
-        attrs.update({"lower": scene.lower, "upper": scene.upper})
-    attrs["law"] = scene.law
-    if scene.law == "compliance":
-        attrs["stiffness_per_mass"] = scene.stiffness_per_mass
-    attrs.update({
-        "elements": scene.elements, "dt": scene.dt, "t_end": scene.t_end, "beta": scene.beta,
-        "load_rule": scene.load_rule, "start": scene.start, "record_every": scene.record_every,
-        "snapshot_every": scene.snapshot_every, "allow_unstable": int(scene.allow_unstable),
-        "max_output_gb": scene.max_output_gb,
-        "kappa_h": float(kappa_h), "kappa_bound": float(kappa_bound), "dt_limit_newmark": float(dt_newmark),
-        "dt_limit_paper": float(dt_paper), "dt_limit_paper_bound": float(dt_paper_bound),
-        "steps": int(steps), "t_final": float(t_final), "cpu_seconds": float(cpu_seconds),
-        "impacts": int(impacts), "max_violation": float(max_violation),
-    })
-    if attrs["status"] != "complete":
-        attrs["message"] = _text(run_message)
+    attrs = attributes_of(_text(attribute_text))
     cut: Callable[[np.ndarray], np.ndarray] = (lambda a: a) if filled == records else (lambda a: a[:filled].copy())
     result = Result(
         t=cut(t), tip_u=cut(tip_u), tip_v=cut(tip_v), reaction=cut(reaction), energy=cut(energy),
@@ -171,39 +173,12 @@ def run(scene: Scene, *, allow_incomplete: bool = False) -> Result:
         snapshot_t=snapshot_t[:snaps] if snaps == snapshots else snapshot_t[:snaps].copy(),
         snapshot_x=snapshot_x,
         snapshot_u=np.ascontiguousarray(snapshot_u.T[:snaps]),
-        stops_x=snapshot_x[list(scene.nodes)] if scene.nodes else np.empty(0),
+        stops_x=stops_x,
         stops_node=np.array(scene.nodes, dtype=np.float64),
         stops_lower=np.array(scene.lower if scene.nodes else (), dtype=np.float64),
         stops_upper=np.array(scene.upper if scene.nodes else (), dtype=np.float64),
         stops_u=np.ascontiguousarray(stops_u.T[:filled]), stops_reaction=np.ascontiguousarray(stops_reaction.T[:filled]),
         attrs=attrs, source="memory")
-    if attrs["status"] != "complete" and not allow_incomplete:
-        raise IncompleteRunError(f"scene: run {attrs['status']}: {attrs.get('message', '')}", result)
+    if attrs.get("status") != "complete" and not allow_incomplete:
+        raise IncompleteRunError(f"scene: run {attrs.get('status')}: {attrs.get('message', '')}", result)
     return result
-
-
-def read_namelist(path: PathLike) -> Scene:
-    """The scene the program itself (the engine's namelist reader) reads from a file."""
-    (length, k2, mass_per_length, amplitude, omega, lower, upper, law, stiffness_per_mass, elements, dt, t_end,
-     beta, centered_load, taylor_start, allow_unstable, record_every, snapshot_every, max_output_gb, stop_count,
-     file, status, message) = _engine.bs_read_scene(os.fsencode(path))
-    _check(status, message)
-    nodes: tuple[int, ...] = ()
-    if stop_count > 0:
-        stop_nodes, stop_lower, stop_upper, status, message = _engine.bs_read_stops(os.fsencode(path), stop_count)
-        _check(status, message)
-        nodes = tuple(int(n) for n in stop_nodes)
-        lower, upper = tuple(float(v) for v in stop_lower), tuple(float(v) for v in stop_upper)
-    return Scene(length=length, k2=k2, mass_per_length=mass_per_length, amplitude=amplitude, omega=omega,
-                 lower=lower, upper=upper, nodes=nodes, law=_LAW_NAMES[int(law)],
-                 stiffness_per_mass=stiffness_per_mass,
-                 elements=int(elements), dt=dt, t_end=t_end, beta=beta,
-                 load_rule="centered" if centered_load else "paper", start="taylor" if taylor_start else "euler",
-                 allow_unstable=bool(allow_unstable), file=_text(file), record_every=int(record_every),
-                 snapshot_every=int(snapshot_every), max_output_gb=max_output_gb)
-
-
-def tube(youngs_modulus: float, density: float, outer_diameter: float, wall_thickness: float) -> tuple[float, float]:
-    """k² = EI/(ρS) and ρS of a tube, by the engine's formulas (as the namelist reader derives them)."""
-    k2, mass_per_length = _engine.bs_tube(youngs_modulus, density, outer_diameter, wall_thickness)
-    return float(k2), float(mass_per_length)

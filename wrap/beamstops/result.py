@@ -103,21 +103,12 @@ class Result:
         return self.snapshot_t, self.snapshot_x, self.snapshot_u
 
     def scene(self) -> Any:
-        """The :class:`beamstops.Scene` of the run, from its attributes."""
+        """The :class:`beamstops.Scene` of the run, from its ``scene`` attribute (the engine's canonical text)."""
         from .scene import Scene
 
-        keys = {f: self.attrs[f] for f in ("length", "k2", "mass_per_length", "amplitude", "omega", "lower", "upper",
-                                           "law", "elements", "dt", "t_end", "beta", "load_rule", "start",
-                                           "record_every", "snapshot_every", "max_output_gb") if f in self.attrs}
-        if self.stops_node.size:
-            keys["nodes"] = tuple(int(n) for n in self.stops_node)
-            keys["lower"] = tuple(float(v) for v in self.stops_lower)
-            keys["upper"] = tuple(float(v) for v in self.stops_upper)
-        if "allow_unstable" in self.attrs:
-            keys["allow_unstable"] = bool(self.attrs["allow_unstable"])
-        if "stiffness_per_mass" in self.attrs:
-            keys["stiffness_per_mass"] = self.attrs["stiffness_per_mass"]
-        return Scene(**keys)
+        if "scene" not in self.attrs:
+            raise ValueError(f"{self.source}: no scene attribute (written by a beamstops older than 0.2)")
+        return Scene.from_text(str(self.attrs["scene"]), self.source)
 
     def __repr__(self) -> str:
         a = self.attrs

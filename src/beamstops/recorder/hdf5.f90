@@ -20,7 +20,8 @@ module beamstops_recorder_hdf5
    use beamstops_recorder_hdf5_vector, only: write_vector
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
       & col_work, col_dissipated
-   use beamstops_version, only: version
+   use beamstops_attributes, only: attribute_list, kind_real, kind_int, kind_logical, kind_text
+   use beamstops_output_attributes, only: run_attributes, summary_attributes
    implicit none
    private
    public :: hdf5_recorder
@@ -115,35 +116,7 @@ contains
       if (.not. ok) call fail(self, 'cannot write dataset /snapshots/x')
       if (stop_count(scene) > 0) call create_stops(self, scene, model)
       call attribute_text(self, 'status', status_running)
-      call attribute_text(self, 'version', version)
-      call attribute_real(self, 'length', scene%length)
-      call attribute_real(self, 'k2', scene%k2)
-      call attribute_real(self, 'mass_per_length', scene%mass_per_length)
-      call attribute_real(self, 'amplitude', scene%amplitude)
-      call attribute_real(self, 'omega', scene%omega)
-      if (stop_count(scene) == 0) then
-         call attribute_real(self, 'lower', scene%lower)
-         call attribute_real(self, 'upper', scene%upper)
-      else
-         call attribute_int(self, 'stops', int(stop_count(scene), ik))
-      end if
-      call attribute_text(self, 'law', law_name(scene%law))
-      if (scene%law == law_compliance) call attribute_real(self, 'stiffness_per_mass', scene%stiffness_per_mass)
-      call attribute_int(self, 'elements', int(scene%elements, ik))
-      call attribute_real(self, 'dt', scene%dt)
-      call attribute_real(self, 't_end', scene%t_end)
-      call attribute_real(self, 'beta', scene%beta)
-      call attribute_text(self, 'load_rule', merge('centered', 'paper   ', scene%centered_load))
-      call attribute_text(self, 'start', merge('taylor', 'euler ', scene%taylor_start))
-      call attribute_int(self, 'record_every', int(scene%record_every, ik))
-      call attribute_int(self, 'snapshot_every', int(scene%snapshot_every, ik))
-      call attribute_int(self, 'allow_unstable', merge(1_ik, 0_ik, scene%allow_unstable))
-      call attribute_real(self, 'max_output_gb', scene%max_output_gb)
-      call attribute_real(self, 'kappa_h', model%kappa_h)
-      call attribute_real(self, 'kappa_bound', model%kappa_bound)
-      call attribute_real(self, 'dt_limit_newmark', model%dt_newmark)
-      call attribute_real(self, 'dt_limit_paper', model%dt_paper_exact)
-      call attribute_real(self, 'dt_limit_paper_bound', model%dt_paper_bound)
+      call write_attributes(self, run_attributes(scene, model))
       if (self%failed) then
          call fatal_error(error, self%message)
          return
@@ -235,12 +208,7 @@ contains
       integer :: hdferr
       if (self%file < 0) return
       call write_buffer(self)
-      call attribute_int(self, 'steps', summary%steps)
-      call attribute_real(self, 't_final', summary%t_final)
-      call attribute_real(self, 'cpu_seconds', summary%cpu_seconds)
-      call attribute_int(self, 'impacts', summary%impacts)
-      call attribute_real(self, 'max_violation', summary%max_violation)
-      if (allocated(summary%message)) call attribute_text(self, 'message', summary%message)
+      call write_attributes(self, summary_attributes(summary))
       call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, hdferr)
       if (.not. self%failed) call attribute_text(self, 'status', summary%status)
       call h5fclose_f(self%file, hdferr)
@@ -431,6 +399,26 @@ contains
       character(len=*), intent(in) :: units
       call text_attribute_on(dset, 'units', units)
    end subroutine dataset_units
+
+   !> Write the root attributes of a list (lists are datasets, not attributes: skipped).
+   subroutine write_attributes(self, list)
+      class(hdf5_recorder), intent(inout) :: self
+      type(attribute_list), intent(in) :: list
+      integer :: i
+      do i = 1, list%count
+         associate (item => list%items(i))
+            if (.not. item%attribute .or. item%list) cycle
+            select case (item%kind)
+            case (kind_real)
+               call attribute_real(self, item%name, item%reals(1))
+            case (kind_int, kind_logical)
+               call attribute_int(self, item%name, item%ints(1))
+            case (kind_text)
+               call attribute_text(self, item%name, item%text)
+            end select
+         end associate
+      end do
+   end subroutine write_attributes
 
    subroutine attribute_text(self, name, value)
       class(hdf5_recorder), intent(inout) :: self
