@@ -147,17 +147,9 @@ contains
 
       do g = 1, size(group_names)
          if (.not. has_group(g)) cycle
-         select case (g)
-         case (1); read (cleaned, nml=beam, iostat=stat, iomsg=msg)
-         case (2); read (cleaned, nml=support, iostat=stat, iomsg=msg)
-         case (3); read (cleaned, nml=stops, iostat=stat, iomsg=msg)
-         case (4); read (cleaned, nml=mesh, iostat=stat, iomsg=msg)
-         case (5); read (cleaned, nml=time, iostat=stat, iomsg=msg)
-         case (6); read (cleaned, nml=output, iostat=stat, iomsg=msg)
-         end select
+         call read_group(g, cleaned, stat, msg)
          if (stat /= 0) then
-            call fatal_error(error, source//': &'//trim(group_names(g))//': '//trim(explain(stat, msg, groups_text(g)))// &
-               & ' in `'//trim(groups_text(g))//'`; keys of &'//trim(group_names(g))//': '//trim(group_keys(g)))
+            call malformed_key(g, stat, msg)
             return
          end if
       end do
@@ -226,7 +218,172 @@ contains
       call stops_from_lists(source, lower, upper, nodes, x, scene, error)
       if (allocated(error)) return
       call validate_scene(scene, source, error)
+
+   contains
+
+      !> Read group g from `text` into the namelist variables.
+      subroutine read_group(g, text, stat, msg)
+         integer, intent(in) :: g
+         character(len=*), intent(in) :: text
+         integer, intent(out) :: stat
+         character(len=*), intent(out) :: msg
+         msg = ''
+         select case (g)
+         case (1); read (text, nml=beam, iostat=stat, iomsg=msg)
+         case (2); read (text, nml=support, iostat=stat, iomsg=msg)
+         case (3); read (text, nml=stops, iostat=stat, iomsg=msg)
+         case (4); read (text, nml=mesh, iostat=stat, iomsg=msg)
+         case (5); read (text, nml=time, iostat=stat, iomsg=msg)
+         case (6); read (text, nml=output, iostat=stat, iomsg=msg)
+         end select
+      end subroutine read_group
+
+      !> The message of a group gfortran could not read: each `key = value` of the group is read
+      !> alone to find the first one that fails, and the message names it with the kind of value
+      !> the key takes; gfortran's own words when no single assignment fails.
+      subroutine malformed_key(g, stat, msg)
+         integer, intent(in) :: g, stat
+         character(len=*), intent(in) :: msg
+         character(len=:), allocatable :: body, key
+         integer, allocatable :: starts(:)
+         integer :: i, one_stat, last
+         character(len=512) :: one_msg
+         body = group_body(cleaned, trim(group_names(g)))
+         starts = assignment_starts(body)
+         do i = 1, size(starts)
+            last = len(body)
+            if (i < size(starts)) last = starts(i + 1) - 1
+            call read_group(g, '&'//trim(group_names(g))//' '//body(starts(i):last)//' /', one_stat, one_msg)
+            if (one_stat == 0) cycle
+            key = key_at(body, starts(i))
+            if (index(one_msg, 'Cannot match namelist object name') > 0 .and. .not. known_key(g, key)) then
+               call fatal_error(error, source//': &'//trim(group_names(g))//': unknown key '//key// &
+                  & '; keys of &'//trim(group_names(g))//': '//trim(group_keys(g)))
+            else
+               call fatal_error(error, source//': &'//trim(group_names(g))//' '// &
+                  & trim(adjustl(body(starts(i):min(last, starts(i) + 120))))//' is malformed; allowed: '//key// &
+                  & ' = '//value_kind(key))
+            end if
+            return
+         end do
+         call fatal_error(error, source//': &'//trim(group_names(g))//': '//trim(explain(stat, msg, groups_text(g)))// &
+            & ' in `'//trim(groups_text(g))//'`; keys of &'//trim(group_names(g))//': '//trim(group_keys(g)))
+      end subroutine malformed_key
    end subroutine scene_from_text
+
+   !> The key (lower case) that starts at position `start` of a group's body.
+   function key_at(body, start) result(key)
+      character(len=*), intent(in) :: body
+      integer, intent(in) :: start
+      character(len=:), allocatable :: key
+      key = lower(body(start:start - 2 + verify(body(start:)//'=', &
+         & 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_')))
+   end function key_at
+
+   !> Whether a key belongs to group g.
+   logical function known_key(g, key)
+      integer, intent(in) :: g
+      character(len=*), intent(in) :: key
+      known_key = index(', '//trim(group_keys(g))//',', ', '//key//',') > 0
+   end function known_key
+
+   !> The kind of value a key takes, for messages.
+   function value_kind(key) result(kind)
+      character(len=*), intent(in) :: key
+      character(len=:), allocatable :: kind
+      select case (key)
+      case ('elements', 'record_every', 'snapshot_every', 'checkpoint_every')
+         kind = 'a whole number'
+      case ('nodes')
+         kind = 'whole numbers separated by commas'
+      case ('lower', 'upper', 'x')
+         kind = 'real numbers separated by commas (one per stop)'
+      case ('law', 'load_rule', 'start', 'file')
+         kind = "a quoted text, e.g. 'name'"
+      case ('allow_unstable')
+         kind = '.true. or .false.'
+      case default
+         kind = 'a real number, e.g. 1e-5'
+      end select
+   end function value_kind
+
+   !> The text of a group in `cleaned` after its name, up to its closing / (outside quotes).
+   function group_body(cleaned, name) result(body)
+      character(len=*), intent(in) :: cleaned, name
+      character(len=:), allocatable :: body
+      character(len=len(cleaned)) :: low
+      integer :: start, i
+      logical :: quoted
+      character :: quote
+      low = lower(cleaned)
+      body = ''
+      start = 0
+      do i = 1, len(low) - len(name)
+         if ((low(i:i) == '&' .or. low(i:i) == '$') .and. low(i + 1:i + len(name)) == name) then
+            if (scan(low(i + len(name) + 1:i + len(name) + 1), 'abcdefghijklmnopqrstuvwxyz0123456789_') == 0) then
+               start = i + len(name) + 1
+               exit
+            end if
+         end if
+      end do
+      if (start == 0) return
+      quoted = .false.
+      quote = ' '
+      do i = start, len(cleaned)
+         if (quoted) then
+            if (cleaned(i:i) == quote) quoted = .false.
+         else if (cleaned(i:i) == '"' .or. cleaned(i:i) == "'") then
+            quoted = .true.
+            quote = cleaned(i:i)
+         else if (scan(cleaned(i:i), '/&$') > 0) then
+            exit
+         end if
+      end do
+      body = cleaned(start:i - 1)
+   end function group_body
+
+   !> Where each `key = ` (or `key(i) = `) of a group's body starts, outside quotes.
+   function assignment_starts(body) result(starts)
+      character(len=*), intent(in) :: body
+      integer, allocatable :: starts(:)
+      integer :: i, j
+      logical :: quoted
+      character :: quote
+      allocate (starts(0))
+      quoted = .false.
+      quote = ' '
+      do i = 1, len(body)
+         if (quoted) then
+            if (body(i:i) == quote) quoted = .false.
+            cycle
+         end if
+         if (body(i:i) == '"' .or. body(i:i) == "'") then
+            quoted = .true.
+            quote = body(i:i)
+            cycle
+         end if
+         if (body(i:i) /= '=') cycle
+         j = i - 1
+         do while (j >= 1)
+            if (body(j:j) /= ' ') exit
+            j = j - 1
+         end do
+         if (j >= 1) then
+            if (body(j:j) == ')') then
+               j = index(body(:j), '(', back=.true.) - 1
+               do while (j >= 1)
+                  if (body(j:j) /= ' ') exit
+                  j = j - 1
+               end do
+            end if
+         end if
+         do while (j >= 1)
+            if (scan(body(j:j), 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_') == 0) exit
+            j = j - 1
+         end do
+         if (j + 1 <= i - 1) starts = [starts, j + 1]
+      end do
+   end function assignment_starts
 
    !> The stops of &stops: without nodes or x, lower and upper (one value each) are the tip stops;
    !> with nodes (indices 1..J) or x (abscissae, each at a node to 1e-9 length), the stops along

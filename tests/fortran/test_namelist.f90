@@ -3,7 +3,7 @@
 !> naming the file, the group and the key.
 module test_namelist
    use testing
-   use beamstops, only: scene_type, read_scene, law_signorini, law_compliance
+   use beamstops, only: scene_type, read_scene, law_signorini, law_compliance, scene_from_text, canonical_text
    implicit none
    private
    public :: collect_namelist
@@ -32,7 +32,11 @@ contains
          & new_unittest('elements = 0 out of range', test_elements), &
          & new_unittest('law = ''glue'' unknown', test_law), &
          & new_unittest('compliance without stiffness', test_compliance_stiffness), &
-         & new_unittest('record_every = 0 out of range', test_record_every) &
+         & new_unittest('record_every = 0 out of range', test_record_every), &
+         & new_unittest('text outside any group is refused, quoted', test_outside_group), &
+         & new_unittest('a file without any group is refused', test_no_group), &
+         & new_unittest('a malformed value names its key and kind', test_malformed_kind), &
+         & new_unittest('canonical text reads back the same scene', test_canonical_round_trip) &
          & ]
    end subroutine collect_namelist
 
@@ -295,4 +299,56 @@ contains
       call expect_error('record_every.nml', [character(len=ll) :: '&output record_every = 0 /'], &
          & [character(len=16) :: '&output', 'record_every'], error)
    end subroutine test_record_every
+
+   subroutine test_outside_group(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('outside.nml', [character(len=ll) :: '&beam length = 2 /', 'time dt = 1e-5 /'], &
+         & [character(len=32) :: 'line 2', 'text outside any group', '`time dt = 1e-5 /`'], error)
+   end subroutine test_outside_group
+
+   subroutine test_no_group(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('no_group.nml', [character(len=ll) :: '! only a comment'], &
+         & [character(len=32) :: 'no namelist group'], error)
+   end subroutine test_no_group
+
+   subroutine test_malformed_kind(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('kind.nml', [character(len=ll) :: '&time beta = 0.25 /', '&mesh elements = 19.5 /'], &
+         & [character(len=32) :: '&mesh elements = 19.5', 'is malformed', 'a whole number'], error)
+   end subroutine test_malformed_kind
+
+   !> Reading the canonical text of a scene gives the same canonical text (so the same values:
+   !> every real is written so that it reads back exactly), for texts using every form of input.
+   subroutine test_canonical_round_trip(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: nl = new_line('a')
+      character(len=200), parameter :: texts(5) = [character(len=200) :: &
+         & '&time dt = 1e-5 /', &
+         & '&beam length = 0.30000000000000004, k2 = 0.3333333333333333 /'//nl//'&support omega = 0 /', &
+         & '&stops law = ''compliance'', stiffness = 1e8 /'//nl//'&time beta = 0.25, dt = 5e-6 /', &
+         & '&beam length = 1.5 /'//nl//'&mesh elements = 30 /'//nl//'&stops x = 0.5, 1.0, 1.5, lower = -0.002, upper = 0.1, 0.2, 0.3 /', &
+         & '&beam youngs_modulus = 2e11, density = 8e3, outer_diameter = 0.01, wall_thickness = 5e-4 /'//nl// &
+         & '&output file = ''it''''s.h5'', checkpoint_every = 9, max_output_gb = 0.01 /']
+      type(scene_type) :: first, second
+      type(error_type), allocatable :: failure
+      character(len=:), allocatable :: canonical
+      integer :: i
+      do i = 1, size(texts)
+         call scene_from_text(trim(texts(i)), 'test', first, failure)
+         call check(error, .not. allocated(failure), 'text '//trim(texts(i))//' is read')
+         if (allocated(error)) return
+         canonical = canonical_text(first)
+         call scene_from_text(canonical, 'canonical', second, failure)
+         call check(error, .not. allocated(failure), 'canonical text is read: '//canonical)
+         if (allocated(error)) return
+         call check(error, canonical_text(second) == canonical, 'canonical text reads back the same: '//canonical)
+         if (allocated(error)) return
+         call check(error, second%dt == first%dt .and. second%k2 == first%k2 .and. &
+            & second%stiffness_per_mass == first%stiffness_per_mass .and. second%length == first%length, &
+            & 'values read back bit for bit')
+         if (allocated(error)) return
+      end do
+      call check(error, first%output_file == 'it''s.h5', 'quotes in texts survive')
+   end subroutine test_canonical_round_trip
 end module test_namelist
