@@ -358,6 +358,29 @@ contains
             call check(error, sum_energy, sum(e(i, :)), 'sum of energies', rel=.true., thr=1.0e-11_wp)
             if (allocated(error)) return
          end do
+         ! One stop through the scalar step_tip: the same rows as the offline detector.
+         call new_shock_log(log, 1, rest, [0.0_wp], error)
+         if (allocated(error)) return
+         deallocate (got)
+         allocate (got(0))
+         do k = 1, n
+            call log%step_tip(k*dt, dt, u(1, k), r(1, k), e(1, k))
+            do while (log%ready())
+               call log%pop(row)
+               got = [got, row]
+            end do
+         end do
+         call log%finish()
+         do while (log%ready())
+            call log%pop(row)
+            got = [got, row]
+         end do
+         want = offline(r(1, :), u(1, :), e(1, :), rest, 1)
+         call check(error, size(got), size(want), 'step_tip: shocks'); if (allocated(error)) return
+         do j = 1, size(got)
+            call same_row(shock_row_values(got(j)), shock_row_values(want(j)), 'step_tip: shock '//int_text(j))
+            if (allocated(error)) return
+         end do
          if (trial == 4) call note('rest 2 dt: '//int_text(size(got))//' shocks, '// &
             & int_text(int(log%phase_count()))//' phases')
          deallocate (got)

@@ -35,7 +35,8 @@
 !>
 !> Cost: the step adds one counter per call and, per stop, one test of r_k /= 0, one compare of
 !> the sample counter against a deadline and two moves (the last two u); everything else
-!> happens on contact samples and at the few samples after a phase.
+!> happens on contact samples and at the few samples after a phase, in procedures kept out of
+!> line so that the common path stays a leaf without register saves.
 module beamstops_observe_shocks
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use beamstops_kinds, only: wp, ik
@@ -127,6 +128,8 @@ module beamstops_observe_shocks
    contains
       !> Take one sample (every step).
       procedure :: step
+      !> Take one sample of a log of one stop, from scalars (every step; the tip-only scene).
+      procedure :: step_tip
       !> Close the open shocks at the end of a run.
       procedure :: finish
       !> Whether a completed row waits.
@@ -141,6 +144,10 @@ module beamstops_observe_shocks
       procedure :: lost_count
       !> Number of stops.
       procedure :: stop_count
+      ! The rare paths, bound so that calls go through the type's table and stay out of line:
+      ! the common path of step is then a leaf without register saves.
+      procedure, private :: contact_sample
+      procedure, private :: free_sample
    end type shock_log
 
    !> Rest in samples beyond which no run reaches (2**60).
@@ -206,30 +213,56 @@ contains
       !> Time step (s).
       real(wp), intent(in) :: dt
       !> Displacement of each stop's node at t_k (m) (m).
-      real(wp), intent(in) :: u(:)
+      real(wp), intent(in), contiguous :: u(:)
       !> Reaction of each stop in the step that brought u there (N) (m).
-      real(wp), intent(in) :: reaction(:)
+      real(wp), intent(in), contiguous :: reaction(:)
       !> Energy each stop took in that step (J) (m).
-      real(wp), intent(in) :: energy_taken(:)
+      real(wp), intent(in), contiguous :: energy_taken(:)
       integer :: i
       integer(ik) :: k
       k = self%k + 1
       self%k = k
       do i = 1, self%m
          if (reaction(i) /= 0) then
-            call contact_sample(self, i, k, t, dt, u(i), reaction(i), energy_taken(i))
+            call self%contact_sample(i, k, t, dt, u(i), reaction(i), energy_taken(i))
          else if (k >= self%deadline(i)) then
-            call free_sample(self, i, k, t, dt, u(i))
+            call self%free_sample(i, k, t, dt, u(i))
          end if
          self%u2(i) = self%u1(i)
          self%u1(i) = u(i)
       end do
    end subroutine step
 
+   !> step for a log of one stop (m = 1), from scalars: the same update without array arguments.
+   subroutine step_tip(self, t, dt, u, reaction, energy_taken)
+      !> Log of one stop.
+      class(shock_log), intent(inout) :: self
+      !> Time of the sample t_k (s).
+      real(wp), intent(in) :: t
+      !> Time step (s).
+      real(wp), intent(in) :: dt
+      !> Displacement of the stop's node (the tip) at t_k (m).
+      real(wp), intent(in) :: u
+      !> Reaction of the stop in the step that brought u there (N).
+      real(wp), intent(in) :: reaction
+      !> Energy the stop took in that step (J).
+      real(wp), intent(in) :: energy_taken
+      integer(ik) :: k
+      k = self%k + 1
+      self%k = k
+      if (reaction /= 0) then
+         call self%contact_sample(1, k, t, dt, u, reaction, energy_taken)
+      else if (k >= self%deadline(1)) then
+         call self%free_sample(1, k, t, dt, u)
+      end if
+      self%u2(1) = self%u1(1)
+      self%u1(1) = u
+   end subroutine step_tip
+
    !> A contact sample of stop i: continue the phase, merge a new phase into the open shock, or
    !> close the open shock and open a new one.
    subroutine contact_sample(self, i, k, t, dt, u, r, e)
-      type(shock_log), intent(inout) :: self
+      class(shock_log), intent(inout) :: self
       integer, intent(in) :: i
       integer(ik), intent(in) :: k
       real(wp), intent(in) :: t, dt, u, r, e
@@ -293,7 +326,7 @@ contains
    !> A free sample of stop i at or after its deadline: the end of a phase (k = b+1), the
    !> velocity after it (k = b+2), the end of the shock (k = b + max(R, 2)).
    subroutine free_sample(self, i, k, t, dt, u)
-      type(shock_log), intent(inout) :: self
+      class(shock_log), intent(inout) :: self
       integer, intent(in) :: i
       integer(ik), intent(in) :: k
       real(wp), intent(in) :: t, dt, u

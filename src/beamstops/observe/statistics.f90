@@ -74,15 +74,17 @@ module beamstops_observe_statistics
       real(wp) :: transient = 0, t_end = 0
       !> Histogram range (m) and bins per metre.
       real(wp) :: lower = 0, upper = 0, scale = 0
-      !> Time step (the last given, s).
+      !> Time step (given at each change of batch, s).
       real(wp) :: dt = 0
       !> Upper edges of the batches (edge(B) = huge) (B).
       real(wp), allocatable :: edge(:)
       !> Current batch (0: the transient) and the time at which it ends.
       integer :: batch = 0
       real(wp) :: next_edge = 0
-      ! The current batch's sums: samples, tip sum, sum of squares, extremes, histogram.
-      integer(ik) :: n = 0
+      ! The current batch's sums: samples, tip sum, sum of squares, extremes, histogram; the
+      ! samples since n = run_start all fell in bin run_bin and are not in hist yet.
+      integer(ik) :: n = 0, run_start = 0
+      integer :: run_bin = 0
       real(wp) :: su = 0, suu = 0, umin = huge(1.0_wp), umax = -huge(1.0_wp)
       integer(ik), allocatable :: hist(:)
       ! Per stop: contact samples, sum |r|, sum r^2, max |r|, sum e.
@@ -99,12 +101,19 @@ module beamstops_observe_statistics
    contains
       !> Take one sample (every step).
       procedure :: step
+      !> Take one sample of statistics of one stop, from scalars (every step; the tip-only scene).
+      procedure :: step_tip
       !> Take one completed shock.
       procedure :: add_shock
       !> Close the current batch at the end of a run.
       procedure :: finish
       !> The table of quantities.
       procedure :: results
+      ! The rare paths, bound so that calls go through the type's table and stay out of line:
+      ! the common path of step is then a leaf without register saves.
+      procedure, private :: contact_sample
+      procedure, private :: turn
+      procedure, private :: new_run
    end type statistics_type
 
 contains
@@ -234,6 +243,7 @@ contains
    pure subroutine reset(stats)
       type(statistics_type), intent(inout) :: stats
       stats%n = 0
+      stats%run_start = 0
       stats%su = 0
       stats%suu = 0
       stats%umin = huge(1.0_wp)
@@ -257,30 +267,59 @@ contains
       !> Tip displacement at t (m).
       real(wp), intent(in) :: u_tip
       !> Reaction of each stop in the step that brought the tip there (N) (m).
-      real(wp), intent(in) :: reaction(:)
+      real(wp), intent(in), contiguous :: reaction(:)
       !> Energy each stop took in that step (J) (m).
-      real(wp), intent(in) :: energy_taken(:)
+      real(wp), intent(in), contiguous :: energy_taken(:)
+      integer :: i
+      call tip_sample(self, t, dt, u_tip)
+      do i = 1, self%m
+         self%se(i) = self%se(i) + energy_taken(i)
+         if (reaction(i) /= 0) call self%contact_sample(i, reaction(i))
+      end do
+   end subroutine step
+
+   !> step for statistics of one stop (m = 1), from scalars: the same update without arrays.
+   subroutine step_tip(self, t, dt, u_tip, reaction, energy_taken)
+      !> Statistics of one stop.
+      class(statistics_type), intent(inout) :: self
+      !> Time of the sample (s).
+      real(wp), intent(in) :: t
+      !> Time step (s).
+      real(wp), intent(in) :: dt
+      !> Tip displacement at t (m).
+      real(wp), intent(in) :: u_tip
+      !> Reaction of the stop in the step that brought the tip there (N).
+      real(wp), intent(in) :: reaction
+      !> Energy the stop took in that step (J).
+      real(wp), intent(in) :: energy_taken
+      call tip_sample(self, t, dt, u_tip)
+      self%se(1) = self%se(1) + energy_taken
+      if (reaction /= 0) call self%contact_sample(1, reaction)
+   end subroutine step_tip
+
+   !> The batch, the count and the tip's sums, extremes and histogram of a sample.
+   pure subroutine tip_sample(self, t, dt, u_tip)
+      class(statistics_type), intent(inout) :: self
+      real(wp), intent(in) :: t, dt, u_tip
       real(wp) :: x
-      integer :: i, bin
-      if (t >= self%next_edge) call turn(self, t)
-      self%dt = dt
-      self%n = self%n + 1
+      integer :: bin
+      if (t >= self%next_edge) call self%turn(t, dt)
       self%su = self%su + u_tip
       self%suu = self%suu + u_tip*u_tip
       self%umin = min(self%umin, u_tip)
       self%umax = max(self%umax, u_tip)
+      ! The bin, safe for any u (NaN and infinities included). Counted by runs: the tip stays in
+      ! a bin for many steps, and an increment of hist(bin) at every step would chain each step's
+      ! load and store through the late-known address.
       x = min(max((u_tip - self%lower)*self%scale, 0.0_wp), self%bins - 0.5_wp)
       bin = min(max(int(x), 0), self%bins - 1)
-      self%hist(bin) = self%hist(bin) + 1
-      do i = 1, self%m
-         self%se(i) = self%se(i) + energy_taken(i)
-         if (reaction(i) /= 0) call contact_sample(self, i, reaction(i))
-      end do
-   end subroutine step
+      if (bin /= self%run_bin) call self%new_run(bin)
+      self%n = self%n + 1
+   end subroutine tip_sample
 
    !> A contact sample of stop i.
    pure subroutine contact_sample(self, i, r)
-      type(statistics_type), intent(inout) :: self
+      class(statistics_type), intent(inout) :: self
       integer, intent(in) :: i
       real(wp), intent(in) :: r
       self%contact(i) = self%contact(i) + 1
@@ -289,10 +328,21 @@ contains
       self%rmax(i) = max(self%rmax(i), abs(r))
    end subroutine contact_sample
 
-   !> The sample at t starts a later batch: keep the current batch's sums and move on.
-   pure subroutine turn(self, t)
-      type(statistics_type), intent(inout) :: self
-      real(wp), intent(in) :: t
+   !> The tip enters another bin: count the run that ends and start one.
+   pure subroutine new_run(self, bin)
+      class(statistics_type), intent(inout) :: self
+      integer, intent(in) :: bin
+      self%hist(self%run_bin) = self%hist(self%run_bin) + (self%n - self%run_start)
+      self%run_bin = bin
+      self%run_start = self%n
+   end subroutine new_run
+
+   !> The sample at t starts a later batch: keep the current batch's sums and move on (and take
+   !> the time step, constant in a run: every run turns at the first sample after the transient).
+   pure subroutine turn(self, t, dt)
+      class(statistics_type), intent(inout) :: self
+      real(wp), intent(in) :: t, dt
+      self%dt = dt
       call keep(self)
       do while (t >= self%next_edge)
          self%batch = self%batch + 1
@@ -305,6 +355,7 @@ contains
       type(statistics_type), intent(inout) :: self
       integer :: j
       j = self%batch
+      self%hist(self%run_bin) = self%hist(self%run_bin) + (self%n - self%run_start)
       if (j >= 1) then
          self%bn(j) = self%bn(j) + self%n
          self%bsu(j) = self%bsu(j) + self%su
@@ -603,16 +654,17 @@ contains
    end subroutine ensemble_table
 
    !> Quantile of Student's t distribution with `dof` degrees of freedom: the t with
-   !> P(T <= t) = p. Exact forms for dof = 1 and 2; otherwise the root of the regularized
-   !> incomplete beta equation I_x(dof/2, 1/2) = 2 min(p, 1-p), x = dof/(dof + t^2), by bisection
-   !> in x to full precision. NaN outside 0 < p < 1 or dof <= 0.
+   !> P(T <= t) = p. Exact forms for dof = 1 and 2; up to dof = 1000 bisection on t of the upper
+   !> tail (student_tail) down to adjacent doubles (relative accuracy about 1e-14 in t); beyond,
+   !> the Cornish-Fisher expansion in 1/dof to the fourth order around the normal quantile
+   !> (relative accuracy 1e-13 at p = 0.9999, 1e-15 at 0.975). NaN outside 0 < p < 1 or dof <= 0.
    elemental function student_t_quantile(p, dof) result(t)
       !> Probability.
       real(wp), intent(in) :: p
       !> Degrees of freedom (> 0, need not be an integer).
       real(wp), intent(in) :: dof
       real(wp) :: t
-      real(wp) :: q, lo, hi, x
+      real(wp) :: q, lo, hi, mid
       real(wp), parameter :: pi = acos(-1.0_wp)
       integer :: it
       if (.not. (p > 0 .and. p < 1 .and. dof > 0)) then
@@ -631,40 +683,153 @@ contains
          t = (2*p - 1)/sqrt(2*p*(1 - p))
          return
       end if
-      q = 2*min(p, 1 - p)
-      ! I_x(dof/2, 1/2) increases from 0 at x = 0 to 1 at x = 1.
+      if (dof > 1000) then
+         t = cornish_fisher(p, dof)
+         return
+      end if
+      ! The upper tail P(T > t) decreases from 1/2 at t = 0; find where it equals q.
+      q = min(p, 1 - p)
       lo = 0
       hi = 1
-      do it = 1, 200
-         x = 0.5_wp*(lo + hi)
-         if (x <= lo .or. x >= hi) exit
-         if (incomplete_beta(0.5_wp*dof, 0.5_wp, x) < q) then
-            lo = x
+      do it = 1, 2000
+         if (student_tail(hi, dof) <= q) exit
+         lo = hi
+         hi = 2*hi
+      end do
+      do it = 1, 2000
+         mid = 0.5_wp*(lo + hi)
+         if (mid <= lo .or. mid >= hi) exit
+         if (student_tail(mid, dof) > q) then
+            lo = mid
          else
-            hi = x
+            hi = mid
          end if
       end do
-      x = 0.5_wp*(lo + hi)
-      t = sqrt(dof*((1 - x)/x))
+      t = 0.5_wp*(lo + hi)
       if (p < 0.5_wp) t = -t
    end function student_t_quantile
 
-   !> Distribution function of Student's t: P(T <= t) = 1 - I_x(dof/2, 1/2)/2 for t >= 0,
-   !> x = dof/(dof + t^2).
+   !> Student's t quantile for a large dof: z + g1/dof + g2/dof^2 + g3/dof^3 + g4/dof^4 with
+   !> z the normal quantile (Abramowitz & Stegun 26.7.5).
+   elemental function cornish_fisher(p, dof) result(t)
+      real(wp), intent(in) :: p, dof
+      real(wp) :: t, z, z2, g1, g2, g3, g4
+      z = normal_quantile(p)
+      z2 = z*z
+      g1 = z*(z2 + 1)/4
+      g2 = z*((5*z2 + 16)*z2 + 3)/96
+      g3 = z*(((3*z2 + 19)*z2 + 17)*z2 - 15)/384
+      g4 = z*((((79*z2 + 776)*z2 + 1482)*z2 - 1920)*z2 - 945)/92160
+      t = z + (g1 + (g2 + (g3 + g4/dof)/dof)/dof)/dof
+   end function cornish_fisher
+
+   !> Quantile of the standard normal distribution: Acklam's rational approximation (relative
+   !> error 1.2e-9) and one Halley step on erfc, to full precision.
+   elemental function normal_quantile(p) result(x)
+      !> Probability, 0 < p < 1.
+      real(wp), intent(in) :: p
+      real(wp) :: x
+      real(wp), parameter :: a(6) = [-3.969683028665376e+01_wp, 2.209460984245205e+02_wp, &
+         & -2.759285104469687e+02_wp, 1.383577518672690e+02_wp, -3.066479806614716e+01_wp, 2.506628277459239e+00_wp]
+      real(wp), parameter :: b(5) = [-5.447609879822406e+01_wp, 1.615858368580409e+02_wp, &
+         & -1.556989798598866e+02_wp, 6.680131188771972e+01_wp, -1.328068155288572e+01_wp]
+      real(wp), parameter :: c(6) = [-7.784894002430293e-03_wp, -3.223964580411365e-01_wp, &
+         & -2.400758277161838e+00_wp, -2.549732539343734e+00_wp, 4.374664141464968e+00_wp, 2.938163982698783e+00_wp]
+      real(wp), parameter :: d(4) = [7.784695709041462e-03_wp, 3.224671290700398e-01_wp, 2.445134137142996e+00_wp, &
+         & 3.754408661907416e+00_wp]
+      real(wp), parameter :: p_low = 0.02425_wp, pi = acos(-1.0_wp)
+      real(wp) :: q, r, e, u
+      if (p < p_low) then
+         q = sqrt(-2*log(p))
+         x = (((((c(1)*q + c(2))*q + c(3))*q + c(4))*q + c(5))*q + c(6))/((((d(1)*q + d(2))*q + d(3))*q + d(4))*q + 1)
+      else if (p <= 1 - p_low) then
+         q = p - 0.5_wp
+         r = q*q
+         x = (((((a(1)*r + a(2))*r + a(3))*r + a(4))*r + a(5))*r + a(6))*q/ &
+            & (((((b(1)*r + b(2))*r + b(3))*r + b(4))*r + b(5))*r + 1)
+      else
+         q = sqrt(-2*log(1 - p))
+         x = -(((((c(1)*q + c(2))*q + c(3))*q + c(4))*q + c(5))*q + c(6))/((((d(1)*q + d(2))*q + d(3))*q + d(4))*q + 1)
+      end if
+      e = 0.5_wp*erfc(-x/sqrt(2.0_wp)) - p
+      u = e*sqrt(2*pi)*exp(0.5_wp*x*x)
+      x = x - u/(1 + 0.5_wp*x*u)
+   end function normal_quantile
+
+   !> Distribution function of Student's t: P(T <= t).
    elemental function student_t_cdf(t, dof) result(p)
       !> Argument.
       real(wp), intent(in) :: t
       !> Degrees of freedom (> 0).
       real(wp), intent(in) :: dof
       real(wp) :: p
-      real(wp) :: tail
-      tail = 0.5_wp*incomplete_beta(0.5_wp*dof, 0.5_wp, dof/(dof + t*t))
       if (t >= 0) then
-         p = 1 - tail
+         p = 1 - student_tail(t, dof)
       else
-         p = tail
+         p = student_tail(-t, dof)
       end if
    end function student_t_cdf
+
+   !> Upper tail P(T > t) = I_x(a, 1/2)/2 of Student's t for t >= 0, a = dof/2, x = dof/(dof + t^2),
+   !> with x and 1 - x = t^2/(dof + t^2) formed separately, log x = -log1p(t^2/dof), and
+   !> log Gamma(a + 1/2) - log Gamma(a) by Stirling's series for a >= 20 (no cancellation).
+   elemental function student_tail(t, dof) result(tail)
+      real(wp), intent(in) :: t, dof
+      real(wp) :: tail
+      real(wp) :: a, x, y, front, lx, ly
+      real(wp), parameter :: half_log_pi = 0.5_wp*log(acos(-1.0_wp))
+      if (t <= 0) then
+         tail = 0.5_wp
+         return
+      end if
+      a = 0.5_wp*dof
+      x = dof/(dof + t*t)
+      y = (t*t)/(dof + t*t)
+      if (y <= 0) then
+         tail = 0.5_wp
+         return
+      end if
+      lx = -log1p(t*t/dof)
+      ly = 2*log(t) - log(dof + t*t)
+      front = exp(log_gamma_ratio(a) - half_log_pi + a*lx + 0.5_wp*ly)
+      if (x < (a + 1)/(a + 2.5_wp)) then
+         tail = 0.5_wp*front*beta_fraction(a, 0.5_wp, x)/a
+      else
+         tail = 0.5_wp*(1 - 2*front*beta_fraction(0.5_wp, a, y))
+      end if
+   end function student_tail
+
+   !> log Gamma(a + 1/2) - log Gamma(a).
+   elemental function log_gamma_ratio(a) result(d)
+      real(wp), intent(in) :: a
+      real(wp) :: d
+      if (a < 20) then
+         d = log_gamma(a + 0.5_wp) - log_gamma(a)
+      else
+         ! (a) log(a + 1/2) - (a - 1/2) log a - 1/2 + c(a + 1/2) - c(a), Stirling's c(z).
+         d = 0.5_wp*log(a) + (a*log1p(0.5_wp/a) - 0.5_wp) + (stirling(a + 0.5_wp) - stirling(a))
+      end if
+   end function log_gamma_ratio
+
+   !> Stirling's correction log Gamma(z) - ((z - 1/2) log z - z + log(2 pi)/2), z >= 20.
+   elemental function stirling(z) result(c)
+      real(wp), intent(in) :: z
+      real(wp) :: c, w
+      w = 1/(z*z)
+      c = (1.0_wp/12 - w*(1.0_wp/360 - w*(1.0_wp/1260 - w*(1.0_wp/1680 - w/1188))))/z
+   end function stirling
+
+   !> log(1 + z) accurate for small z (z > -1).
+   elemental function log1p(z) result(l)
+      real(wp), intent(in) :: z
+      real(wp) :: l, w
+      w = 1 + z
+      if (w == 1) then
+         l = z
+      else
+         l = log(w)*(z/(w - 1))
+      end if
+   end function log1p
 
    !> Regularized incomplete beta function I_x(a, b) by its continued fraction (modified
    !> Lentz), on the side of x where it converges fast.
