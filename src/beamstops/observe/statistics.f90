@@ -118,7 +118,10 @@ module beamstops_observe_statistics
 
 contains
 
-   !> Check the values of the &statistics group; `source` (a file name) starts the message.
+   !> Check the values of the &statistics group (keys transient, batches, bins, rest_time,
+   !> histogram_lower, histogram_upper; t_end is &time's); `source` (a file name) starts the
+   !> message, in the form of validate_scene's: "SOURCE: &statistics KEY = VALUE is out of range;
+   !> allowed: RANGE".
    subroutine validate_statistics(transient, t_end, batches, bins, rest_time, lower, upper, source, error)
       !> Start of the window (s) and end of the run (s).
       real(wp), intent(in) :: transient, t_end
@@ -126,7 +129,7 @@ contains
       integer, intent(in) :: batches, bins
       !> Rest time of the shock log (s, >= 0).
       real(wp), intent(in) :: rest_time
-      !> Histogram range (m), lower < upper.
+      !> Histogram range (m), lower < upper (keys histogram_lower, histogram_upper).
       real(wp), intent(in) :: lower, upper
       !> Where the values came from, for messages.
       character(len=*), intent(in) :: source
@@ -145,10 +148,11 @@ contains
          call say('transient', fmt_real(transient), '0 <= transient < t_end = '//fmt_real(t_end)//' s'); return
       end if
       if (.not. ieee_is_finite(lower)) then
-         call say('lower', fmt_real(lower), 'a finite histogram bound (m)'); return
+         call say('histogram_lower', fmt_real(lower), 'a finite value (m)'); return
       end if
       if (.not. (ieee_is_finite(upper) .and. upper > lower)) then
-         call say('upper', fmt_real(upper), 'upper > lower = '//fmt_real(lower)//' m'); return
+         call say('histogram_upper', fmt_real(upper), 'histogram_upper > histogram_lower = '//fmt_real(lower)//' m')
+         return
       end if
    contains
       subroutine say(key, value, allowed)
