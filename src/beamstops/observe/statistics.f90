@@ -28,7 +28,12 @@
 !> t_{0.975, B'-1} s / sqrt(B'), s the sample standard deviation (divisor B'-1) of the B'
 !> finite batch values (a batch without samples, or a ratio with a zero denominator, has none);
 !> NaN when B' < 2, and for counts and extremes (min, max), which batch means do not estimate.
-!> An undefined value (a ratio over nothing) is NaN.
+!> An undefined value (a ratio over nothing) is NaN. Shock rows whose stop is not in 1..m are
+!> ignored; truncated rows (closed by the log's finish) count like the others.
+!>
+!> Use: new_statistics, then every step `step` (arrays over the m stops) or `step_tip` (m = 1,
+!> scalars: about half the cost), add_shock for each row drained from the shock log, finish at
+!> the end, results for the table. The step allocates nothing and writes nothing.
 module beamstops_observe_statistics
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite, ieee_is_nan
    use beamstops_kinds, only: wp, ik
