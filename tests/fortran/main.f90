@@ -13,13 +13,15 @@ program tester
    use test_scheme, only: collect_scheme
    use test_box_qp, only: collect_box_qp
    use test_stops, only: collect_stops
+   use test_shocks, only: collect_shocks
+   use test_statistics, only: collect_statistics
    implicit none
    character(len=64) :: suite
    type(unittest_type), allocatable :: tests(:)
    integer :: failures
 
    if (command_argument_count() /= 1) then
-      write (error_unit, '(a)') 'usage: tester SUITE (harness, hermite, eigen, projection, energy, order, scheme, namelist, box_qp, stops)'
+      write (error_unit, '(a)') 'usage: tester SUITE (harness, hermite, eigen, projection, energy, order, scheme, namelist, box_qp, stops, shocks, statistics)'
       error stop 2
    end if
    call get_command_argument(1, suite)
@@ -34,6 +36,8 @@ program tester
    case ('namelist'); call collect_namelist(tests)
    case ('box_qp'); call collect_box_qp(tests)
    case ('stops'); call collect_stops(tests)
+   case ('shocks'); call collect_shocks(tests)
+   case ('statistics'); call collect_statistics(tests)
    case default
       write (error_unit, '(a)') 'tester: unknown suite '''//trim(suite)//''''
       error stop 2
