@@ -3,10 +3,13 @@
 !>                                        checkpoint), write its HDF5 file, print a summary
 !>   beamstops info FILE.nml              print the scene, its discretization and limits
 program beamstops_main
-   use, intrinsic :: iso_c_binding, only: c_int
+   use, intrinsic :: iso_c_binding, only: c_int, c_intptr_t, c_funptr, c_null_funptr
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use beamstops
-   use beamstops_checkpoint, only: checkpoint_path, read_checkpoint
+   use beamstops_checkpoint, only: checkpoint_path, read_checkpoint, is_checkpoint
+   use beamstops_files, only: file_exists, remove_file
+   use beamstops_recorder_hdf5, only: partial_path, check_output_path
+   use beamstops_run, only: continue_run
    implicit none
 
    interface
@@ -15,11 +18,21 @@ program beamstops_main
          integer(c_int), value :: fd
          integer(c_int) :: r
       end function c_isatty
-      subroutine c_exit(status) bind(c, name='exit')
+      subroutine c_exit(status) bind(c, name='_exit')
          import :: c_int
          integer(c_int), value :: status
       end subroutine c_exit
+      function c_signal(signum, handler) bind(c, name='signal') result(previous)
+         import :: c_int, c_funptr
+         integer(c_int), value :: signum
+         type(c_funptr), value :: handler
+         type(c_funptr) :: previous
+      end function c_signal
    end interface
+
+   !> SIGXFSZ (Linux on x86, ARM, POWER, RISC-V, s390; BSD and macOS too) and SIG_IGN.
+   integer(c_int), parameter :: sigxfsz = 25_c_int
+   integer(c_intptr_t), parameter :: sig_ign = 1_c_intptr_t
 
    integer, parameter :: exit_input = 1, exit_usage = 2, exit_diverged = 3, exit_output = 4
    character(len=:), allocatable :: command, path, out
@@ -28,6 +41,7 @@ program beamstops_main
    type(model_type) :: model
    type(error_type), allocatable :: error
 
+   call ignore_file_size_signal()
    call parse_arguments(command, path, out, restart)
    call read_scene(path, scene, error)
    call stop_on(error, exit_input)
@@ -38,7 +52,7 @@ program beamstops_main
    case ('info')
       call print_info(scene, model)
    case ('run')
-      call run_to_file(scene, model, restart)
+      call run_to_file(scene, model, path, restart)
    end select
 
 contains
@@ -108,7 +122,9 @@ contains
       call quit(status)
    end subroutine stop_on
 
-   !> End the program with an exit status, without a runtime traceback.
+   !> End the program with an exit status, without a runtime traceback and without the HDF5
+   !> library's exit handler (which must not touch a file whose writes failed; every file that
+   !> was written correctly is closed by then).
    subroutine quit(status)
       integer, intent(in) :: status
       flush (output_unit)
@@ -116,51 +132,92 @@ contains
       call c_exit(int(status, c_int))
    end subroutine quit
 
-   subroutine run_to_file(scene, model, restart)
+   !> A write beyond the file-size limit (ulimit -f) kills the process with SIGXFSZ; ignored, the
+   !> write fails with EFBIG instead, and the run ends with a message like any failed write.
+   subroutine ignore_file_size_signal()
+      type(c_funptr) :: previous
+      previous = c_signal(sigxfsz, transfer(sig_ign, c_null_funptr))
+   end subroutine ignore_file_size_signal
+
+   !> Run a scene into its HDF5 output. The output path is checked before anything is written
+   !> (not the input, not a file other than a beamstops output); the run writes OUT.partial
+   !> and the recorder renames it onto OUT when the run went to its end (complete or diverged).
+   !> With `restart`, the partial file continues from the checkpoint OUT.checkpoint.
+   subroutine run_to_file(scene, model, input, restart)
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
+      character(len=*), intent(in) :: input
       logical, intent(in) :: restart
       type(hdf5_recorder) :: recorder
       type(run_summary) :: summary
       type(state_type) :: state
-      type(error_type), allocatable :: error, finish_error
+      type(error_type), allocatable :: error, write_error, finish_error
+      character(len=:), allocatable :: output, partial, checkpoint
       integer(ik) :: records, snapshots
       logical :: resume
+      output = scene%output_file
+      partial = partial_path(output)
+      checkpoint = checkpoint_path(output)
+      call check_output_path(output, input, error)
+      call stop_on(error, exit_output)
+      if (file_exists(checkpoint) .and. .not. is_checkpoint(checkpoint)) then
+         call fatal_error(error, checkpoint//': exists and is not a beamstops checkpoint; refusing to overwrite it '// &
+            & '(move it away)')
+         call stop_on(error, exit_output)
+      end if
       resume = .false.
       if (restart) then
-         inquire (file=checkpoint_path(scene%output_file), exist=resume)
-         if (.not. resume) write (error_unit, '(a)') 'beamstops: no checkpoint '// &
-            & checkpoint_path(scene%output_file)//': starting from t = 0'
+         if (.not. file_exists(checkpoint)) then
+            write (error_unit, '(a)') 'beamstops: no checkpoint '//checkpoint//': starting from t = 0'
+         else if (.not. file_exists(partial)) then
+            write (error_unit, '(a)') 'beamstops: no '//partial//' (the output of the interrupted run): '// &
+               & 'starting from t = 0'
+         else
+            resume = .true.
+         end if
       end if
       if (resume) then
-         call read_checkpoint(checkpoint_path(scene%output_file), scene, model, state, records, snapshots, error)
+         call read_checkpoint(checkpoint, scene, model, state, records, snapshots, error)
          call stop_on(error, exit_input)
-         call recorder%reopen(scene%output_file, scene, model, records, snapshots, error)
+         call recorder%reopen(output, scene, model, records, snapshots, error)
          call stop_on(error, exit_output)
       else
-         call recorder%open(scene%output_file, scene, model, error)
+         call remove_file(checkpoint)
+         call recorder%open(output, scene, model, error)
          call stop_on(error, exit_output)
       end if
       recorder%show_progress = c_isatty(2_c_int) == 1
-      if (resume) then
-         call run_scheme(scene, model, state, recorder, summary)
-      else
-         call simulate(scene, model, recorder, summary, error)
-      end if
+      if (.not. resume) call start_state(scene, model, state, recorder, error)
       if (allocated(error)) then
          summary%status = status_failed
          summary%message = error%message
+      else
+         call continue_run(scene, model, state, recorder, summary, write_error, checkpoint)
       end if
       call recorder%finish(summary, finish_error)
       call stop_on(error, exit_input)
-      call stop_on(finish_error, exit_output)
+      if (allocated(write_error)) call stop_on_write(write_error, output)
+      if (allocated(finish_error)) call stop_on_write(finish_error, output)
+      if (summary%status == status_complete .or. summary%status == status_diverged) call remove_file(checkpoint)
       write (output_unit, '(a)') summary_line(scene, summary)
-      if (summary%status /= status_complete) then
-         write (error_unit, '(a)') 'beamstops: error: '//scene%output_file//': run '//summary%status//': '// &
-            & summary%message
+      if (summary%status == status_diverged) then
+         write (error_unit, '(a)') 'beamstops: error: '//output//': run diverged: '//summary%message
+         call quit(exit_diverged)
+      else if (summary%status /= status_complete) then
+         write (error_unit, '(a)') 'beamstops: error: '//output//': run '//summary%status//': '// &
+            & summary%message//'; '//output//' is left as it was, the run so far is in '//partial
          call quit(exit_diverged)
       end if
+
    end subroutine run_to_file
+
+   !> A write failed: one message, exit status 4; the output is untouched.
+   subroutine stop_on_write(failure, output)
+      type(error_type), intent(in) :: failure
+      character(len=*), intent(in) :: output
+      write (error_unit, '(a)') 'beamstops: error: '//failure%message//'; '//output//' is left as it was'
+      call quit(exit_output)
+   end subroutine stop_on_write
 
    function summary_line(scene, summary) result(line)
       type(scene_type), intent(in) :: scene
