@@ -136,3 +136,172 @@ def test_unwritable_output_exits_4(tmp_path: Path) -> None:
     done = beamstops("run", scene, "-o", tmp_path / "no" / "such" / "dir.h5", cwd=tmp_path)
     assert done.returncode == 4
     assert "dir.h5" in done.stderr
+
+
+# ---------------------------------------------------------------- no input can destroy data (issue 11)
+
+
+def one_error_line(done: subprocess.CompletedProcess[str]) -> str:
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1, done.stderr
+    assert lines[0].startswith("beamstops: error: "), lines[0]
+    assert "Traceback" not in done.stderr and "Backtrace" not in done.stderr
+    return lines[0]
+
+
+def complete_output(tmp_path: Path, name: str = "kept.h5") -> tuple[Path, bytes]:
+    """A complete output of a short run, and its bytes."""
+    scene = write(tmp_path, SHORT, name="previous.nml")
+    done = beamstops("run", scene, "-o", name, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    return tmp_path / name, (tmp_path / name).read_bytes()
+
+
+@pytest.mark.parametrize("spelling", ["same name", "./ spelling", "hard link", "symbolic link"])
+def test_output_that_is_the_input_is_refused(spelling: str, tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT)
+    text = scene.read_bytes()
+    out = {"same name": "scene.nml", "./ spelling": "./scene.nml", "hard link": "link.h5",
+           "symbolic link": "symlink.h5"}[spelling]
+    if spelling == "hard link":
+        os.link(scene, tmp_path / out)
+    elif spelling == "symbolic link":
+        os.symlink(scene, tmp_path / out)
+    done = beamstops("run", "scene.nml", "-o", out, cwd=tmp_path)
+    assert done.returncode == 4
+    line = one_error_line(done)
+    assert line.startswith(f"beamstops: error: {out}: ") and "input" in line
+    assert scene.read_bytes() == text
+    assert not list(tmp_path.glob("*.partial"))
+
+
+def test_namelist_output_key_naming_the_input_is_refused(tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT + "&output file='scene.nml' /\n")
+    text = scene.read_bytes()
+    done = beamstops("run", scene, cwd=tmp_path)
+    assert done.returncode == 4
+    assert "input" in one_error_line(done)
+    assert scene.read_bytes() == text
+
+
+def foreign_files(tmp_path: Path) -> dict[str, tuple[Path, str]]:
+    text = tmp_path / "notes.h5"
+    text.write_text("my notes, not HDF5\n")
+    plain = tmp_path / "plain.h5"
+    with h5py.File(plain, "w") as f:
+        f["data"] = np.arange(3.0)
+        f.attrs["version"] = "mine"  # a version but no status: still not a beamstops output
+    folder = tmp_path / "folder.h5"
+    folder.mkdir()
+    return {"text": (text, "not an HDF5 file"), "hdf5": (plain, "without the root attributes"),
+            "folder": (folder, "folder")}
+
+
+@pytest.mark.parametrize("kind", ["text", "hdf5", "folder"])
+def test_existing_file_that_is_not_an_output_is_refused(kind: str, tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT)
+    target, why = foreign_files(tmp_path)[kind]
+    before = target.read_bytes() if target.is_file() else None
+    done = beamstops("run", scene, "-o", target.name, cwd=tmp_path)
+    assert done.returncode == 4
+    line = one_error_line(done)
+    assert line.startswith(f"beamstops: error: {target.name}: ") and why in line
+    if before is not None:
+        assert target.read_bytes() == before
+    assert not list(tmp_path.glob("*.partial")) and not list(tmp_path.glob("*.checkpoint"))
+
+
+@pytest.mark.parametrize("suffix", [".partial", ".checkpoint"])
+def test_foreign_file_at_the_partial_or_checkpoint_name_is_refused(suffix: str, tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT)
+    mine = tmp_path / f"out.h5{suffix}"
+    mine.write_text("not HDF5\n")
+    done = beamstops("run", scene, "-o", "out.h5", cwd=tmp_path)
+    assert done.returncode == 4
+    assert one_error_line(done).startswith(f"beamstops: error: out.h5{suffix}: ")
+    assert mine.read_text() == "not HDF5\n" and not (tmp_path / "out.h5").exists()
+
+
+def test_an_earlier_output_is_replaced_only_when_the_run_is_complete(tmp_path: Path) -> None:
+    output, _ = complete_output(tmp_path)
+    scene = write(tmp_path, "&time dt=5e-5, t_end=0.5 /\n")
+    done = beamstops("run", scene, "-o", output.name, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    with h5py.File(output) as f:
+        assert f.attrs["status"] == b"complete" and f.attrs["steps"] == 10000
+    assert not list(tmp_path.glob("*.partial"))
+
+
+def limit_file_size(size: int):  # type: ignore[no-untyped-def]
+    import resource
+
+    def apply() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (size, size))
+
+    return apply
+
+
+def test_write_beyond_the_file_size_limit_fails_cleanly(tmp_path: Path) -> None:
+    output, before = complete_output(tmp_path)
+    # about 13 MB of records against a 1 MB limit: the write fails with EFBIG, not SIGXFSZ
+    scene = write(tmp_path, "&time dt=1e-5, t_end=2 /\n")
+    done = subprocess.run([PROGRAM, "run", "scene.nml", "-o", output.name], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=120, preexec_fn=limit_file_size(1 << 20))
+    assert done.returncode == 4, (done.returncode, done.stderr)
+    line = one_error_line(done)
+    assert line.startswith(f"beamstops: error: {output.name}: ") and "file-size limit" in line
+    assert "kept.h5.partial" in line
+    assert output.read_bytes() == before  # the complete output of the earlier run is untouched
+    partial = tmp_path / "kept.h5.partial"
+    assert partial.exists() and partial.stat().st_size <= 1 << 20
+    try:  # the partial file is never presented as complete (a failed write may leave it unreadable)
+        with h5py.File(partial) as f:
+            assert f.attrs["status"] != b"complete"
+    except OSError:
+        pass
+    # once the limit is lifted, the same command runs (the broken partial file is its own)
+    done = beamstops("run", scene, "-o", output.name, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    with h5py.File(output) as f:
+        assert f.attrs["status"] == b"complete" and f.attrs["steps"] == 200000
+
+
+def test_unwritable_folder_exits_4_and_writes_nothing(tmp_path: Path) -> None:
+    """A folder the program may not write into; root writes anywhere, so as root the program
+    runs as the user nobody."""
+    import tempfile
+
+    base = Path(tempfile.mkdtemp(prefix="beamstops-ro-"))
+    try:
+        base.chmod(0o755)
+        scene = base / "scene.nml"
+        scene.write_text(SHORT)
+        scene.chmod(0o644)
+        locked = base / "locked"
+        locked.mkdir()
+        locked.chmod(0o555)
+        preexec = None
+        if os.geteuid() == 0:
+            def preexec() -> None:
+                os.setgid(65534)
+                os.setuid(65534)
+        done = subprocess.run([PROGRAM, "run", "scene.nml", "-o", "locked/out.h5"], cwd=base, capture_output=True,
+                              text=True, timeout=120, preexec_fn=preexec)
+        assert done.returncode == 4, done.stderr
+        line = one_error_line(done)
+        assert line.startswith("beamstops: error: locked/out.h5: ") and "locked/out.h5.partial" in line
+        assert list(locked.iterdir()) == []
+    finally:
+        shutil.rmtree(base, ignore_errors=True)
+
+
+def test_diverged_run_replaces_the_output_and_says_so(tmp_path: Path) -> None:
+    output, _ = complete_output(tmp_path, "bad.h5")
+    scene = write(tmp_path, "&time dt=2e-5, beta=0, t_end=0.5, allow_unstable=.true. /\n"
+                            "&output record_every=100 /\n")
+    done = beamstops("run", scene, "-o", output.name, cwd=tmp_path)
+    assert done.returncode == 3
+    assert "diverged" in one_error_line(done)
+    with h5py.File(output) as f:
+        assert f.attrs["status"] == b"diverged" and f.attrs["beta"] == 0
+    assert not list(tmp_path.glob("*.partial")) and not list(tmp_path.glob("*.checkpoint"))
