@@ -305,3 +305,111 @@ def test_diverged_run_replaces_the_output_and_says_so(tmp_path: Path) -> None:
     with h5py.File(output) as f:
         assert f.attrs["status"] == b"diverged" and f.attrs["beta"] == 0
     assert not list(tmp_path.glob("*.partial")) and not list(tmp_path.glob("*.checkpoint"))
+
+
+# ---------------------------------------------------------------- one entry point: the Python subcommands
+
+
+def listed_commands(help_text: str) -> dict[str, str]:
+    """Command names of `beamstops --help` (two-space indented lines) and their descriptions."""
+    out = {}
+    for line in help_text.split("exit statuses")[0].splitlines():
+        if line.startswith("  ") and not line.startswith("   "):
+            name, _, description = line.strip().partition(" ")
+            out[name] = description.strip()
+    return out
+
+
+def test_help_lists_every_command_with_a_description(tmp_path: Path) -> None:
+    from beamstops.cli import commands
+
+    done = beamstops("--help", cwd=tmp_path)
+    assert done.returncode == 0 and done.stderr == ""
+    listed = listed_commands(done.stdout)
+    python = commands()
+    assert {"plot", "sweep", "converge", "work-precision", "stability-map", "compliance"} <= set(python)
+    for name in ["run", "info", *python]:
+        assert name in listed, (name, done.stdout)
+    for name in python:
+        assert listed[name], name
+    # the program hands on exactly the Python subcommands: none missing, none extra
+    assert set(listed) - {"run", "info", "--version"} == set(python)
+
+
+def test_python_subcommands_run_from_the_program(tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT)
+    assert beamstops("run", scene, "-o", "short.h5", cwd=tmp_path).returncode == 0
+    done = beamstops("plot", "short.h5", "--kind", "energy", "-o", "energy.png", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "energy.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # the exit status is Python's: 1 for a user error, 2 for argparse's usage error
+    done = beamstops("plot", "missing.h5", cwd=tmp_path)
+    assert done.returncode == 1 and done.stderr.startswith("beamstops: error: missing.h5")
+    done = beamstops("plot", cwd=tmp_path)
+    assert done.returncode == 2 and "usage: beamstops plot" in done.stderr
+    for name in ["sweep", "converge", "work-precision", "stability-map", "compliance"]:
+        done = beamstops(name, "--help", cwd=tmp_path)
+        assert done.returncode == 0 and f"usage: beamstops {name}" in done.stdout, (name, done.stderr)
+
+
+def test_a_python_subcommand_replaces_the_program(tmp_path: Path) -> None:
+    """execv, not a child process: the process becomes Python, so signals reach it directly."""
+    import signal
+    import time
+
+    process = subprocess.Popen([PROGRAM, "converge", "-o", str(tmp_path / "c"), "--quiet"], cwd=tmp_path,
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    cmdline = Path(f"/proc/{process.pid}/cmdline")
+    deadline = time.time() + 30
+    seen = b""
+    while time.time() < deadline and process.poll() is None:
+        seen = cmdline.read_bytes() if cmdline.exists() else b""
+        if b"beamstops.cli" in seen:
+            break
+        time.sleep(0.01)
+    try:
+        assert b"beamstops.cli" in seen and b"converge" in seen, seen
+        assert not [p for p in Path("/proc").glob("[0-9]*") if _parent(p) == process.pid]
+    finally:
+        process.send_signal(signal.SIGTERM)
+        returncode = process.wait(timeout=30)
+    assert returncode == -signal.SIGTERM
+
+
+def _parent(proc: Path) -> int:
+    try:
+        return int((proc / "stat").read_text().rsplit(")", 1)[1].split()[1])
+    except (OSError, IndexError, ValueError):
+        return -1
+
+
+def test_without_python_a_python_subcommand_says_so(tmp_path: Path) -> None:
+    lone = tmp_path / "bin" / "beamstops"
+    lone.parent.mkdir()
+    shutil.copy2(PROGRAM, lone)  # no python beside it, and none on PATH
+    done = subprocess.run([str(lone), "plot", "x.h5"], cwd=tmp_path, capture_output=True, text=True, timeout=60,
+                          env={"PATH": str(tmp_path / "bin")})
+    assert done.returncode == 2
+    line = one_error_line(done)
+    assert "'plot'" in line and "Python" in line
+    # the engine's own commands need no Python
+    scene = write(tmp_path, SHORT)
+    assert subprocess.run([str(lone), "info", str(scene)], capture_output=True, env={"PATH": ""}).returncode == 0
+
+
+def test_without_the_package_a_python_subcommand_says_so(tmp_path: Path) -> None:
+    import sys
+
+    base = getattr(sys, "_base_executable", sys.executable)
+    probe = subprocess.run([base, "-c", "import beamstops"], capture_output=True)
+    if probe.returncode == 0:
+        pytest.skip(f"{base} imports beamstops: no Python without the package here")
+    lone = tmp_path / "bin" / "beamstops"
+    lone.parent.mkdir()
+    shutil.copy2(PROGRAM, lone)
+    (tmp_path / "bin" / "python").symlink_to(base)  # a Python beside the program, without the package
+    done = subprocess.run([str(lone), "sweep", "spec.toml"], cwd=tmp_path, capture_output=True, text=True,
+                          timeout=60)
+    assert done.returncode == 2
+    line = one_error_line(done)
+    assert "'sweep'" in line and "beamstops Python package" in line and "pip install" in line
