@@ -413,3 +413,14 @@ def test_without_the_package_a_python_subcommand_says_so(tmp_path: Path) -> None
     assert done.returncode == 2
     line = one_error_line(done)
     assert "'sweep'" in line and "beamstops Python package" in line and "pip install" in line
+
+
+def test_an_empty_partial_file_left_by_a_kill_is_replaced(tmp_path: Path) -> None:
+    """A run killed right after creating OUT.h5.partial leaves it empty: the next run takes it."""
+    scene = write(tmp_path, SHORT)
+    (tmp_path / "out.h5.partial").write_bytes(b"")
+    done = beamstops("run", scene, "-o", "out.h5", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert not (tmp_path / "out.h5.partial").exists()
+    with h5py.File(tmp_path / "out.h5") as f:
+        assert f.attrs["status"] == b"complete"

@@ -379,9 +379,9 @@ contains
    !> Refuse, before anything is written, an output that would destroy data: the input file
    !> itself (under any name: same device and inode), an existing file at the output path that
    !> is not a beamstops output (an HDF5 file with the root attributes `version` and `status`),
-   !> or a file at the partial path that is not HDF5 (an HDF5 file there is taken for the
-   !> partial output of an earlier run, which a failed write may have left unreadable). The
-   !> message names the file and says why.
+   !> or a file at the partial path that is neither empty nor HDF5 (an empty or HDF5 file there
+   !> is taken for the partial output of an earlier run, which a kill may have left empty and a
+   !> failed write unreadable). The message names the file and says why.
    subroutine check_output_path(output, input, error)
       !> Output file.
       character(len=*), intent(in) :: output
@@ -407,13 +407,14 @@ contains
    end subroutine check_output_path
 
    !> Why an existing `path` is not a beamstops output ('' when it is one, or does not exist);
-   !> not `strict`: any HDF5 file passes.
+   !> not `strict`: any HDF5 file passes, and an empty file.
    function not_an_output(path, strict) result(why)
       character(len=*), intent(in) :: path
       logical, intent(in) :: strict
       character(len=:), allocatable :: why
       integer(hid_t) :: file
       integer :: hdferr, closing
+      integer(ik) :: bytes
       logical :: hdf5_file, has_version, has_status
       why = ''
       if (.not. file_exists(path)) return
@@ -421,6 +422,8 @@ contains
          why = 'a folder'
          return
       end if
+      inquire (file=path, size=bytes)
+      if (.not. strict .and. bytes == 0) return
       call h5open_f(hdferr)
       call h5eset_auto_f(0, hdferr)
       call h5fis_hdf5_f(path, hdf5_file, hdferr)
