@@ -348,3 +348,28 @@ def test_the_lock_of_a_dead_sweep_is_taken_over(tmp_path: Path, write_spec: Call
     outcome = run_sweep(spec, out, jobs=1, stream=log)
     assert (outcome.ran, outcome.complete) == (1, 4)
     assert f"took over the lock of a sweep that is no longer running (pid {dead.pid} host elsewhere)" in log.getvalue()
+
+
+def test_without_flock_the_pid_in_the_lock_file_decides(tmp_path: Path, write_spec: Callable[..., Path],
+                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    import errno
+    import fcntl
+    import socket
+
+    from beamstops.sweep.runner import FolderLock
+
+    def no_locks(fd: int, operation: int) -> None:
+        raise OSError(errno.ENOLCK, "No locks available")
+
+    monkeypatch.setattr(fcntl, "flock", no_locks)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / ".lock").write_text(f"pid {os.getpid()} host {socket.gethostname()}\n")  # alive: this process
+    with pytest.raises(ValueError, match=f"pid {os.getpid()} host"):
+        FolderLock(out).acquire()
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    (out / ".lock").write_text(f"pid {dead.pid} host {socket.gethostname()}\n")
+    with FolderLock(out) as lock:
+        assert lock.unlocked and lock.stale == f"pid {dead.pid} host {socket.gethostname()}"
+        assert (out / ".lock").read_text().split()[1] == str(os.getpid())

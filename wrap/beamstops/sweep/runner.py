@@ -190,12 +190,16 @@ class FolderLock:
     """The exclusive lock of a sweep's folder: ``flock`` on ``DIR/.lock``, which holds the
     holder's pid and host. :meth:`acquire` raises ValueError naming the holder when another
     process holds it; a lock left by a dead process (the kernel released it) is taken over,
-    and :attr:`stale` then says whose it was."""
+    and :attr:`stale` then says whose it was. On a file system without ``flock`` (ENOLCK,
+    EOPNOTSUPP, ENOSYS) the pid and host in the file decide: a running process of this host,
+    or any process of another host, holds the folder."""
 
     def __init__(self, folder: Path):
         self.path = Path(folder) / LOCK
         self.fd: Optional[int] = None
         self.stale = ""
+        #: The file system refused flock: the lock is the pid in the file only.
+        self.unlocked = False
 
     def acquire(self) -> "FolderLock":
         import fcntl
@@ -205,12 +209,14 @@ class FolderLock:
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as exc:
-            holder = _read_holder(fd) or "its process id is not written yet"
-            os.close(fd)
-            if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
-                raise ValueError(f"{self.path.parent}: another sweep is running into this folder ({holder}); wait "
-                                 "for it to end, or stop it, before running or resuming a sweep here") from None
-            raise ValueError(f"{self.path}: cannot lock the sweep's folder ({exc})") from None
+            holder = _read_holder(fd)
+            if exc.errno in (errno.ENOLCK, errno.EOPNOTSUPP, errno.ENOSYS) and not _alive_here(holder):
+                self.unlocked = True  # a file system without locks: the pid written in the file decides
+            else:
+                os.close(fd)
+                raise ValueError(f"{self.path.parent}: another sweep is running into this folder "
+                                 f"({holder or 'its process id is not written yet'}); wait for it to end, or stop "
+                                 "it, before running or resuming a sweep here") from None
         self.stale = _read_holder(fd)
         os.ftruncate(fd, 0)
         os.pwrite(fd, f"pid {os.getpid()} host {socket.gethostname()}\n".encode(), 0)
@@ -236,6 +242,22 @@ class FolderLock:
 
     def __exit__(self, *exc: Any) -> None:
         self.release()
+
+
+def _alive_here(holder: str) -> bool:
+    """Whether ``pid N host H`` names a running process of this host (unknown hosts: assumed running)."""
+    words = holder.split()
+    if len(words) != 4 or words[0] != "pid" or words[2] != "host":
+        return False
+    if words[3] != socket.gethostname():
+        return True
+    try:
+        os.kill(int(words[1]), 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, ValueError):
+        return True
+    return True
 
 
 def _read_holder(fd: int) -> str:
