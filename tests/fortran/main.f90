@@ -17,6 +17,7 @@ program tester
    use test_scheme, only: collect_scheme
    use test_box_qp, only: collect_box_qp
    use test_stops, only: collect_stops
+   use test_run, only: collect_run
    implicit none
 
    abstract interface
@@ -51,7 +52,8 @@ program tester
       & new_testsuite('scheme', collect_scheme), &
       & new_testsuite('namelist', collect_namelist), &
       & new_testsuite('box_qp', collect_box_qp), &
-      & new_testsuite('stops', collect_stops) &
+      & new_testsuite('stops', collect_stops), &
+      & new_testsuite('run', collect_run) &
       & ]
 
    if (command_argument_count() < 1) call usage()
