@@ -360,7 +360,6 @@ contains
             & summary%message//'; '//output//' is left as it was, the run so far is in '//partial
          call quit(exit_diverged)
       end if
-
    end subroutine run_to_file
 
    !> A write failed: one message, exit status 4; the output is untouched.
