@@ -165,10 +165,10 @@ contains
       call band_matvec(model%stiffness, x, y)
    end function matmul_band
 
-   !> Run from the state's step to the scene's last step, in blocks; fills the summary.
-   !> Between blocks: the divergence check, progress, and every scene%checkpoint_every
-   !> steps the recorder's checkpoint (blocks end on checkpoint steps).
-   subroutine run_scheme(scene, model, state, recorder, summary)
+   !> Run from the state's step to the scene's last step (or to step `until`), in blocks; fills
+   !> the summary. Between blocks: the divergence check and progress. A call that ends at `until`
+   !> before the last step leaves the status 'running': the caller continues with another call.
+   subroutine run_scheme(scene, model, state, recorder, summary, until)
       !> Scene.
       type(scene_type), intent(in) :: scene
       !> Its model.
@@ -179,15 +179,17 @@ contains
       class(recorder_type), intent(inout) :: recorder
       !> Outcome of the run.
       type(run_summary), intent(inout) :: summary
-      integer(ik) :: steps, last, every
+      !> Last step of this call (default: the scene's last).
+      integer(ik), intent(in), optional :: until
+      integer(ik) :: steps, last, final
       real(wp) :: t0, kinetic, cap
       steps = steps_of(scene)
-      every = scene%checkpoint_every
+      final = steps
+      if (present(until)) final = min(steps, until)
       summary%status = status_running
       t0 = thread_cpu_seconds() - state%cpu_seconds
-      do while (state%step <= steps)
-         last = min(steps, state%step + block_steps - 1)
-         if (every > 0) last = min(last, ((state%step - 1)/every + 1)*every)
+      do while (state%step <= final)
+         last = min(final, state%step + block_steps - 1)
          call advance(scene, model, state, recorder, last)
          state%cpu_seconds = thread_cpu_seconds() - t0
          if (recorder%failed) then
@@ -211,9 +213,6 @@ contains
                & 'before t = '//trim(real_text(real(state%step - 1, wp)*model%dt))//' s'
             exit
          end if
-         if (every > 0 .and. state%step <= steps) then
-            if (mod(state%step - 1, every) == 0) call recorder%checkpoint(state)
-         end if
          call recorder%progress(state%step - 1, steps)
       end do
       summary%cpu_seconds = state%cpu_seconds
@@ -221,7 +220,7 @@ contains
       summary%t_final = real(summary%steps, wp)*model%dt
       summary%impacts = state%impacts
       summary%max_violation = state%max_violation
-      if (summary%status == status_running) summary%status = status_complete
+      if (summary%status == status_running .and. state%step > steps) summary%status = status_complete
    end subroutine run_scheme
 
    !> Text of a real for messages.

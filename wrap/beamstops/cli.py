@@ -2,7 +2,11 @@
 
 Each subcommand is a function ``register(subparsers)`` that adds its parser and sets
 ``handler`` (a function of the parsed arguments returning an exit status). To add one,
-write such a function (here or in a module of its own) and list it in :data:`COMMANDS`.
+write such a function (here or in a module of its own) and list it in :data:`COMMANDS`, and
+add its name and one-line help to the table of the program (``python_commands`` in
+src/main.f90), which hands these subcommands to this module: ``beamstops plot ...`` runs
+``main(["plot", ...], prog="beamstops")`` in the Python beside the program
+(tests/python/test_cli.py checks that the two tables agree).
 Errors a user can fix end in one line ``beamstops: error: ...`` and exit status 1.
 """
 
@@ -55,10 +59,10 @@ from .studies.cli import STUDIES  # noqa: E402  (issue 6: converge, work-precisi
 COMMANDS += STUDIES
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(prog: str = "python -m beamstops") -> argparse.ArgumentParser:
     from . import version
 
-    parser = argparse.ArgumentParser(prog="python -m beamstops",
+    parser = argparse.ArgumentParser(prog=prog,
                                      description="beamstops: a beam on a vibrating support between rigid stops.")
     parser.add_argument("-V", "--version", action="version", version=f"beamstops {version()}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
@@ -67,8 +71,17 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: Optional[Sequence[str]] = None) -> int:
-    args = build_parser().parse_args(argv)
+def commands() -> dict[str, str]:
+    """The subcommands and their one-line help, in the order ``--help`` lists them."""
+    parser = build_parser()
+    action = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return {choice.dest: choice.help or "" for choice in action._choices_actions}
+
+
+def main(argv: Optional[Sequence[str]] = None, prog: str = "python -m beamstops") -> int:
+    """Run a subcommand; ``prog`` names the command in messages (``beamstops`` when the
+    program hands a subcommand on)."""
+    args = build_parser(prog).parse_args(argv)
     try:
         return int(args.handler(args))
     except (OSError, ValueError) as exc:
