@@ -176,6 +176,7 @@ amplitude = { start = 0.10, stop = 0.15, step = 0.01 }
     deadline = time.monotonic() + 60
     while not list((out / "points").glob("*.json")) and time.monotonic() < deadline:
         time.sleep(0.02)
+    time.sleep(0.5)  # the sweep takes the point's result after its worker wrote the file (slow when loaded)
     os.killpg(process.pid, signal.SIGTERM)  # a batch system's time limit: the whole job
     _, err = process.communicate(timeout=60)
     assert process.returncode == 130, err
