@@ -10,6 +10,7 @@ module beamstops_model
    use beamstops_hermite, only: element_mass, element_stiffness, hermite_basis, gauss_points, gauss_weights
    use beamstops_band, only: kd, assemble_band, cholesky_factor, cholesky_solve, &
       & largest_eigenvalue_exact, largest_eigenvalue_iterative
+   use beamstops_band_solve, only: band_solver, prepare_solver, band_diagonals, prepare_diagonals
    use beamstops_forcing, only: lift_shape, lift_slope
    use beamstops_contact_span_stops, only: span_stops_type, new_span_stops
    use beamstops_contact_box_qp, only: box_qp_type, new_box_qp
@@ -40,6 +41,10 @@ module beamstops_model
       real(wp), allocatable :: stiffness(:, :)
       !> Cholesky factor U of A = M + dt^2 beta S, band storage (kd+1, n).
       real(wp), allocatable :: factor(:, :)
+      !> The factor of A in the form of the fused substitutions (from factor).
+      type(band_solver) :: solver
+      !> S and M by diagonals (the vectorized products of the time loop).
+      type(band_diagonals) :: stiffness_diagonals, mass_diagonals
       !> Load vector g: G(t) = sin(omega t) g (n).
       real(wp), allocatable :: load(:)
       !> Tip column z = A^{-1} e_tip (n).
@@ -108,6 +113,9 @@ contains
       model%factor = model%mass + model%dt2*model%beta*model%stiffness
       call cholesky_factor(model%factor, 'A = M + dt^2 beta S', error)
       if (allocated(error)) return
+      call prepare_solver(model%factor, model%solver)
+      call prepare_diagonals(model%stiffness, model%stiffness_diagonals)
+      call prepare_diagonals(model%mass, model%mass_diagonals)
       allocate (model%z(n))
       model%z = 0
       model%z(model%tip) = 1

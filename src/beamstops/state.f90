@@ -2,7 +2,6 @@
 !> A run resumes from it (checkpoints), and a recorder may save it.
 module beamstops_state
    use beamstops_kinds, only: wp, ik
-   use beamstops_band_solve, only: band_solver, band_diagonals
    use beamstops_contact_span_stops, only: span_work_type
    implicit none
    private
@@ -45,10 +44,6 @@ module beamstops_state
       real(wp) :: cpu_seconds = 0
       !> Largest violation of the stops so far (m).
       real(wp) :: max_violation = 0
-      !> The factor of A in the form of the fused substitutions (from model%factor).
-      type(band_solver) :: solver
-      !> S and M by diagonals (for the vectorized products of the loop).
-      type(band_diagonals) :: stiffness, mass
       !> Solve with LAPACK's dpbtrs and separate updates: the reference path of the tests.
       logical :: lapack_solve = .false.
    end type state_type
