@@ -8,7 +8,7 @@ module beamstops_band
    implicit none
    private
    public :: kd, assemble_band, band_matvec, band_to_dense, cholesky_factor, cholesky_solve
-   public :: largest_eigenvalue_exact, largest_eigenvalue_iterative
+   public :: largest_eigenvalue_exact, largest_eigenvalue_iterative, generalized_eigenvalues
 
    !> Half-bandwidth of Hermite cubic matrices with (u, u') interleaved.
    integer, parameter :: kd = 3
@@ -145,6 +145,45 @@ contains
       end if
       kappa = w(n)
    end subroutine largest_eigenvalue_exact
+
+   !> All finite eigenvalues kappa of S v = kappa M v, ascending (LAPACK dsbgv; O(n^2): small n
+   !> only). M may be singular with `massless` zero rows (mass redistribution): then the pencil
+   !> is taken the other way round, M v = mu S v (S is positive definite), whose `massless`
+   !> smallest eigenvalues are the zeros of M (infinite kappa) and the others give kappa = 1/mu.
+   subroutine generalized_eigenvalues(s, m, massless, kappa, error)
+      !> Stiffness, band storage (positive definite).
+      real(wp), intent(in) :: s(:, :)
+      !> Mass, band storage (positive definite, or semi-definite with `massless` zero rows).
+      real(wp), intent(in) :: m(:, :)
+      !> Number of zero rows of M.
+      integer, intent(in) :: massless
+      !> The n - massless finite eigenvalues, ascending.
+      real(wp), allocatable, intent(out) :: kappa(:)
+      !> Set when LAPACK fails.
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: sa(:, :), ma(:, :), w(:), work(:)
+      real(wp) :: zdum(1, 1)
+      integer :: n, info
+      n = size(s, 2)
+      allocate (sa, source=s)
+      allocate (ma, source=m)
+      allocate (w(n), work(3*n))
+      if (massless == 0) then
+         call dsbgv('N', 'U', n, kd, kd, sa, kd + 1, ma, kd + 1, w, zdum, 1, work, info)
+      else
+         call dsbgv('N', 'U', n, kd, kd, ma, kd + 1, sa, kd + 1, w, zdum, 1, work, info)
+      end if
+      if (info /= 0) then
+         call fatal_error(error, dsbgv_message(info, n))
+         allocate (kappa(0))
+         return
+      end if
+      if (massless == 0) then
+         kappa = w
+      else
+         kappa = 1/w(n:massless + 1:-1)
+      end if
+   end subroutine generalized_eigenvalues
 
    !> Largest eigenvalue of S v = kappa M v by inverse iteration shifted at an upper bound
    !> `shift` (O(n) per iteration; for meshes too large for dsbgv). Converges to the top of

@@ -51,6 +51,13 @@ contains
          & merge(1.0_wp, 0.0_wp, scene%taylor_start), real(scene%record_every, wp), &
          & real(scene%snapshot_every, wp), real(scene%checkpoint_every, wp)]
       if (stop_count(scene) > 0) values = [values, real(scene%stop_nodes, wp), scene%stop_lower, scene%stop_upper]
+      ! Damping, restitution, mass redistribution (issue 12): only when used, so that the
+      ! checkpoints of scenes without them keep their signature.
+      if (scene%damping_mass /= 0 .or. scene%damping_stiffness /= 0 .or. scene%damping_by_ratio .or. &
+         & scene%restitution /= 0 .or. scene%redistributed_mass) values = [values, scene%damping_mass, &
+         & scene%damping_stiffness, scene%damping_ratio, real(scene%damping_modes, wp), &
+         & merge(1.0_wp, 0.0_wp, scene%damping_by_ratio), scene%restitution, &
+         & merge(1.0_wp, 0.0_wp, scene%redistributed_mass)]
    end function scene_signature
 
    !> Remove a file if it exists.
