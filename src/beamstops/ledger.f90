@@ -8,10 +8,11 @@ module beamstops_ledger
    use beamstops_state, only: state_type
    use beamstops_forcing, only: support_position
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
-      & col_work, col_dissipated
+      & col_work, col_dissipated, col_damped
+   use beamstops_band_solve, only: diagonal_matvec, dot
    implicit none
    private
-   public :: energy, move_on, fill_row, take_snapshot, physical_shape, first_events
+   public :: energy, move_on, damping_loss, fill_row, take_snapshot, physical_shape, first_events
 
 contains
 
@@ -46,6 +47,23 @@ contains
       state%sigma_now = sigma_next
    end subroutine move_on
 
+   !> The energy the Rayleigh damping takes in step n (SPEC 8), once d^n is final:
+   !>   (1/(4 dt)) (d^n + d^{n-1}).C (d^n + d^{n-1}) = (d^n.C d^n + 2 d^n.C d^{n-1} + d^{n-1}.C d^{n-1})/(4 dt)
+   !> >= 0 (C is positive semi-definite), added to state%damped; state%cd becomes C d^n, the
+   !> term of the next step's right-hand side (one product by C a step, no solve).
+   pure subroutine damping_loss(model, state)
+      !> Model (C by diagonals, dt).
+      type(model_type), intent(in) :: model
+      !> State after the step: d = d^n, cd = C d^{n-1} on entry, C d^n on return.
+      type(state_type), intent(inout) :: state
+      real(wp) :: cross, dcd
+      cross = dot(state%d, state%cd)
+      call diagonal_matvec(model%damping_diagonals, state%d, state%cd)
+      dcd = dot(state%d, state%cd)
+      state%damped = state%damped + (dcd + 2*cross + state%dcd_prev)/(4*model%dt)
+      state%dcd_prev = dcd
+   end subroutine damping_loss
+
    !> A record row of step n, the energy column left for the caller.
    pure subroutine fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_step, row)
       !> Scene (mass per length).
@@ -67,6 +85,7 @@ contains
       row(col_energy) = 0
       row(col_work) = scene%mass_per_length*state%work
       row(col_dissipated) = scene%mass_per_length*state%dissipated
+      row(col_damped) = scene%mass_per_length*state%damped
    end subroutine fill_row
 
    !> Snapshot of u^n (= u^{n+1} - d^n) at t_n.

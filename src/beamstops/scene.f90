@@ -127,13 +127,13 @@ contains
       if (scene%snapshot_every > 0) n = steps_of(scene)/scene%snapshot_every + 1
    end function snapshot_count
 
-   !> Bytes of recorded data of a complete run: 8 series of records, 2 per stop along the span,
+   !> Bytes of recorded data of a complete run: 9 series of records, 2 per stop along the span,
    !> and the snapshots.
    pure function output_bytes(scene) result(bytes)
       !> Scene.
       type(scene_type), intent(in) :: scene
       real(wp) :: bytes
-      bytes = 8*(8 + 2*stop_count(scene))*real(record_count(scene), wp) &
+      bytes = 8*(9 + 2*stop_count(scene))*real(record_count(scene), wp) &
          & + 8*real(snapshot_count(scene), wp)*(scene%elements + 2)
    end function output_bytes
 

@@ -11,15 +11,17 @@ module beamstops_scheme
    use beamstops_error, only: error_type
    use beamstops_band, only: band_matvec, cholesky_solve
    use beamstops_band_solve, only: band_solver, forward_substitution, back_substitution, &
-      & forward_substitution_energy, band_diagonals, diagonal_matvec, dot
+      & forward_substitution_energy, band_diagonals, diagonal_matvec, diagonal_row, dot
    use beamstops_state, only: state_type
    use beamstops_clock, only: thread_cpu_seconds
    use beamstops_forcing, only: load_average, support_position, load_rotation, start_loads, next_load
    use beamstops_contact_tip_contact, only: spring_term, tip_step, update
-   use beamstops_contact_span_stops, only: new_span_work, span_contact, span_correction, span_settle, span_energy
+   use beamstops_contact_span_stops, only: new_span_work, span_contact, span_correction, span_settle, span_energy, &
+      & span_energy_massless
    use beamstops_contact_box_qp, only: qp_solved, qp_message
    use beamstops_recorder, only: recorder_type, n_columns, col_energy
-   use beamstops_ledger, only: energy, move_on, fill_row, take_snapshot, first_events
+   use beamstops_ledger, only: energy, move_on, damping_loss, fill_row, take_snapshot, first_events
+   use beamstops_contact_mass_redistribution, only: equilibrium_rows, massless_reaction
    use beamstops_start, only: start_state
    use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running
    implicit none
@@ -114,10 +116,13 @@ contains
       integer(ik), intent(in) :: last
       integer(ik) :: done
       done = last
+      if (model%damped .and. .not. allocated(state%cd)) call resume_damping(model, state)
       if (model%stops%m > 0) then
          call advance_span(scene, model, state, recorder, last, done)
       else if (state%lapack_solve) then
          call advance_reference(scene, model, state, recorder, last)
+      else if (model%damped) then
+         call advance_fused_damped(scene, model, state, recorder, last)
       else
          call advance_fused(scene, model, state, recorder, last)
       end if
@@ -144,9 +149,13 @@ contains
          sigma_next = load_average(step + 1, model%dt, scene%omega, scene%centered_load)
          weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
          state%rhs = model%dt2*(weight*model%load - state%su)
+         if (model%damped) state%rhs = state%rhs - model%dt*state%cd
          state%rhs(tip) = state%rhs(tip) + spring_term(scene, model, state)
+         if (model%redistributed) call equilibrium_rows(model%massless, model%row_scale, sigma_next, model%load, &
+            & state%su, model%stiffness_diagonals, state%d, state%rhs)
          call cholesky_solve(model%factor, state%rhs)
          call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+         if (model%damped) call damping_loss(model, state)
          if (step == next_record) u_old_su = dot_product(state%u, state%su) - dot_product(state%d, state%su)
          call band_matvec(model%stiffness, state%u, state%su)
          if (step == next_record) then
@@ -196,7 +205,7 @@ contains
          weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
          call forward_pass(model%stiffness_diagonals, model%mass_diagonals, model%solver, model%load, state%u, state%d, &
             & model%dt2*weight, model%dt2, spring_term(scene, model, state), pending .or. step == next_record, &
-            & state%su, state%rhs, usu, dsu, dmd)
+            & state%su, state%rhs, usu, dsu, dmd, model%massless, model%row_scale, sigma_next)
          if (pending) then
             ! usu = u^n.S u^n, dsu = d^{n-1}.S u^n and dmd = d^{n-1}.M d^{n-1} complete the energy
             ! of step n-1.
@@ -227,6 +236,66 @@ contains
       end if
    end subroutine advance_fused
 
+   !> advance_fused with Rayleigh damping (SPEC 8): rhs gains -dt C d^{n-1} and each step ends
+   !> with damping_loss (C d^n, the energy the damping took). A loop of its own, so that the
+   !> undamped loop is today's, unchanged (advance branches once per call).
+   subroutine advance_fused_damped(scene, model, state, recorder, last)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      class(recorder_type), intent(inout) :: recorder
+      integer(ik), intent(in) :: last
+      integer(ik) :: step, next_record, next_snapshot
+      integer :: tip
+      real(wp) :: sigma_next, weight, d_tip_prev, u_tip_prev
+      real(wp) :: usu, dsu, u_old_su, dmd, r_prev, row(n_columns)
+      logical :: pending
+      type(load_rotation) :: loads
+
+      tip = model%tip
+      call first_events(scene, state%step, next_record, next_snapshot)
+      pending = .false.
+      u_old_su = 0
+      dmd = 0
+      call start_loads(loads, state%step + 1, model%dt, scene%omega, scene%centered_load)
+      do step = state%step, last
+         sigma_next = loads%sigma
+         call next_load(loads)
+         weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
+         call forward_pass(model%stiffness_diagonals, model%mass_diagonals, model%solver, model%load, state%u, state%d, &
+            & model%dt2*weight, model%dt2, spring_term(scene, model, state), pending .or. step == next_record, &
+            & state%su, state%rhs, usu, dsu, dmd, model%massless, model%row_scale, sigma_next, state%cd, model%dt)
+         if (pending) then
+            ! usu = u^n.S u^n, dsu = d^{n-1}.S u^n and dmd = d^{n-1}.M d^{n-1} complete the energy
+            ! of step n-1.
+            row(col_energy) = scene%mass_per_length*energy(model, dmd, usu, dsu, u_old_su)
+            call recorder%record(row)
+            pending = .false.
+         end if
+         u_old_su = usu
+         call back_substitution(model%solver, state%rhs)
+         call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+         call damping_loss(model, state)
+         if (step == next_record) then
+            next_record = next_record + scene%record_every
+            call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_prev, row)
+            pending = .true.
+         end if
+         if (step == next_snapshot) then
+            next_snapshot = next_snapshot + scene%snapshot_every
+            call take_snapshot(scene, model, state, step, recorder)
+         end if
+      end do
+      ! The state carries S u^{last+1}; it also completes a waiting record.
+      call diagonal_matvec(model%stiffness_diagonals, state%u, state%su)
+      if (pending) then
+         call diagonal_matvec(model%mass_diagonals, state%d, state%scratch)
+         row(col_energy) = scene%mass_per_length*energy(model, dot(state%d, state%scratch), dot(state%u, state%su), &
+            & dot(state%d, state%su), u_old_su)
+         call recorder%record(row)
+      end if
+   end subroutine advance_fused_damped
+
    !> The fused step with stops along the span (SPEC 7; contact/span_stops.f90): the full back
    !> substitution gives x = A^{-1} rhs; the trial values u^n + d^{n-1} + x at the stops against
    !> the bounds of t_{n+1}; only when some are out, the QP on C; then the loop's update, with
@@ -242,7 +311,7 @@ contains
       integer(ik), intent(in) :: last
       integer(ik), intent(out) :: done
       integer(ik) :: step, next_record, next_snapshot
-      integer :: tip, col
+      integer :: tip, col, i
       real(wp) :: sigma_next, weight, c, gd, d_tip_prev, u_tip_prev, r_tip
       real(wp) :: usu, dsu, u_old_su, dmd, r_prev, phi_prev, phi_now, phi_next, row(n_columns)
       logical :: contact, pending, enforce
@@ -266,7 +335,7 @@ contains
          weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
          call forward_pass(model%stiffness_diagonals, model%mass_diagonals, model%solver, model%load, state%u, state%d, &
             & model%dt2*weight, model%dt2, 0.0_wp, pending .or. step == next_record, &
-            & state%su, state%rhs, usu, dsu, dmd)
+            & state%su, state%rhs, usu, dsu, dmd, model%massless, model%row_scale, sigma_next, state%cd, model%dt)
          if (pending) then
             row(col_energy) = scene%mass_per_length*energy(model, dmd, usu, dsu, u_old_su)
             call recorder%record_stops(state%span%record_u, state%span%record_reaction)
@@ -277,7 +346,14 @@ contains
          call back_substitution(model%solver, state%rhs)
          d_tip_prev = state%d(tip)
          u_tip_prev = state%u(tip)
-         call span_contact(model%stops, state%span, state%u, state%d, state%rhs, phi_next, enforce, state%span%info)
+         if (model%redistributed) then
+            do i = 1, model%stops%m
+               state%span%s_u(i) = diagonal_row(model%stiffness_diagonals, state%u, model%stops%unknown(i))
+               state%span%s_d_prev(i) = diagonal_row(model%stiffness_diagonals, state%d, model%stops%unknown(i))
+            end do
+         end if
+         call span_contact(model%stops, state%span, state%u, state%d, state%rhs, phi_next, enforce, state%span%info, &
+            & scene%restitution, phi_prev)
          if (state%span%info /= qp_solved) exit
          call span_correction(model%stops, state%span, model%solver, state%rhs, c, col)
          if (col > 0) then
@@ -288,13 +364,29 @@ contains
          gd = dot(model%load, state%d)
          contact = state%span%contact
          ! The stops on their bounds, the energy they take and the work of the support through them.
-         if (enforce) call span_settle(model%stops, state%span, state%u, state%d, state%max_violation)
+         if (enforce) call span_settle(model%stops, state%span, state%u, state%d, state%max_violation, &
+            & .not. model%redistributed)
          r_prev = state%reaction
          r_tip = 0
-         if (model%stops%tip > 0) r_tip = state%span%lambda(model%stops%tip)/model%dt2
+         if (model%redistributed) then
+            do i = 1, model%stops%m
+               state%span%reaction(i) = massless_reaction(model%beta, weight, model%load(model%stops%unknown(i)), &
+                  & state%span%s_u(i), state%span%s_d_prev(i), &
+                  & diagonal_row(model%stiffness_diagonals, state%d, model%stops%unknown(i)))
+            end do
+            if (model%stops%tip > 0) r_tip = state%span%reaction(model%stops%tip)
+         else
+            if (model%stops%tip > 0) r_tip = state%span%lambda(model%stops%tip)/model%dt2
+         end if
          call move_on(state, contact, gd, weight, r_tip, sigma_next)
-         call span_energy(model%stops, state%span, state%d, model%dt2, phi_next - phi_prev, state%dissipated, &
-            & state%work)
+         if (model%redistributed) then
+            call span_energy_massless(model%stops, state%span, state%d, phi_next - phi_prev, state%dissipated, &
+               & state%work)
+         else
+            call span_energy(model%stops, state%span, state%d, model%dt2, phi_next - phi_prev, state%dissipated, &
+               & state%work)
+         end if
+         if (model%damped) call damping_loss(model, state)
          if (step == next_record) then
             next_record = next_record + scene%record_every
             call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_prev, row)
@@ -302,7 +394,11 @@ contains
             state%span%record_reaction = scene%mass_per_length*state%stop_reaction
             pending = .true.
          end if
-         state%stop_reaction = state%span%lambda/model%dt2
+         if (model%redistributed) then
+            state%stop_reaction = state%span%reaction
+         else
+            state%stop_reaction = state%span%lambda/model%dt2
+         end if
          if (step == next_snapshot) then
             next_snapshot = next_snapshot + scene%snapshot_every
             call take_snapshot(scene, model, state, step, recorder)
@@ -321,6 +417,16 @@ contains
       end if
    end subroutine advance_span
 
+   !> The damping terms of the state after a checkpoint: C d^{n-1} and d^{n-1}.C d^{n-1}, from d
+   !> by the same product as the loop's (so a resumed run continues with the same bits).
+   subroutine resume_damping(model, state)
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      allocate (state%cd(model%n))
+      call diagonal_matvec(model%damping_diagonals, state%d, state%cd)
+      state%dcd_prev = dot(state%d, state%cd)
+   end subroutine resume_damping
+
    !> The work of the stops along the span after a checkpoint (the state holds no QP).
    subroutine resume_span(model, state)
       type(model_type), intent(in) :: model
@@ -333,10 +439,12 @@ contains
       end if
    end subroutine resume_span
 
-   !> Forward pass of a step: su = S u, rhs = a g - b su plus `spring` in the tip row (n-1),
-   !> both vectorized, then the forward substitution (rhs replaced by D^{-2} w); with `energy`,
-   !> usu = u.su, dsu = d.su and dmd = d.M d, accumulated beside the substitution.
-   subroutine forward_pass(stiffness, mass, solver, g, u, d, a, b, spring, energy, su, rhs, usu, dsu, dmd)
+   !> Forward pass of a step: su = S u, rhs = a g - b su (- c_scale cd with damping) plus
+   !> `spring` in the tip row (n-1), the rows of the massless unknowns replaced by their
+   !> equilibrium (mass redistribution), then the forward substitution (rhs replaced by D^{-2} w);
+   !> with `energy`, usu = u.su, dsu = d.su and dmd = d.M d, accumulated beside the substitution.
+   subroutine forward_pass(stiffness, mass, solver, g, u, d, a, b, spring, energy, su, rhs, usu, dsu, dmd, &
+      & massless, row_scale, sigma_next, cd, c_scale)
       !> S and M by diagonals.
       type(band_diagonals), intent(in) :: stiffness, mass
       !> Factor of A.
@@ -353,11 +461,21 @@ contains
       real(wp), intent(out), contiguous :: rhs(:)
       !> u.S u, d.S u and d.M d (when energy).
       real(wp), intent(out) :: usu, dsu, dmd
+      !> The massless unknowns (mass redistribution; empty otherwise).
+      integer, intent(in) :: massless(:)
+      !> Their rows of A over those of S, and sigma_{n+1} (equilibrium_rows).
+      real(wp), intent(in) :: row_scale, sigma_next
+      !> C d^{n-1} (n), absent without damping.
+      real(wp), intent(in), contiguous, optional :: cd(:)
+      !> Its coefficient in rhs (dt).
+      real(wp), intent(in), optional :: c_scale
       integer :: n
       n = solver%n
       call diagonal_matvec(stiffness, u, su)
       rhs = a*g - b*su
+      if (present(cd)) rhs = rhs - c_scale*cd
       rhs(n - 1) = rhs(n - 1) + spring
+      if (size(massless) > 0) call equilibrium_rows(massless, row_scale, sigma_next, g, su, stiffness, d, rhs)
       if (energy) then
          call forward_substitution_energy(solver, mass, u, d, su, rhs, usu, dsu, dmd)
       else

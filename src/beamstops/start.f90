@@ -5,7 +5,8 @@ module beamstops_start
    use beamstops_scene, only: scene_type, law_none, law_signorini, law_compliance
    use beamstops_model, only: model_type
    use beamstops_error, only: error_type, fatal_error
-   use beamstops_band, only: band_matvec, cholesky_factor, cholesky_solve
+   use beamstops_band, only: kd, band_matvec, cholesky_factor, cholesky_solve
+   use beamstops_band_solve, only: diagonal_matvec, dot
    use beamstops_state, only: state_type
    use beamstops_forcing, only: load_average, support_position
    use beamstops_contact_tip_projection, only: project_tip
@@ -43,18 +44,30 @@ contains
       allocate (state%u(n), state%d(n), state%su(n), state%rhs(n), state%scratch(n), state%shape(size(model%x)))
       state%u = model%u0 + model%dt*model%v0
       if (scene%taylor_start) then
-         ! M a0 = G(0) - S u0 + p(u0) e_tip
+         ! M a0 = G(0) - S u0 + p(u0) e_tip - C v0
          allocate (a0(n), su0(n))
          call band_matvec(model%stiffness, model%u0, su0)
          a0 = support_position(0.0_wp, 1.0_wp, scene%omega)*model%load - su0
          if (scene%law == law_compliance) a0(tip) = a0(tip) + &
             & spring_force(model%u0(tip), scene%lower, scene%upper, scene%stiffness_per_mass)
+         if (model%damped) then
+            call band_matvec(model%damping, model%v0, su0)
+            a0 = a0 - su0
+         end if
          mfac = model%mass
+         if (model%redistributed) then
+            ! M^rho: the massless rows and columns are zero; a unit diagonal there leaves the
+            ! others' accelerations and gives the massless ones 0 (their values follow below).
+            mfac(kd + 1, model%massless) = 1
+            a0(model%massless) = 0
+         end if
          call cholesky_factor(mfac, 'M', error)
          if (allocated(error)) return
          call cholesky_solve(mfac, a0)
          state%u = state%u + 0.5_wp*model%dt2*a0
       end if
+      if (model%redistributed) call equilibrium_start(model, load_average(1_ik, model%dt, scene%omega, &
+         & scene%centered_load), state%u)
       if (model%stops%m > 0) then
          call start_span(scene, model, state, error)
          if (allocated(error)) return
@@ -73,6 +86,12 @@ contains
          state%p_now = spring_force(state%u(tip), scene%lower, scene%upper, scene%stiffness_per_mass)
       end if
       if (scene%law /= law_none .and. model%stops%m == 0) state%max_violation = violation(state%u(tip), scene)
+      if (model%damped) then
+         allocate (state%cd(n))
+         call diagonal_matvec(model%damping_diagonals, state%d, state%cd)
+         state%dcd_prev = dot(state%d, state%cd)
+         state%damped = 0
+      end if
       call band_matvec(model%mass, state%d, state%scratch)
       state%energy0 = energy(model, dot_product(state%d, state%scratch), dot_product(state%u, state%su), &
          & dot_product(state%d, state%su), dot_product(model%u0, matmul_band(model, model%u0)))
@@ -110,7 +129,7 @@ contains
       if (scene%law /= law_signorini) return
       state%scratch = 0
       call span_contact(model%stops, state%span, state%u, state%scratch, state%scratch, &
-         & support_position(model%dt, scene%amplitude, scene%omega), .true., state%span%info)
+         & support_position(model%dt, scene%amplitude, scene%omega), .true., state%span%info, 0.0_wp, 0.0_wp)
       if (state%span%info /= qp_solved) then
          call fatal_error(error, 'the start u^1: '//qp_message(state%span%info))
          return
@@ -123,9 +142,30 @@ contains
       end if
       worst = 0
       state%rhs = 0
-      call span_settle(model%stops, state%span, state%u, state%rhs, worst)
+      call span_settle(model%stops, state%span, state%u, state%rhs, worst, .true.)
       state%max_violation = worst
    end subroutine start_span
+
+   !> Mass redistribution: each massless value of u^1 from the equilibrium of its row at t_1,
+   !> (S u^1)_k = sigma_1 g_k, the others fixed (no two massless values share a row of S).
+   pure subroutine equilibrium_start(model, sigma, u)
+      type(model_type), intent(in) :: model
+      real(wp), intent(in) :: sigma
+      real(wp), intent(inout) :: u(:)
+      integer :: i, j, k
+      real(wp) :: others
+      associate (a => model%stiffness_diagonals%a)
+         do i = 1, size(model%massless)
+            k = model%massless(i)
+            others = 0
+            do j = 1, kd
+               if (k - j >= 1) others = others + a(k, j)*u(k - j)
+               if (k + j <= model%n) others = others + a(k + j, j)*u(k + j)
+            end do
+            u(k) = (sigma*model%load(k) - others)/a(k, 0)
+         end do
+      end associate
+   end subroutine equilibrium_start
 
    !> S x as a new array (start-up only).
    function matmul_band(model, x) result(y)

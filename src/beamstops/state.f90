@@ -27,6 +27,11 @@ module beamstops_state
       real(wp) :: p_prev = 0, p_now = 0
       !> Work of the load W_{n-1} and energy taken by the stops D_{n-1}, per unit mass.
       real(wp) :: work = 0, dissipated = 0
+      !> Energy taken by the Rayleigh damping so far, per unit mass (SPEC 8).
+      real(wp) :: damped = 0
+      !> With damping: C d^{n-1} (n; unallocated without damping) and d^{n-1}.C d^{n-1}.
+      real(wp), allocatable :: cd(:)
+      real(wp) :: dcd_prev = 0
       !> Discrete energy E^{1/2} per unit mass (reference for the divergence check).
       real(wp) :: energy0 = 0
       !> Reaction per unit mass of the step that gave u^n (r_{n-1}; recorded with u^n).

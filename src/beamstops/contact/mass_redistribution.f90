@@ -35,9 +35,10 @@ module beamstops_contact_mass_redistribution
    use beamstops_kinds, only: wp
    use beamstops_band, only: kd
    use beamstops_hermite, only: element_mass
+   use beamstops_band_solve, only: band_diagonals, diagonal_row
    implicit none
    private
-   public :: redistributed_element, assemble_redistributed_mass
+   public :: redistributed_element, assemble_redistributed_mass, equilibrium_rows, massless_reaction
 
 contains
 
@@ -100,4 +101,47 @@ contains
          end do
       end do
    end subroutine assemble_redistributed_mass
+
+   !> The right-hand side rows of the massless unknowns: each is stepped as an equilibrium at
+   !> t_{n+1}, (S u^{n+1})_k = sigma_{n+1} g_k (+ the stops' reaction), not as the Newmark row
+   !> (which, massless, has a double root -1 at beta = 1/4: a sawtooth the energy cannot see).
+   !> The row k of A = M^rho + dt^2 beta S is row_scale S_k (its mass row is zero), so with
+   !> u^{n+1} = u^n + d^{n-1} + x and A x = rhs that equation is
+   !>   rhs_k = row_scale (sigma_{n+1} g_k - (S u^n)_k - (S d^{n-1})_k);
+   !> A and z do not change, nor does the projection.
+   pure subroutine equilibrium_rows(massless, row_scale, sigma_next, g, su, stiffness, d, rhs)
+      !> The massless unknowns.
+      integer, intent(in) :: massless(:)
+      !> Their rows of A over those of S (dt^2 beta).
+      real(wp), intent(in) :: row_scale
+      !> Load average sigma_{n+1}.
+      real(wp), intent(in) :: sigma_next
+      !> Load vector, S u^n and d^{n-1} (n).
+      real(wp), intent(in) :: g(:), su(:), d(:)
+      !> S by diagonals.
+      type(band_diagonals), intent(in) :: stiffness
+      !> Right-hand side (n); the rows `massless` replaced.
+      real(wp), intent(inout) :: rhs(:)
+      integer :: i, k
+      do i = 1, size(massless)
+         k = massless(i)
+         rhs(k) = row_scale*(sigma_next*g(k) - (su(k) + diagonal_row(stiffness, d, k)))
+      end do
+   end subroutine equilibrium_rows
+
+   !> The reaction of the step at a massless unknown k, per unit mass, as the residual of the
+   !> scheme's own (Newmark) row there, whose mass term is zero:
+   !>   r_k = (S (u^n + beta (d^n - d^{n-1})))_k - weight g_k,
+   !> from (S u^n)_k, (S d^{n-1})_k and (S d^n)_k. With it the energy identity of SPEC 6 holds
+   !> exactly (E with M^rho): the stops take D^n = -1/2 r_k (d^n_k + d^{n-1}_k). It is zero off
+   !> the stops (the equilibrium rows make the Newmark average of (S u)_k its load), but for
+   !> the load rule's average versus the value at t_{n+1}.
+   pure function massless_reaction(beta, weight, g_k, s_u, s_d_prev, s_d) result(r)
+      !> Newmark beta and the load average weight of the step.
+      real(wp), intent(in) :: beta, weight
+      !> g_k, (S u^n)_k, (S d^{n-1})_k, (S d^n)_k.
+      real(wp), intent(in) :: g_k, s_u, s_d_prev, s_d
+      real(wp) :: r
+      r = s_u + beta*(s_d - s_d_prev) - weight*g_k
+   end function massless_reaction
 end module beamstops_contact_mass_redistribution

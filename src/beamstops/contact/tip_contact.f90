@@ -1,13 +1,17 @@
 !> The contact law at the tip, chosen by the scene: exact projection (Signorini, SPEC 4),
 !> normal compliance (SPEC 5) or none; and the tip step of the time loop built on it (the
 !> update of d and u along z = A^{-1} e_tip and the bookkeeping), shared by the reference
-!> and the fused paths.
+!> and the fused paths. With a restitution coefficient e > 0 the projection acts on the
+!> combination (u^{n+1} + e u^{n-1})/(1 + e) (Paoli-Schatzman, SPEC 9); with mass redistribution
+!> (SPEC 10) the tip is massless, its reaction the residual of its row, and d stays the primary
+!> variable (no exact fix-up of the tip).
 module beamstops_contact_tip_contact
    use beamstops_kinds, only: wp
    use beamstops_scene, only: scene_type, law_none, law_signorini, law_compliance
    use beamstops_model, only: model_type
    use beamstops_state, only: state_type
-   use beamstops_band_solve, only: dot
+   use beamstops_band_solve, only: dot, diagonal_row
+   use beamstops_contact_mass_redistribution, only: massless_reaction
    use beamstops_contact_tip_projection, only: project_tip
    use beamstops_contact_compliance, only: spring_force, solve_spring_tip
    use beamstops_ledger, only: move_on
@@ -59,10 +63,19 @@ contains
       real(wp), intent(out) :: c, tip_value, r_step
       !> Whether the stops act.
       logical, intent(out) :: contact
-      real(wp) :: p_next
+      real(wp) :: p_next, e, u_old
       select case (scene%law)
       case (law_signorini)
-         call project_tip(trial, scene%lower, scene%upper, model%z(model%tip), c, tip_value)
+         if (scene%restitution > 0) then
+            ! (u^{n+1}_tip + e u^{n-1}_tip)/(1+e) in [g1, g2]: the projection of u^{n+1}_tip on the
+            ! bounds (1+e) g - e u^{n-1}_tip (u^{n-1} = u^n - d^{n-1}; the state is still at step n).
+            e = scene%restitution
+            u_old = state%u(model%tip) - state%d(model%tip)
+            call project_tip(trial, (1 + e)*scene%lower - e*u_old, (1 + e)*scene%upper - e*u_old, &
+               & model%z(model%tip), c, tip_value)
+         else
+            call project_tip(trial, scene%lower, scene%upper, model%z(model%tip), c, tip_value)
+         end if
          contact = c /= 0
          r_step = c/model%dt2
       case (law_compliance)
@@ -96,13 +109,19 @@ contains
       real(wp), intent(in) :: weight, sigma_next
       !> u^n_tip, d^{n-1}_tip and the reaction recorded with u^n.
       real(wp), intent(out) :: u_tip_prev, d_tip_prev, r_prev
-      real(wp) :: trial, c, tip_value, r_step
+      real(wp) :: trial, c, tip_value, r_step, s_u, s_d_prev
       logical :: contact
       d_tip_prev = state%d(model%tip)
       u_tip_prev = state%u(model%tip)
+      if (model%redistributed) then
+         s_u = diagonal_row(model%stiffness_diagonals, state%u, model%tip)
+         s_d_prev = diagonal_row(model%stiffness_diagonals, state%d, model%tip)
+      end if
       trial = u_tip_prev + (d_tip_prev + state%rhs(model%tip))
       call contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
       call update(state%rhs, c, model%z, state%d, state%u)
+      if (model%redistributed) r_step = massless_reaction(model%beta, weight, model%load(model%tip), s_u, s_d_prev, &
+         & diagonal_row(model%stiffness_diagonals, state%d, model%tip))
       r_prev = state%reaction
       call close_step(scene, model, state, contact, tip_value, dot(model%load, state%d), weight, r_step, &
          & d_tip_prev, u_tip_prev, sigma_next)
@@ -124,7 +143,7 @@ contains
       real(wp), intent(in) :: tip_value, gd, weight, r_step, d_tip_prev, u_tip_prev, sigma_next
       integer :: tip
       tip = model%tip
-      if (scene%law == law_signorini .and. contact) then
+      if (scene%law == law_signorini .and. contact .and. .not. model%redistributed) then
          ! The tip exactly on the stop, and d^n its exact increment (a tip resting on a stop
          ! then has exactly zero velocity).
          state%u(tip) = tip_value
