@@ -209,6 +209,11 @@ contains
             return
          end if
       end if
+      if (model%redistributed .and. model%damping_b /= 0) then
+         call fatal_error(error, '&stops redistributed_mass = .true. with stiffness-proportional damping (b = '// &
+            & fmt_real(model%damping_b, 6)//' s) is not supported; allowed: &damping damping_mass alone')
+         return
+      end if
       model%damped = model%damping_a /= 0 .or. model%damping_b /= 0
       if (.not. model%damped) return
       model%damping = model%damping_a*model%mass + model%damping_b*model%stiffness

@@ -77,6 +77,12 @@ contains
                & 'allowed: &time beta > 0 (got beta = '//fmt_real(scene%beta)//')')
             return
          end if
+         if (scene%damping_stiffness > 0 .or. scene%damping_by_ratio) then
+            call fatal_error(error, source//': &stops '//key_redistributed//' = .true. with stiffness-proportional '// &
+               & 'damping (&damping '//key_stiffness//' or '//key_ratio//') is not supported; allowed: '// &
+               & key_mass//' alone (C = a M^rho leaves the massless rows undamped)')
+            return
+         end if
          if (scene%law /= law_signorini) then
             call fatal_error(error, source//': &stops '//key_redistributed//' = .true. is out of range for law = '''// &
                & law_name(scene%law)//'''; allowed: law = ''signorini'' (the constrained unknowns lose their mass)')

@@ -13,13 +13,17 @@ program tester
    use test_scheme, only: collect_scheme
    use test_box_qp, only: collect_box_qp
    use test_stops, only: collect_stops
+   use test_damping, only: collect_damping
+   use test_restitution, only: collect_restitution
+   use test_redistribution, only: collect_redistribution
+   use test_physics_checks, only: collect_physics_checks
    implicit none
    character(len=64) :: suite
    type(unittest_type), allocatable :: tests(:)
    integer :: failures
 
    if (command_argument_count() /= 1) then
-      write (error_unit, '(a)') 'usage: tester SUITE (harness, hermite, eigen, projection, energy, order, scheme, namelist, box_qp, stops)'
+      write (error_unit, '(a)') 'usage: tester SUITE (harness, hermite, eigen, projection, energy, order, scheme, namelist, box_qp, stops, damping, restitution, redistribution, physics_checks)'
       error stop 2
    end if
    call get_command_argument(1, suite)
@@ -34,6 +38,10 @@ program tester
    case ('namelist'); call collect_namelist(tests)
    case ('box_qp'); call collect_box_qp(tests)
    case ('stops'); call collect_stops(tests)
+   case ('damping'); call collect_damping(tests)
+   case ('restitution'); call collect_restitution(tests)
+   case ('redistribution'); call collect_redistribution(tests)
+   case ('physics_checks'); call collect_physics_checks(tests)
    case default
       write (error_unit, '(a)') 'tester: unknown suite '''//trim(suite)//''''
       error stop 2
