@@ -19,8 +19,9 @@ module beamstops_forcing
       real(wp) :: sigma = 0, cosine = 0
       !> cos(omega dt), sin(omega dt).
       real(wp) :: cos_step = 1, sin_step = 0
-      !> Time step (s), angular frequency (rad/s) and load rule (centred when true).
+      !> Time step (s) and angular frequency (rad/s).
       real(wp) :: dt = 0, omega = 0
+      !> Load rule: centred when true, the paper's otherwise.
       logical :: centered = .true.
    end type load_rotation
 

@@ -80,8 +80,9 @@ module beamstops_model
       real(wp) :: damping_a = 0, damping_b = 0
       !> Angular frequencies of the two modes of the ratio form (rad/s; 0 otherwise).
       real(wp) :: damping_omega(2) = 0
-      !> C = a M + b S, band storage (kd+1, n), and by diagonals (allocated when damped).
+      !> C = a M + b S, band storage (kd+1, n) (allocated when damped).
       real(wp), allocatable :: damping(:, :)
+      !> C by diagonals (the loop's product C d^n; filled when damped).
       type(band_diagonals) :: damping_diagonals
       !> Mass redistribution (SPEC 10): the constrained unknowns carry no mass.
       logical :: redistributed = .false.

@@ -7,6 +7,7 @@ module test_damping
    use beamstops, only: ik, scene_type, model_type, build_model, state_type, array_recorder, run_summary, &
       & law_none, law_signorini, steps_of
    use beamstops_scheme, only: advance
+   use beamstops_checkpoint, only: write_checkpoint, read_checkpoint, remove_file
    use beamstops_recorder, only: col_t, col_u, col_energy, col_work, col_dissipated, col_damped, n_columns
    implicit none
    private
@@ -22,7 +23,9 @@ contains
          & new_unittest('free decay of mode 1: log decrement 2 pi zeta/sqrt(1-zeta^2) to O(dt^2)', test_decrement), &
          & new_unittest('ratio form: zeta at both chosen modes; one ratio: both equal', test_ratio_form), &
          & new_unittest('balance E - E0 = W - D - damped to round-off (fused and reference paths)', test_balance), &
-         & new_unittest('zero damping: the undamped engine to the bit', test_zero_damping) &
+         & new_unittest('zero damping: the undamped engine to the bit', test_zero_damping), &
+         & new_unittest('stops along the span (tube), damped: balance E - E0 = W - D - damped', test_span_balance), &
+         & new_unittest('a damped run resumed from a checkpoint continues with the same bits', test_resume) &
          & ]
    end subroutine collect_damping
 
@@ -204,4 +207,64 @@ contains
       end do
       call check(error, maxval(abs(b%rows(col_damped, 1:b%filled))), 0.0_wp, 'nothing damped')
    end subroutine test_zero_damping
+
+   subroutine test_span_balance(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(array_recorder) :: rec
+      type(run_summary) :: summary
+      scene%length = 1.5_wp
+      scene%k2 = 2.0e11_wp*1.6881e-10_wp/(8.0e3_wp*1.4923e-5_wp)
+      scene%mass_per_length = 8.0e3_wp*1.4923e-5_wp
+      scene%amplitude = 0.002_wp
+      scene%omega = 40.0_wp
+      scene%elements = 30
+      scene%stop_nodes = [10, 20, 30]
+      scene%stop_lower = [-0.002_wp, -0.002_wp, -0.004_wp]
+      scene%stop_upper = [0.002_wp, 0.002_wp, 0.004_wp]
+      scene%dt = 2.0e-5_wp
+      scene%t_end = 1.0_wp
+      scene%beta = 0.25_wp
+      scene%damping_by_ratio = .true.
+      scene%damping_ratio = [0.02_wp, 0.0_wp]
+      call run_recorded(scene, rec, summary, error)
+      if (allocated(error)) return
+      call note('tube, zeta = 0.02: defect '//real_text(defect(rec))//', damped '// &
+         & real_text(rec%rows(col_damped, rec%filled))//' J, stops '//real_text(rec%rows(col_dissipated, rec%filled))// &
+         & ' J, '//int_text(summary%impacts)//' contact phases')
+      call check(error, summary%impacts > 0, 'the stops act')
+      if (allocated(error)) return
+      call check(error, defect(rec) < 1.0e-10_wp, 'balance within 1e-10 of max |E|')
+   end subroutine test_span_balance
+
+   subroutine test_resume(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: path = 'test_damping_resume.checkpoint'
+      type(scene_type) :: scene
+      type(model_type) :: model
+      type(state_type) :: straight, resumed
+      type(array_recorder) :: a, b
+      integer(ik) :: records, snapshots
+      scene = quiet_scene(8, 5.0e-5_wp, 0.2_wp)
+      scene%amplitude = 0.2_wp
+      scene%law = law_signorini
+      scene%lower = -0.02_wp
+      scene%upper = 0.02_wp
+      scene%damping_mass = 2.0_wp
+      scene%damping_stiffness = 2.0e-4_wp
+      call open_run(scene, model, straight, a, error)
+      if (allocated(error)) return
+      call advance(scene, model, straight, a, 1000_ik)
+      call write_checkpoint(path, scene, straight, a%filled, 0_ik, error)
+      if (allocated(error)) return
+      call read_checkpoint(path, scene, model, resumed, records, snapshots, error)
+      call remove_file(path)
+      if (allocated(error)) return
+      call b%reserve(a%filled + 4000, 0_ik, scene%elements + 1)
+      call advance(scene, model, straight, a, 4000_ik)
+      call advance(scene, model, resumed, b, 4000_ik)
+      call check(error, all(straight%u == resumed%u) .and. all(straight%d == resumed%d), 'u and d to the bit')
+      if (allocated(error)) return
+      call check(error, straight%damped == resumed%damped .and. straight%damped > 0, 'the damped energy to the bit')
+   end subroutine test_resume
 end module test_damping
