@@ -15,7 +15,7 @@ module beamstops_scheme
    use beamstops_state, only: state_type
    use beamstops_clock, only: thread_cpu_seconds
    use beamstops_forcing, only: load_average, support_position, load_rotation, start_loads, next_load
-   use beamstops_contact_tip_contact, only: spring_term, tip_step, update
+   use beamstops_contact_tip_contact, only: spring_term, tip_step, tip_step_massless, update
    use beamstops_contact_span_stops, only: new_span_work, span_contact, span_correction, span_settle, span_energy, &
       & span_energy_massless
    use beamstops_contact_box_qp, only: qp_solved, qp_message
@@ -121,8 +121,8 @@ contains
          call advance_span(scene, model, state, recorder, last, done)
       else if (state%lapack_solve) then
          call advance_reference(scene, model, state, recorder, last)
-      else if (model%damped) then
-         call advance_fused_damped(scene, model, state, recorder, last)
+      else if (model%damped .or. model%redistributed) then
+         call advance_fused_general(scene, model, state, recorder, last)
       else
          call advance_fused(scene, model, state, recorder, last)
       end if
@@ -154,7 +154,11 @@ contains
          if (model%redistributed) call equilibrium_rows(model%massless, model%row_scale, sigma_next, model%load, &
             & state%su, model%stiffness_diagonals, state%d, state%rhs)
          call cholesky_solve(model%factor, state%rhs)
-         call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+         if (model%redistributed) then
+            call tip_step_massless(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+         else
+            call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+         end if
          if (model%damped) call damping_loss(model, state)
          if (step == next_record) u_old_su = dot_product(state%u, state%su) - dot_product(state%d, state%su)
          call band_matvec(model%stiffness, state%u, state%su)
@@ -205,7 +209,7 @@ contains
          weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
          call forward_pass(model%stiffness_diagonals, model%mass_diagonals, model%solver, model%load, state%u, state%d, &
             & model%dt2*weight, model%dt2, spring_term(scene, model, state), pending .or. step == next_record, &
-            & state%su, state%rhs, usu, dsu, dmd, model%massless, model%row_scale, sigma_next)
+            & state%su, state%rhs, usu, dsu, dmd)
          if (pending) then
             ! usu = u^n.S u^n, dsu = d^{n-1}.S u^n and dmd = d^{n-1}.M d^{n-1} complete the energy
             ! of step n-1.
@@ -236,10 +240,12 @@ contains
       end if
    end subroutine advance_fused
 
-   !> advance_fused with Rayleigh damping (SPEC 8): rhs gains -dt C d^{n-1} and each step ends
-   !> with damping_loss (C d^n, the energy the damping took). A loop of its own, so that the
-   !> undamped loop is today's, unchanged (advance branches once per call).
-   subroutine advance_fused_damped(scene, model, state, recorder, last)
+   !> advance_fused with Rayleigh damping (SPEC 8) and/or mass redistribution (SPEC 10): with
+   !> damping, rhs gains -dt C d^{n-1} and each step ends with damping_loss (C d^n, the energy
+   !> the damping took); with massless unknowns, their rows of rhs are their equilibria. A loop
+   !> of its own, so that the loop of the paper's scheme is today's, unchanged (advance branches
+   !> once per call).
+   subroutine advance_fused_general(scene, model, state, recorder, last)
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
       type(state_type), intent(inout) :: state
@@ -274,8 +280,12 @@ contains
          end if
          u_old_su = usu
          call back_substitution(model%solver, state%rhs)
-         call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
-         call damping_loss(model, state)
+         if (model%redistributed) then
+            call tip_step_massless(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+         else
+            call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+         end if
+         if (model%damped) call damping_loss(model, state)
          if (step == next_record) then
             next_record = next_record + scene%record_every
             call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_prev, row)
@@ -294,7 +304,7 @@ contains
             & dot(state%d, state%su), u_old_su)
          call recorder%record(row)
       end if
-   end subroutine advance_fused_damped
+   end subroutine advance_fused_general
 
    !> The fused step with stops along the span (SPEC 7; contact/span_stops.f90): the full back
    !> substitution gives x = A^{-1} rhs; the trial values u^n + d^{n-1} + x at the stops against
@@ -461,10 +471,10 @@ contains
       real(wp), intent(out), contiguous :: rhs(:)
       !> u.S u, d.S u and d.M d (when energy).
       real(wp), intent(out) :: usu, dsu, dmd
-      !> The massless unknowns (mass redistribution; empty otherwise).
-      integer, intent(in) :: massless(:)
-      !> Their rows of A over those of S, and sigma_{n+1} (equilibrium_rows).
-      real(wp), intent(in) :: row_scale, sigma_next
+      !> The massless unknowns (mass redistribution; absent or empty otherwise).
+      integer, intent(in), optional :: massless(:)
+      !> Their rows of A over those of S, and sigma_{n+1} (equilibrium_rows; with massless).
+      real(wp), intent(in), optional :: row_scale, sigma_next
       !> C d^{n-1} (n), absent without damping.
       real(wp), intent(in), contiguous, optional :: cd(:)
       !> Its coefficient in rhs (dt).
@@ -472,10 +482,15 @@ contains
       integer :: n
       n = solver%n
       call diagonal_matvec(stiffness, u, su)
-      rhs = a*g - b*su
-      if (present(cd)) rhs = rhs - c_scale*cd
+      if (present(cd)) then
+         rhs = a*g - b*su - c_scale*cd
+      else
+         rhs = a*g - b*su
+      end if
       rhs(n - 1) = rhs(n - 1) + spring
-      if (size(massless) > 0) call equilibrium_rows(massless, row_scale, sigma_next, g, su, stiffness, d, rhs)
+      if (present(massless)) then
+         if (size(massless) > 0) call equilibrium_rows(massless, row_scale, sigma_next, g, su, stiffness, d, rhs)
+      end if
       if (energy) then
          call forward_substitution_energy(solver, mass, u, d, su, rhs, usu, dsu, dmd)
       else

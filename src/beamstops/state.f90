@@ -29,8 +29,9 @@ module beamstops_state
       real(wp) :: work = 0, dissipated = 0
       !> Energy taken by the Rayleigh damping so far, per unit mass (SPEC 8).
       real(wp) :: damped = 0
-      !> With damping: C d^{n-1} (n; unallocated without damping) and d^{n-1}.C d^{n-1}.
+      !> With damping: C d^{n-1} (n; unallocated without damping).
       real(wp), allocatable :: cd(:)
+      !> With damping: d^{n-1}.C d^{n-1}.
       real(wp) :: dcd_prev = 0
       !> Discrete energy E^{1/2} per unit mass (reference for the divergence check).
       real(wp) :: energy0 = 0

@@ -17,7 +17,7 @@ module beamstops_contact_tip_contact
    use beamstops_ledger, only: move_on
    implicit none
    private
-   public :: spring_term, contact_law, tip_step, close_step, update, violation
+   public :: spring_term, contact_law, tip_step, tip_step_massless, close_step, update, violation
 
 contains
 
@@ -109,28 +109,53 @@ contains
       real(wp), intent(in) :: weight, sigma_next
       !> u^n_tip, d^{n-1}_tip and the reaction recorded with u^n.
       real(wp), intent(out) :: u_tip_prev, d_tip_prev, r_prev
+      real(wp) :: trial, c, tip_value, r_step
+      logical :: contact
+      d_tip_prev = state%d(model%tip)
+      u_tip_prev = state%u(model%tip)
+      trial = u_tip_prev + (d_tip_prev + state%rhs(model%tip))
+      call contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
+      call update(state%rhs, c, model%z, state%d, state%u)
+      r_prev = state%reaction
+      call close_step(scene, model, state, contact, tip_value, dot(model%load, state%d), weight, r_step, &
+         & d_tip_prev, u_tip_prev, sigma_next, .true.)
+   end subroutine tip_step
+
+   !> tip_step with a massless tip (mass redistribution, SPEC 10): the same law and update (the
+   !> tip's row of rhs already holds its equilibrium), then the reaction of the step as the
+   !> residual of the tip's Newmark row (massless_reaction), and no exact fix-up of the tip: d
+   !> stays the primary variable.
+   subroutine tip_step_massless(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      !> Model.
+      type(model_type), intent(in) :: model
+      !> State: rhs holds A^{-1} rhs on entry; u, d and the sums of step n on return.
+      type(state_type), intent(inout) :: state
+      !> Load average weight of the step and sigma_{n+1}.
+      real(wp), intent(in) :: weight, sigma_next
+      !> u^n_tip, d^{n-1}_tip and the reaction recorded with u^n.
+      real(wp), intent(out) :: u_tip_prev, d_tip_prev, r_prev
       real(wp) :: trial, c, tip_value, r_step, s_u, s_d_prev
       logical :: contact
       d_tip_prev = state%d(model%tip)
       u_tip_prev = state%u(model%tip)
-      if (model%redistributed) then
-         s_u = diagonal_row(model%stiffness_diagonals, state%u, model%tip)
-         s_d_prev = diagonal_row(model%stiffness_diagonals, state%d, model%tip)
-      end if
+      s_u = diagonal_row(model%stiffness_diagonals, state%u, model%tip)
+      s_d_prev = diagonal_row(model%stiffness_diagonals, state%d, model%tip)
       trial = u_tip_prev + (d_tip_prev + state%rhs(model%tip))
       call contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
       call update(state%rhs, c, model%z, state%d, state%u)
-      if (model%redistributed) r_step = massless_reaction(model%beta, weight, model%load(model%tip), s_u, s_d_prev, &
+      r_step = massless_reaction(model%beta, weight, model%load(model%tip), s_u, s_d_prev, &
          & diagonal_row(model%stiffness_diagonals, state%d, model%tip))
       r_prev = state%reaction
       call close_step(scene, model, state, contact, tip_value, dot(model%load, state%d), weight, r_step, &
-         & d_tip_prev, u_tip_prev, sigma_next)
-   end subroutine tip_step
+         & d_tip_prev, u_tip_prev, sigma_next, .false.)
+   end subroutine tip_step_massless
 
    !> After the update: the exact tip value (Signorini), the violation of the stops, the energy
    !> taken by the stops, and the sums of every path (beamstops_ledger's move_on).
    pure subroutine close_step(scene, model, state, contact, tip_value, gd, weight, r_step, d_tip_prev, u_tip_prev, &
-      & sigma_next)
+      & sigma_next, exact)
       !> Scene.
       type(scene_type), intent(in) :: scene
       !> Model.
@@ -141,9 +166,11 @@ contains
       logical, intent(in) :: contact
       !> Tip value of the law, g.d^n, weight, reaction, d^{n-1}_tip, u^n_tip and sigma_{n+1}.
       real(wp), intent(in) :: tip_value, gd, weight, r_step, d_tip_prev, u_tip_prev, sigma_next
+      !> Whether a tip in contact is set exactly on the stop (not with a massless tip).
+      logical, intent(in) :: exact
       integer :: tip
       tip = model%tip
-      if (scene%law == law_signorini .and. contact .and. .not. model%redistributed) then
+      if (scene%law == law_signorini .and. contact .and. exact) then
          ! The tip exactly on the stop, and d^n its exact increment (a tip resting on a stop
          ! then has exactly zero velocity).
          state%u(tip) = tip_value
