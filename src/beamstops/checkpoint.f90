@@ -104,6 +104,8 @@ contains
       call write_vector(file, 'su', state%su, ok(5))
       ok(6) = .true.
       if (allocated(state%stop_reaction)) call write_vector(file, 'stop_reaction', state%stop_reaction, ok(6))
+      ! The energy the damping took (its other terms are rebuilt from d on resume).
+      if (ok(6) .and. allocated(state%cd)) call write_vector(file, 'damped', [state%damped], ok(6))
       call h5fclose_f(file, hdferr)
       if (.not. all(ok) .or. hdferr /= 0) then
          call remove_file(temporary)
@@ -130,7 +132,7 @@ contains
       !> Set when the file is unreadable or belongs to another scene.
       type(error_type), allocatable, intent(out) :: error
       real(wp), allocatable :: signature(:)
-      real(wp) :: scalars(n_scalars)
+      real(wp) :: scalars(n_scalars), damped(1)
       integer(hid_t) :: file
       integer :: hdferr, n
       logical :: ok(6)
@@ -154,6 +156,10 @@ contains
       call read_vector(file, 'su', state%su, ok(5))
       ok(6) = .true.
       if (allocated(state%stop_reaction)) call read_vector(file, 'stop_reaction', state%stop_reaction, ok(6))
+      if (ok(6) .and. model%damped) then
+         call read_vector(file, 'damped', damped, ok(6))
+         state%damped = damped(1)
+      end if
       call h5fclose_f(file, hdferr)
       if (.not. all(ok)) then
          call fatal_error(error, path//': the checkpoint is damaged or of another mesh')

@@ -9,10 +9,11 @@ module beamstops_recorder
    implicit none
    private
    public :: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, col_work, col_dissipated
+   public :: col_damped
 
-   !> Columns of a record row.
+   !> Columns of a record row; col_damped: the energy the Rayleigh damping took so far (J).
    integer, parameter :: col_t = 1, col_u = 2, col_v = 3, col_reaction = 4, col_energy = 5, &
-      & col_work = 6, col_dissipated = 7, n_columns = 7
+      & col_work = 6, col_dissipated = 7, col_damped = 8, n_columns = 8
 
    !> Receives records from the time loop.
    type, abstract :: recorder_type
@@ -21,7 +22,7 @@ module beamstops_recorder
       !> What failed, naming the file (when the implementation says).
       character(len=:), allocatable :: message
    contains
-      !> Take one row (t, tip u, tip v, reaction, energy, work, dissipated).
+      !> Take one row (t, tip u, tip v, reaction, energy, work, dissipated, damped).
       procedure(record_interface), deferred :: record
       !> Take one snapshot of the physical displacement at the nodes x_0..x_J.
       procedure(snapshot_interface), deferred :: snapshot

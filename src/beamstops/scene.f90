@@ -71,6 +71,26 @@ module beamstops_scene
       integer :: record_every = 1
       !> &output: record the beam's shape every this many steps (0: never).
       integer :: snapshot_every = 0
+      ! ---- physics of issue 12 (SPEC 8-10): damping, restitution, mass redistribution ----
+      ! Checked by beamstops_physics_checks' validate_physics; the model derives what it uses.
+      !> &damping: Rayleigh coefficient a of C = a M + b S (1/s), >= 0.
+      real(wp) :: damping_mass = 0
+      !> &damping: Rayleigh coefficient b of C = a M + b S (s), >= 0.
+      real(wp) :: damping_stiffness = 0
+      !> &damping: damping ratios zeta at the two modes damping_modes, in [0, 1) (ratio form:
+      !> a and b solve zeta(omega) = a/(2 omega) + b omega/2 at those modes; one ratio given
+      !> means both equal).
+      real(wp) :: damping_ratio(2) = 0
+      !> &damping: the two cantilever modes (1-based, distinct, <= 2J) of the ratio form.
+      integer :: damping_modes(2) = [1, 2]
+      !> &damping: .true. when a and b come from damping_ratio (the ratio form).
+      logical :: damping_by_ratio = .false.
+      !> &stops: Paoli-Schatzman restitution coefficient e in [0, 1] (law 'signorini'; 0: the
+      !> paper's scheme).
+      real(wp) :: restitution = 0
+      !> &stops: .true. to give the constrained displacement unknowns no mass (SPEC 10; beta > 0).
+      logical :: redistributed_mass = .false.
+      ! ---- end of issue 12 ----
    end type scene_type
 
 contains
@@ -109,13 +129,13 @@ contains
       if (scene%snapshot_every > 0) n = steps_of(scene)/scene%snapshot_every + 1
    end function snapshot_count
 
-   !> Bytes of recorded data of a complete run: 8 series of records, 2 per stop along the span,
+   !> Bytes of recorded data of a complete run: 9 series of records, 2 per stop along the span,
    !> and the snapshots.
    pure function output_bytes(scene) result(bytes)
       !> Scene.
       type(scene_type), intent(in) :: scene
       real(wp) :: bytes
-      bytes = 8*(8 + 2*stop_count(scene))*real(record_count(scene), wp) &
+      bytes = 8*(9 + 2*stop_count(scene))*real(record_count(scene), wp) &
          & + 8*real(snapshot_count(scene), wp)*(scene%elements + 2)
    end function output_bytes
 

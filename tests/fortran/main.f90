@@ -20,6 +20,10 @@ program tester
    use test_run, only: collect_run
    use test_shocks, only: collect_shocks
    use test_statistics, only: collect_statistics
+   use test_damping, only: collect_damping
+   use test_restitution, only: collect_restitution
+   use test_redistribution, only: collect_redistribution
+   use test_physics_checks, only: collect_physics_checks
    implicit none
 
    abstract interface
@@ -57,7 +61,11 @@ program tester
       & new_testsuite('stops', collect_stops), &
       & new_testsuite('run', collect_run), &
       & new_testsuite('shocks', collect_shocks), &
-      & new_testsuite('statistics', collect_statistics) &
+      & new_testsuite('statistics', collect_statistics), &
+      & new_testsuite('damping', collect_damping), &
+      & new_testsuite('restitution', collect_restitution), &
+      & new_testsuite('redistribution', collect_redistribution), &
+      & new_testsuite('physics_checks', collect_physics_checks) &
       & ]
 
    if (command_argument_count() < 1) call usage()

@@ -7,7 +7,7 @@
 !> input itself or an existing file that is not a beamstops output.
 !>
 !>   /tip/t, /tip/u, /tip/v, /tip/reaction
-!>   /energy/t, /energy/E, /energy/work, /energy/dissipated
+!>   /energy/t, /energy/E, /energy/work, /energy/dissipated, /energy/damped
 !>   /snapshots/t, /snapshots/x, /snapshots/u   (u: snapshots x (J+1))
 !>   /stops/x, /stops/node, /stops/lower, /stops/upper, /stops/u, /stops/reaction
 !>                                              (stops along the span; u, reaction: records x m)
@@ -22,7 +22,7 @@ module beamstops_recorder_hdf5
    use beamstops_files, only: file_exists, is_directory, same_file, rename_file
    use beamstops_recorder_hdf5_vector, only: write_vector
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
-      & col_work, col_dissipated
+      & col_work, col_dissipated, col_damped
    use beamstops_attributes, only: attribute_list, kind_real, kind_int, kind_logical, kind_text
    use beamstops_output_attributes, only: run_attributes, summary_attributes
    implicit none
@@ -31,14 +31,14 @@ module beamstops_recorder_hdf5
 
    !> Rows buffered before a write (and rows of a chunk).
    integer, parameter :: buffer_rows = 16384
-   integer, parameter :: n_series = 8
+   integer, parameter :: n_series = 9
    character(len=*), parameter :: group_names(3) = [character(len=9) :: 'tip', 'energy', 'snapshots']
    character(len=*), parameter :: series_path(n_series) = [character(len=18) :: '/tip/t', '/tip/u', '/tip/v', &
-      & '/tip/reaction', '/energy/t', '/energy/E', '/energy/work', '/energy/dissipated']
+      & '/tip/reaction', '/energy/t', '/energy/E', '/energy/work', '/energy/dissipated', '/energy/damped']
    character(len=*), parameter :: series_units(n_series) = [character(len=4) :: 's', 'm', 'm/s', 'N', 's', &
-      & 'J', 'J', 'J']
+      & 'J', 'J', 'J', 'J']
    integer, parameter :: series_column(n_series) = [col_t, col_u, col_v, col_reaction, col_t, col_energy, &
-      & col_work, col_dissipated]
+      & col_work, col_dissipated, col_damped]
 
    !> Recorder writing an HDF5 file.
    type, extends(recorder_type) :: hdf5_recorder
