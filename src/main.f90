@@ -374,11 +374,12 @@ contains
       type(scene_type), intent(in) :: scene
       type(run_summary), intent(in) :: summary
       character(len=:), allocatable :: line
-      character(len=512) :: buf
+      character(len=768) :: buf
       write (buf, '(a,": ",i0," steps, ",f0.3," s CPU (",f0.3," us/step), ",i0," impacts, largest violation ",' // &
-         & 'es9.3," m, status ",a)') scene%output_file, summary%steps, summary%cpu_seconds, &
+         & 'es9.3," m; energy (J): support work ",es10.3,", stops ",es10.3,", damping ",es10.3,' // &
+         & '", balance residual ",es9.2,"; status ",a)') scene%output_file, summary%steps, summary%cpu_seconds, &
          & 1.0e6_wp*summary%cpu_seconds/max(1_ik, summary%steps), summary%impacts, summary%max_violation, &
-         & summary%status
+         & summary%work, summary%dissipated, summary%damped, summary%energy_residual, summary%status
       line = trim(buf)
    end function summary_line
 
@@ -406,6 +407,12 @@ contains
       write (output_unit, fa) '      law', law_name(scene%law)
       if (scene%law == law_compliance) write (output_unit, f) '      stiffness_per_mass', scene%stiffness_per_mass, &
          & '1/s^2'
+      write (output_unit, f) '      restitution', scene%restitution, ''
+      write (output_unit, fa) '      mass', trim(merge('redistributed', 'consistent   ', scene%redistributed_mass))
+      if (scene%damping_by_ratio) write (output_unit, '(a,t24,2(es13.6,1x),a,2(1x,i0))') '&damping ratio', &
+         & scene%damping_ratio, 'at modes', scene%damping_modes
+      write (output_unit, f) '      a (C = a M + b S)', model%damping_a, '1/s'
+      write (output_unit, f) '      b', model%damping_b, 's'
       write (output_unit, fi) '&mesh elements', scene%elements, ''
       write (output_unit, f) '&time dt', scene%dt, 's'
       write (output_unit, f) '      t_end', scene%t_end, 's'
@@ -424,5 +431,7 @@ contains
       write (output_unit, fi) 'records', record_count(scene), ''
       write (output_unit, fi) 'snapshots', snapshot_count(scene), ''
       write (output_unit, f) 'output size', output_bytes(scene)/1.0e6_wp, 'MB'
+      write (output_unit, fa) 'energy ledger', 'support work /energy/work, stops /energy/dissipated, damping '// &
+         & '/energy/damped (J, cumulative); balance residual E - E(0) - (work - stops - damping) in the summary'
    end subroutine print_info
 end program beamstops_main

@@ -143,11 +143,11 @@ end subroutine bs_stability
 !> status last; the quoted `scene` text spans lines); status/message report errors that
 !> prevent the run.
 subroutine bs_run(text, source, records, snapshots, nodes, stops, t, tip_u, tip_v, reaction, energy, work, &
-   & dissipated, snapshot_t, snapshot_x, snapshot_u, stops_x, stops_u, stops_reaction, filled, snaps, &
+   & dissipated, damped, snapshot_t, snapshot_x, snapshot_u, stops_x, stops_u, stops_reaction, filled, snaps, &
    & attributes, status, message)
    use beamstops, only: error_type, fatal_error, scene_type, record_count, snapshot_count, stop_count, &
       & model_type, prepare_run, simulate, array_recorder, n_columns, run_summary
-   use beamstops_recorder, only: col_t, col_u, col_v, col_reaction, col_energy, col_work, col_dissipated
+   use beamstops_recorder, only: col_t, col_u, col_v, col_reaction, col_energy, col_work, col_dissipated, col_damped
    use beamstops_attributes, only: attribute_list, attribute_lines
    use beamstops_output_attributes, only: run_attributes, summary_attributes
    use beamstops_wrap_support, only: scene_of, report
@@ -156,7 +156,7 @@ subroutine bs_run(text, source, records, snapshots, nodes, stops, t, tip_u, tip_
    character(len=*), intent(in) :: text, source
    integer(8), intent(in) :: records, snapshots, nodes, stops
    real(8), intent(out) :: t(records), tip_u(records), tip_v(records), reaction(records)
-   real(8), intent(out) :: energy(records), work(records), dissipated(records)
+   real(8), intent(out) :: energy(records), work(records), dissipated(records), damped(records)
    real(8), intent(out) :: snapshot_t(snapshots), snapshot_x(nodes), snapshot_u(nodes, snapshots)
    real(8), intent(out) :: stops_x(stops), stops_u(stops, records), stops_reaction(stops, records)
    integer(8), intent(out) :: filled, snaps
@@ -172,7 +172,7 @@ subroutine bs_run(text, source, records, snapshots, nodes, stops, t, tip_u, tip_
    integer :: stat
    integer(8) :: k
 
-   t = 0; tip_u = 0; tip_v = 0; reaction = 0; energy = 0; work = 0; dissipated = 0
+   t = 0; tip_u = 0; tip_v = 0; reaction = 0; energy = 0; work = 0; dissipated = 0; damped = 0
    snapshot_t = 0; snapshot_x = 0; snapshot_u = 0
    stops_x = 0; stops_u = 0; stops_reaction = 0
    filled = 0; snaps = 0
@@ -210,6 +210,7 @@ subroutine bs_run(text, source, records, snapshots, nodes, stops, t, tip_u, tip_
       energy(k) = recorder%rows(col_energy, k)
       work(k) = recorder%rows(col_work, k)
       dissipated(k) = recorder%rows(col_dissipated, k)
+      damped(k) = recorder%rows(col_damped, k)
    end do
    stops_u(:, :recorder%stops_filled) = recorder%stops_u(:, :recorder%stops_filled)
    stops_reaction(:, :recorder%stops_filled) = recorder%stops_reaction(:, :recorder%stops_filled)

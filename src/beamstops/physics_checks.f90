@@ -9,10 +9,9 @@ module beamstops_physics_checks
    private
    public :: validate_physics
 
-   !> Namelist keys of the fields checked here (the scene's field names).
-   character(len=*), parameter :: key_mass = 'damping_mass', key_stiffness = 'damping_stiffness', &
-      & key_ratio = 'damping_ratio', key_modes = 'damping_modes', key_restitution = 'restitution', &
-      & key_redistributed = 'redistributed_mass'
+   !> Namelist keys of the fields checked here.
+   character(len=*), parameter :: key_mass = 'mass_coefficient', key_stiffness = 'stiffness_coefficient', &
+      & key_ratio = 'ratio', key_modes = 'modes', key_restitution = 'restitution'
 
 contains
 
@@ -73,18 +72,18 @@ contains
       ! &stops redistributed_mass
       if (scene%redistributed_mass) then
          if (.not. (scene%beta > 0)) then
-            call fatal_error(error, source//': &stops '//key_redistributed//' = .true. needs beta > 0; '// &
+            call fatal_error(error, source//': &stops mass = ''redistributed'' needs beta > 0; '// &
                & 'allowed: &time beta > 0 (got beta = '//fmt_real(scene%beta)//')')
             return
          end if
          if (scene%damping_stiffness > 0 .or. scene%damping_by_ratio) then
-            call fatal_error(error, source//': &stops '//key_redistributed//' = .true. with stiffness-proportional '// &
+            call fatal_error(error, source//': &stops mass = ''redistributed'' with stiffness-proportional '// &
                & 'damping (&damping '//key_stiffness//' or '//key_ratio//') is not supported; allowed: '// &
                & key_mass//' alone (C = a M^rho leaves the massless rows undamped)')
             return
          end if
          if (scene%law /= law_signorini) then
-            call fatal_error(error, source//': &stops '//key_redistributed//' = .true. is out of range for law = '''// &
+            call fatal_error(error, source//': &stops mass = ''redistributed'' is out of range for law = '''// &
                & law_name(scene%law)//'''; allowed: law = ''signorini'' (the constrained unknowns lose their mass)')
             return
          end if
@@ -92,7 +91,7 @@ contains
             nodes = scene%stop_nodes
             do i = 1, size(nodes)
                if (any(abs(nodes - nodes(i)) == 1)) then
-                  call fatal_error(error, source//': &stops '//key_redistributed//' = .true. with stops at the '// &
+                  call fatal_error(error, source//': &stops mass = ''redistributed'' with stops at the '// &
                      & 'neighbouring nodes '//fmt_int(int(nodes(i), ik))//' and '// &
                      & fmt_int(int(nodes(i) + merge(1, -1, any(nodes == nodes(i) + 1)), ik))// &
                      & '; allowed: no element between two stops (the element would keep no translation mass)')

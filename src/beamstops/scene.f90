@@ -228,6 +228,15 @@ contains
       end if
       call list%add_text('stops', 'law', law_name(scene%law))
       if (scene%law == law_compliance) call list%add_real('stops', 'stiffness_per_mass', scene%stiffness_per_mass)
+      call list%add_real('stops', 'restitution', scene%restitution)
+      call list%add_text('stops', 'mass', trim(merge('redistributed', 'consistent   ', scene%redistributed_mass)))
+      if (scene%damping_by_ratio) then
+         call list%add_real('damping', 'ratio', 0.0_wp, values=scene%damping_ratio, attribute=.false.)
+      else
+         call list%add_real('damping', 'mass_coefficient', scene%damping_mass)
+         call list%add_real('damping', 'stiffness_coefficient', scene%damping_stiffness)
+      end if
+      call list%add_int('damping', 'modes', 0_ik, values=int(scene%damping_modes, ik), attribute=.false.)
       call list%add_int('mesh', 'elements', int(scene%elements, ik))
       call list%add_real('time', 'dt', scene%dt)
       call list%add_real('time', 't_end', scene%t_end)

@@ -88,8 +88,33 @@ contains
       summary%t_final = real(summary%steps, wp)*model%dt
       summary%impacts = state%impacts
       summary%max_violation = state%max_violation
+      call close_ledger(scene, model, state, summary)
       if (summary%status == status_running .and. state%step > steps) summary%status = status_complete
    end subroutine run_scheme
+
+   !> The energy ledger of the summary (J): work, stops' and damping's losses, and the balance
+   !> residual E^{N+1/2} - E^{1/2} - (work - dissipated - damped), E from u^{N+1}, d^N and S u^{N+1}.
+   subroutine close_ledger(scene, model, state, summary)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      type(run_summary), intent(inout) :: summary
+      real(wp) :: dmd, usu, dsu, dsd, e_end
+      if (.not. allocated(state%d)) return
+      call band_matvec(model%mass, state%d, state%scratch)
+      dmd = dot_product(state%d, state%scratch)
+      call band_matvec(model%stiffness, state%u, state%scratch)
+      usu = dot_product(state%u, state%scratch)
+      dsu = dot_product(state%d, state%scratch)
+      call band_matvec(model%stiffness, state%d, state%scratch)
+      dsd = dot_product(state%d, state%scratch)
+      e_end = energy(model, dmd, usu, dsu, usu - 2*dsu + dsd)
+      summary%work = scene%mass_per_length*state%work
+      summary%dissipated = scene%mass_per_length*state%dissipated
+      summary%damped = scene%mass_per_length*state%damped
+      summary%energy_residual = scene%mass_per_length*((e_end - state%energy0) &
+         & - (state%work - state%dissipated - state%damped))
+   end subroutine close_ledger
 
    !> Text of a real for messages.
    function real_text(x) result(s)

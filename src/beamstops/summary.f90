@@ -25,6 +25,10 @@ module beamstops_summary
       integer(ik) :: impacts = 0
       !> Largest violation of the stops max(u_tip - upper, lower - u_tip, 0) (m).
       real(wp) :: max_violation = 0
+      !> Energy ledger (J): work of the support's load, energy taken by the stops and by the
+      !> damping since t = 0, and the scheme's own balance residual
+      !> E(t_final) - E(0) - (work - dissipated - damped), round-off without contact.
+      real(wp) :: work = 0, dissipated = 0, damped = 0, energy_residual = 0
       !> Records and snapshots written.
       integer(ik) :: records = 0, snapshots = 0
    end type run_summary

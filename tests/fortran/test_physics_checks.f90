@@ -87,39 +87,39 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(scene_type) :: scene
       scene%damping_mass = -1
-      call refused(scene, [character(len=64) :: 'scene.nml: &damping damping_mass = -1', 'allowed: damping_mass >= 0'], &
+      call refused(scene, [character(len=64) :: 'scene.nml: &damping mass_coefficient = -1', 'allowed: mass_coefficient >= 0'], &
          & error)
       if (allocated(error)) return
       scene = scene_type()
       scene%damping_stiffness = -1.0e-4_wp
-      call refused(scene, [character(len=64) :: '&damping damping_stiffness = -0.0001', &
-         & 'allowed: damping_stiffness >= 0'], error)
+      call refused(scene, [character(len=64) :: '&damping stiffness_coefficient = -0.0001', &
+         & 'allowed: stiffness_coefficient >= 0'], error)
       if (allocated(error)) return
       scene = scene_type()
       scene%damping_by_ratio = .true.
       scene%damping_ratio = 0.02_wp
       scene%damping_mass = 1
-      call refused(scene, [character(len=64) :: '&damping damping_ratio is given together with damping_mass', &
+      call refused(scene, [character(len=64) :: '&damping ratio is given together with mass_coefficient', &
          & 'allowed: either the ratios or the coefficients'], error)
       if (allocated(error)) return
       scene%damping_mass = 0
       scene%damping_ratio = [0.02_wp, 1.0_wp]
-      call refused(scene, [character(len=64) :: '&damping damping_ratio = 1 is out of range', &
-         & 'allowed: 0 <= damping_ratio < 1'], error)
+      call refused(scene, [character(len=64) :: '&damping ratio = 1 is out of range', &
+         & 'allowed: 0 <= ratio < 1'], error)
       if (allocated(error)) return
       scene%damping_ratio = [-0.01_wp, 0.0_wp]
-      call refused(scene, [character(len=64) :: 'damping_ratio = -0.01'], error)
+      call refused(scene, [character(len=64) :: 'ratio = -0.01'], error)
       if (allocated(error)) return
       scene%damping_ratio = 0.02_wp
       scene%damping_modes = [2, 2]
-      call refused(scene, [character(len=64) :: '&damping damping_modes = 2, 2 is out of range', &
+      call refused(scene, [character(len=64) :: '&damping modes = 2, 2 is out of range', &
          & 'two distinct modes', '1 <= mode <= 2 elements = 38'], error)
       if (allocated(error)) return
       scene%damping_modes = [0, 1]
-      call refused(scene, [character(len=64) :: 'damping_modes = 0, 1'], error)
+      call refused(scene, [character(len=64) :: 'modes = 0, 1'], error)
       if (allocated(error)) return
       scene%damping_modes = [1, 39]
-      call refused(scene, [character(len=64) :: 'damping_modes = 1, 39'], error)
+      call refused(scene, [character(len=64) :: 'modes = 1, 39'], error)
    end subroutine test_damping
 
    subroutine test_redistributed(error)
@@ -127,17 +127,17 @@ contains
       type(scene_type) :: scene
       scene%redistributed_mass = .true.
       scene%beta = 0
-      call refused(scene, [character(len=64) :: 'scene.nml: &stops redistributed_mass = .true. needs beta > 0'], error)
+      call refused(scene, [character(len=64) :: 'scene.nml: &stops mass = ''redistributed'' needs beta > 0'], error)
       if (allocated(error)) return
       scene%beta = 0.25_wp
       scene%law = law_none
-      call refused(scene, [character(len=64) :: 'redistributed_mass', 'law = ''none''', 'allowed: law = ''signorini'''], &
+      call refused(scene, [character(len=64) :: 'mass = ''redistributed''', 'law = ''none''', 'allowed: law = ''signorini'''], &
          & error)
       if (allocated(error)) return
       scene = scene_type()
       scene%redistributed_mass = .true.
       scene%damping_stiffness = 1.0e-4_wp
-      call refused(scene, [character(len=64) :: 'stiffness-proportional', 'allowed: damping_mass alone'], error)
+      call refused(scene, [character(len=64) :: 'stiffness-proportional', 'allowed: mass_coefficient alone'], error)
       if (allocated(error)) return
       scene = scene_type()
       scene%redistributed_mass = .true.

@@ -160,7 +160,7 @@ def run(scene: Scene, *, allow_incomplete: bool = False) -> Result:
     """
     text = _scene_text(scene)
     records, snapshots, nodes, stops = sizes(scene)
-    (t, tip_u, tip_v, reaction, energy, work, dissipated, snapshot_t, snapshot_x, snapshot_u, stops_x, stops_u,
+    (t, tip_u, tip_v, reaction, energy, work, dissipated, damped, snapshot_t, snapshot_x, snapshot_u, stops_x, stops_u,
      stops_reaction, filled, snaps, attribute_text, status, message) = _engine.bs_run(
         text, b"scene", records, snapshots, nodes, stops)
     _check(status, message)
@@ -169,7 +169,7 @@ def run(scene: Scene, *, allow_incomplete: bool = False) -> Result:
     cut: Callable[[np.ndarray], np.ndarray] = (lambda a: a) if filled == records else (lambda a: a[:filled].copy())
     result = Result(
         t=cut(t), tip_u=cut(tip_u), tip_v=cut(tip_v), reaction=cut(reaction), energy=cut(energy),
-        work=cut(work), dissipated=cut(dissipated),
+        work=cut(work), dissipated=cut(dissipated), damped=cut(damped),
         snapshot_t=snapshot_t[:snaps] if snaps == snapshots else snapshot_t[:snaps].copy(),
         snapshot_x=snapshot_x,
         snapshot_u=np.ascontiguousarray(snapshot_u.T[:snaps]),

@@ -10,6 +10,7 @@ reaction           /tip/reaction          contact reaction (N)
 energy             /energy/E              discrete energy E^{n+1/2} (J)
 work               /energy/work           work of the load (J)
 dissipated         /energy/dissipated     energy taken by the stops (J)
+damped             /energy/damped         energy taken by the Rayleigh damping (J)
 snapshot_t         /snapshots/t           snapshot times (s)
 snapshot_x         /snapshots/x           node abscissae x_0..x_J (m)
 snapshot_u         /snapshots/u           physical displacement ũ(x, t), (snapshots, J+1) (m)
@@ -48,6 +49,7 @@ ARRAYS: dict[str, str] = {
     "energy": "energy/E",
     "work": "energy/work",
     "dissipated": "energy/dissipated",
+    "damped": "energy/damped",
     "snapshot_t": "snapshots/t",
     "snapshot_x": "snapshots/x",
     "snapshot_u": "snapshots/u",
@@ -82,6 +84,7 @@ class Result:
     snapshot_t: np.ndarray
     snapshot_x: np.ndarray
     snapshot_u: np.ndarray
+    damped: np.ndarray = field(default_factory=lambda: np.empty(0))
     stops_x: np.ndarray = field(default_factory=lambda: np.empty(0))
     stops_node: np.ndarray = field(default_factory=lambda: np.empty(0))
     stops_lower: np.ndarray = field(default_factory=lambda: np.empty(0))
