@@ -202,6 +202,29 @@ def test_animation_writes_a_gif_of_at_most_200_frames(tmp_path: Path) -> None:
     assert list(frame_indices(601, 200)[[0, -1]]) == [0, 600] and frame_indices(601, 200).size == 200
 
 
+def test_animation_with_stops_along_the_span_marks_the_contacts(tmp_path: Path) -> None:
+    from PIL import Image
+
+    from beamstops.animation import _contacts
+
+    span = beamstops.run(Scene(length=1.5, elements=30, amplitude=0.002, omega=40.0, beta=0.25, dt=2e-5, t_end=0.3,
+                               nodes=(10, 20, 30), lower=(-0.002, -0.002, -0.004), upper=(0.002, 0.002, 0.004),
+                               snapshot_every=100))
+    acting = np.array([_contacts(span, i) for i in range(span.snapshot_t.size)])
+    assert acting.shape == (span.snapshot_t.size, 3) and acting.any()
+    rows = np.searchsorted(span.t, span.snapshot_t)
+    np.testing.assert_array_equal(acting, span.stops_reaction[rows] != 0)
+    path = plots.save(span, tmp_path / "span.gif", kind="animation", dpi=40, frames=20)
+    with Image.open(path) as gif:
+        assert gif.n_frames == 20
+
+
+@pytest.mark.skipif(not __import__("shutil").which("ffmpeg"), reason="ffmpeg is not installed")
+def test_animation_writes_mp4_with_ffmpeg(result: beamstops.Result, tmp_path: Path) -> None:
+    path = plots.save(result, tmp_path / "beam.mp4", kind="animation", dpi=40, frames=10)
+    assert path.stat().st_size > 1000 and path.read_bytes()[4:8] == b"ftyp"
+
+
 def test_animation_format_errors(result: beamstops.Result, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     from matplotlib import animation
 

@@ -3,7 +3,7 @@ the checks that a plot's data is there (with the message saying how to get it)."
 
 from __future__ import annotations
 
-from typing import Optional
+from typing import Any, Optional
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -14,8 +14,8 @@ from .result import Result
 __all__ = ["LINE", "STOP", "envelope", "new_axes", "title", "tip_stops", "stop_geometry", "placeholder",
            "NO_SNAPSHOTS", "need_records", "need_snapshots", "need_impacts"]
 
-LINE = {"color": "k", "linewidth": 0.6}
-STOP = {"color": "tab:red", "linewidth": 0.8, "linestyle": "--"}
+LINE: dict[str, Any] = {"color": "k", "linewidth": 0.6}
+STOP: dict[str, Any] = {"color": "tab:red", "linewidth": 0.8, "linestyle": "--"}
 # Above this many points a series is drawn through its per-bin minima and maxima:
 # the picture is the same at screen resolution, and drawing stays fast.
 DRAW_POINTS = 20000

@@ -59,7 +59,7 @@ def _histograms(ax: Axes, result: Result, values: np.ndarray, keep: np.ndarray, 
         edges = np.histogram_bin_edges(values[keep], bins=60)
     for label, mask in _groups(result, keep):
         if mask.any():
-            ax.hist(values[mask], bins=edges, histtype="step", linewidth=1.0, label=f"{label} ({mask.sum()})")
+            ax.hist(values[mask], bins=edges.tolist(), histtype="step", linewidth=1.0, label=f"{label} ({mask.sum()})")
     ax.set_xlabel(xlabel)
     ax.set_ylabel("shocks")
     ax.legend(fontsize="small", loc="best")
