@@ -14,7 +14,7 @@ import pytest
 import synthetic
 import beamstops
 from beamstops import Statistic
-from beamstops.observations import IMPACT_FIELDS, STATISTIC_NAMES
+from beamstops.observations import IMPACT_FIELDS, IMPACT_UNITS, STATISTIC_NAMES
 
 
 @pytest.fixture
@@ -47,6 +47,7 @@ def test_load_round_trips_impacts_and_statistics(logged: Path) -> None:
     assert len(result.statistics["power"]) == 2 and len(result.statistics["tip_histogram_edges"]) == 21
     assert result.statistics_attrs == {"transient": 0.25, "batches": 8, "bins": 20, "rest_time": 1e-3}
     assert "shocks=25" in repr(result)
+    _check_layout(result, stops=2)
 
 
 def test_fixed_length_text_attributes_as_fortran_writes_them(tmp_path: Path) -> None:
@@ -153,3 +154,44 @@ def test_frames_without_pandas_say_what_to_install(logged: Path, monkeypatch: py
         result.impacts_frame()
     with pytest.raises(ImportError, match=r"statistics_frame\(\) needs pandas"):
         result.statistics_frame()
+
+
+def _check_layout(result: beamstops.Result, stops: int) -> None:
+    """What the contract says of the groups, on whatever the engine wrote."""
+    if result.impacts:
+        assert set(result.impacts) == set(IMPACT_FIELDS)
+        assert len({a.size for a in result.impacts.values()}) == 1
+        if result.shocks:
+            assert set(np.unique(result.impacts["stop"])) <= set(range(1, stops + 1))
+            assert set(np.unique(result.impacts["side"])) <= {-1.0, 1.0}
+            assert np.all(result.impacts["t_end"] > result.impacts["t_start"])
+    if result.statistics:
+        assert set(result.statistics) <= set(STATISTIC_NAMES)
+        bins = int(result.statistics_attrs["bins"])
+        counts = {"stop": stops, "tip": 1, "run": 1, "bin": bins, "edge": bins + 1}
+        for name, stat in result.statistics.items():
+            assert stat.axis in counts, (name, stat.axis)
+            assert len(stat) == counts[stat.axis], name
+        assert {"transient", "batches", "bins", "rest_time"} <= set(result.statistics_attrs)
+
+
+def test_the_engine_output_follows_the_layout(program: str, tmp_path: Path) -> None:
+    """Live once the engine writes /impacts and /statistics (skipped before)."""
+    import subprocess
+
+    from beamstops import Scene
+
+    Scene(t_end=0.5, file="out.h5").to_namelist(tmp_path / "scene.nml")
+    done = subprocess.run([program, "run", "scene.nml"], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    result = beamstops.load(tmp_path / "out.h5")
+    memory = beamstops.run(Scene(t_end=0.5))
+    if not (result.impacts or result.statistics or memory.impacts or memory.statistics):
+        pytest.skip("this engine writes no /impacts or /statistics yet")
+    _check_layout(result, 1)
+    _check_layout(memory, 1)
+    for name in result.impacts:
+        np.testing.assert_array_equal(result.impacts[name], memory.impacts.get(name, result.impacts[name]))
+    with h5py.File(tmp_path / "out.h5") as f:
+        for name in f.get("impacts", {}):
+            assert f["impacts"][name].attrs["units"] in (IMPACT_UNITS[name], IMPACT_UNITS[name].encode())
