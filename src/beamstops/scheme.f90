@@ -81,6 +81,7 @@ contains
                & 'before t = '//trim(real_text(real(state%step - 1, wp)*model%dt))//' s'
             exit
          end if
+         if (state%observer%active) call state%observer%drain()
          call recorder%progress(state%step - 1, steps)
       end do
       summary%cpu_seconds = state%cpu_seconds
@@ -88,8 +89,13 @@ contains
       summary%t_final = real(summary%steps, wp)*model%dt
       summary%impacts = state%impacts
       summary%max_violation = state%max_violation
+      summary%contact_phases = state%impacts
       call close_ledger(scene, model, state, summary)
       if (summary%status == status_running .and. state%step > steps) summary%status = status_complete
+      if (state%observer%active .and. summary%status /= status_running) then
+         call state%observer%finish(summary%shocks, summary%statistics)
+         summary%impacts = state%observer%shocks%shock_count()
+      end if
    end subroutine run_scheme
 
    !> The energy ledger of the summary (J): work, stops' and damping's losses, and the balance
@@ -183,6 +189,8 @@ contains
          else
             call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
          end if
+         if (state%observer%active) call state%observer%tip(real(step + 1, wp)*model%dt, state%u(tip), &
+            & state%reaction, state%dissipated)
          if (model%damped) call damping_loss(model, state)
          if (step == next_record) u_old_su = dot_product(state%u, state%su) - dot_product(state%d, state%su)
          call band_matvec(model%stiffness, state%u, state%su)
@@ -244,6 +252,8 @@ contains
          u_old_su = usu
          call back_substitution(model%solver, state%rhs)
          call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+         if (state%observer%active) call state%observer%tip(real(step + 1, wp)*model%dt, state%u(tip), &
+            & state%reaction, state%dissipated)
          if (step == next_record) then
             next_record = next_record + scene%record_every
             call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_prev, row)
@@ -309,6 +319,8 @@ contains
          else
             call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
          end if
+         if (state%observer%active) call state%observer%tip(real(step + 1, wp)*model%dt, state%u(tip), &
+            & state%reaction, state%dissipated)
          if (model%damped) call damping_loss(model, state)
          if (step == next_record) then
             next_record = next_record + scene%record_every
@@ -433,6 +445,9 @@ contains
          else
             state%stop_reaction = state%span%lambda/model%dt2
          end if
+         if (state%observer%active) call state%observer%span(real(step + 1, wp)*model%dt, &
+            & state%u(model%stops%unknown) + model%stops%lift*phi_next, state%stop_reaction, state%u(tip), &
+            & state%dissipated)
          if (step == next_snapshot) then
             next_snapshot = next_snapshot + scene%snapshot_every
             call take_snapshot(scene, model, state, step, recorder)
