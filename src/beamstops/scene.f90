@@ -71,6 +71,10 @@ module beamstops_scene
       integer :: record_every = 1
       !> &output: record the beam's shape every this many steps (0: never).
       integer :: snapshot_every = 0
+      ! ---- reduced (modal) models (SPEC 11, issue 14; beamstops_reduced) ----
+      !> &mesh: fixed-interface modes r of a reduced (Craig-Bampton) model; 0: the full model.
+      integer :: modes = 0
+      ! ---- end reduced ----
    end type scene_type
 
 contains

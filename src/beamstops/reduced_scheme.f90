@@ -1,0 +1,503 @@
+!> The time loop of a reduced (modal) model (SPEC 11; beamstops_reduced): the paper's scheme in
+!> increment form on q = (modal amplitudes, stop values),
+!>   A_r (d^n - d^{n-1}) = dt^2 (G^n l_r - S_r q^n),  q^{n+1} = q^n + d^n,
+!> with the load rules, starts, contact laws and energy bookkeeping of the full loop (scheme.f90):
+!> the tip projection (Lemma 4.1 with z_r = A_r^{-1} e_tip), the compliance spring at the tip, the
+!> box QP of the stops along the span on C_r = P_r^T A_r^{-1} P_r, or none. The stops are physical
+!> coordinates of q, so the laws are exact; T being a change of basis, the energy
+!>   E^{n+1/2} = 1/2 d^T M_r d/dt^2 + 1/2 [beta q^{n+1} S_r q^{n+1} + beta q^n S_r q^n
+!>               + (1 - 2 beta) q^n S_r q^{n+1}]
+!> is the full model's energy of u = T q, and its balance (SPEC 6) holds as in the full loop.
+!> A step costs O(r m + m^2) (the block solve of A_r and S_r q): the modal block is diagonal.
+!> Records go to the same recorder interface, snapshots expanded to the nodes (u = T q).
+!> The loop allocates nothing and writes nothing itself.
+module beamstops_reduced_scheme
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use beamstops_kinds, only: wp, ik
+   use beamstops_error, only: error_type, fatal_error
+   use beamstops_scene, only: scene_type, steps_of, law_none, law_signorini, law_compliance
+   use beamstops_reduced, only: reduced_model_type, block_solve, reduced_stiffness_product, reduced_mass_product
+   use beamstops_clock, only: thread_cpu_seconds
+   use beamstops_forcing, only: load_average, support_position
+   use beamstops_contact_tip_projection, only: project_tip
+   use beamstops_contact_compliance, only: spring_force, solve_spring_tip
+   use beamstops_contact_span_stops, only: span_work_type, new_span_work, span_contact, span_settle, span_energy
+   use beamstops_contact_box_qp, only: qp_solved, qp_message
+   use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
+      & col_work, col_dissipated
+   use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running
+   implicit none
+   private
+   public :: reduced_state_type, start_reduced, advance_reduced, run_reduced, simulate_reduced, reduced_block_steps
+
+   !> Steps between progress reports and divergence checks.
+   integer(ik), parameter :: reduced_block_steps = 8192_ik
+
+   !> Everything the reduced loop carries from step n to step n + 1.
+   type :: reduced_state_type
+      !> Index n of the next step (the step that computes q^{n+1}).
+      integer(ik) :: step = 1
+      !> q^n and d^{n-1} = q^n - q^{n-1} (r + m).
+      real(wp), allocatable :: q(:), d(:)
+      !> S_r q^n, and the right-hand side / increment of a step (r + m).
+      real(wp), allocatable :: sq(:), x(:)
+      !> Snapshot buffer: physical displacement at the nodes x_0..x_J (J + 1).
+      real(wp), allocatable :: shape(:)
+      !> Load averages sigma_{n-1}, sigma_n.
+      real(wp) :: sigma_prev = 0, sigma_now = 0
+      !> l_r . d^{n-1}.
+      real(wp) :: gd_prev = 0
+      !> Spring forces p(u^{n-1}), p(u^n) at the tip (compliance).
+      real(wp) :: p_prev = 0, p_now = 0
+      !> Work of the load and energy taken by the stops so far, per unit mass.
+      real(wp) :: work = 0, dissipated = 0
+      !> E^{1/2} per unit mass (reference of the divergence check).
+      real(wp) :: energy0 = 0
+      !> Reaction per unit mass at the tip of the step that gave q^n.
+      real(wp) :: reaction = 0
+      !> The same for each stop along the span (m; unallocated without them).
+      real(wp), allocatable :: stop_reaction(:)
+      !> Stops along the span: the program on C_r and its work arrays.
+      type(span_work_type) :: span
+      !> Whether the previous step was in contact.
+      logical :: in_contact = .false.
+      !> Impacts so far.
+      integer(ik) :: impacts = 0
+      !> CPU time of the loop so far (s).
+      real(wp) :: cpu_seconds = 0
+      !> Largest violation of the stops so far (m).
+      real(wp) :: max_violation = 0
+   end type reduced_state_type
+
+contains
+
+   !> Run a reduced model from t = 0 to t_end, feeding `recorder` (the entry run.f90 dispatches to
+   !> when scene%modes > 0, with the model from prepare_reduced).
+   subroutine simulate_reduced(scene, reduced, recorder, summary, error)
+      !> Validated scene.
+      type(scene_type), intent(in) :: scene
+      !> Its reduced model (prepare_reduced).
+      type(reduced_model_type), intent(in) :: reduced
+      !> Receives records and snapshots.
+      class(recorder_type), intent(inout) :: recorder
+      !> Outcome.
+      type(run_summary), intent(out) :: summary
+      !> Set when the run cannot start.
+      type(error_type), allocatable, intent(out) :: error
+      type(reduced_state_type) :: state
+      call start_reduced(scene, reduced, state, recorder, error)
+      if (allocated(error)) return
+      call run_reduced(scene, reduced, state, recorder, summary)
+   end subroutine simulate_reduced
+
+   !> Start: q^0 = q0 and q^1 by the Taylor start (M_r a0 = G(0) l_r - S_r q0 + p(u0_tip) e_tip) or
+   !> the Euler start, projected into K; hands the record (and snapshot) of t = 0 to the recorder.
+   subroutine start_reduced(scene, reduced, state, recorder, error)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      !> Its reduced model.
+      type(reduced_model_type), intent(in) :: reduced
+      !> State at n = 1 on return.
+      type(reduced_state_type), intent(out) :: state
+      !> Receives the record of t = 0.
+      class(recorder_type), intent(inout) :: recorder
+      !> Set when the start's contact problem fails.
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: c, tip_value, row(n_columns), dt
+      integer :: s, pt
+
+      s = reduced%size
+      dt = reduced%dt
+      pt = tip_coordinate(reduced)
+      allocate (state%q(s), state%d(s), state%sq(s), state%x(s), state%shape(size(reduced%x)))
+      state%q = reduced%q0 + dt*reduced%v0
+      if (scene%taylor_start) then
+         call reduced_stiffness_product(reduced, reduced%q0, state%sq)
+         state%x = support_position(0.0_wp, 1.0_wp, scene%omega)*reduced%load - state%sq
+         if (scene%law == law_compliance .and. pt > 0) state%x(pt) = state%x(pt) + &
+            & spring_force(reduced%q0(pt), scene%lower, scene%upper, scene%stiffness_per_mass)
+         call block_solve(reduced%m_solver, state%x)
+         state%q = state%q + 0.5_wp*reduced%dt2*state%x
+      end if
+      if (reduced%stops%m > 0) then
+         call start_span(scene, reduced, state, error)
+         if (allocated(error)) return
+      else if (scene%law == law_signorini) then
+         call project_tip(state%q(pt), scene%lower, scene%upper, reduced%z(pt, reduced%tip_stop), c, tip_value)
+         state%q = state%q + c*reduced%z(:, reduced%tip_stop)
+         state%q(pt) = tip_value
+      end if
+      state%d = state%q - reduced%q0
+      state%sigma_prev = load_average(0_ik, dt, scene%omega, scene%centered_load)
+      state%sigma_now = load_average(1_ik, dt, scene%omega, scene%centered_load)
+      state%gd_prev = dot_product(reduced%load, state%d)
+      if (scene%law == law_compliance .and. pt > 0) then
+         state%p_prev = spring_force(reduced%q0(pt), scene%lower, scene%upper, scene%stiffness_per_mass)
+         state%p_now = spring_force(state%q(pt), scene%lower, scene%upper, scene%stiffness_per_mass)
+      end if
+      if (scene%law /= law_none .and. reduced%stops%m == 0) state%max_violation = violation(state%q(pt), scene)
+      call reduced_stiffness_product(reduced, reduced%q0, state%x)
+      call reduced_stiffness_product(reduced, state%q, state%sq)
+      state%energy0 = energy(reduced, reduced_mass_product(reduced, state%d), dot_product(state%q, state%sq), &
+         & dot_product(state%d, state%sq), dot_product(reduced%q0, state%x))
+      row = 0
+      row(col_u) = dot_product(reduced%tip_row, reduced%q0)
+      row(col_v) = dot_product(reduced%tip_row, reduced%v0)
+      row(col_energy) = scene%mass_per_length*state%energy0
+      if (reduced%stops%m > 0) then
+         state%span%record_u = reduced%q0(reduced%r + 1:) + reduced%stops%lift*support_position(0.0_wp, &
+            & scene%amplitude, scene%omega)
+         state%span%record_reaction = 0
+         call recorder%record_stops(state%span%record_u, state%span%record_reaction)
+      end if
+      call recorder%record(row)
+      if (scene%snapshot_every > 0) then
+         call physical_shape(reduced, reduced%q0, 0.0_wp, scene, state%shape)
+         call recorder%snapshot(0.0_wp, state%shape)
+      end if
+      state%step = 1
+   end subroutine start_reduced
+
+   !> The stops along the span at the start: their work arrays, and q^1 projected on the bounds of
+   !> t_1 (the QP on the trial values of q^1 at the stops).
+   subroutine start_span(scene, reduced, state, error)
+      type(scene_type), intent(in) :: scene
+      type(reduced_model_type), intent(in) :: reduced
+      type(reduced_state_type), intent(inout) :: state
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: c, worst
+      integer :: col
+      allocate (state%stop_reaction(reduced%stops%m))
+      state%stop_reaction = 0
+      call new_span_work(state%span, reduced%stops, error)
+      if (allocated(error)) return
+      if (scene%law /= law_signorini) return
+      state%x = 0
+      call span_contact(reduced%stops, state%span, state%q, state%x, state%x, &
+         & support_position(reduced%dt, scene%amplitude, scene%omega), .true., state%span%info)
+      if (state%span%info /= qp_solved) then
+         call fatal_error(error, 'the start q^1: '//qp_message(state%span%info))
+         return
+      end if
+      call correction(reduced, state%span, state%x, c, col)
+      if (col > 0) then
+         state%q = state%q + c*reduced%z(:, col)
+      else
+         state%q = state%q + state%x
+      end if
+      worst = 0
+      state%x = 0
+      call span_settle(reduced%stops, state%span, state%q, state%x, worst)
+      state%max_violation = worst
+   end subroutine start_span
+
+   !> Run from the state's step to the scene's last step in blocks; between blocks the
+   !> divergence check and progress (no checkpoints: validate_reduced refuses them). Fills the
+   !> summary.
+   subroutine run_reduced(scene, reduced, state, recorder, summary)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      !> Its reduced model.
+      type(reduced_model_type), intent(in) :: reduced
+      !> State (from start_reduced), advanced to the end.
+      type(reduced_state_type), intent(inout) :: state
+      !> Receives the records.
+      class(recorder_type), intent(inout) :: recorder
+      !> Outcome of the run.
+      type(run_summary), intent(inout) :: summary
+      integer(ik) :: steps, last, done
+      real(wp) :: t0, kinetic, cap
+      steps = steps_of(scene)
+      summary%status = status_running
+      t0 = thread_cpu_seconds() - state%cpu_seconds
+      do while (state%step <= steps)
+         last = min(steps, state%step + reduced_block_steps - 1)
+         call advance_reduced(scene, reduced, state, recorder, last, done)
+         state%cpu_seconds = thread_cpu_seconds() - t0
+         if (recorder%failed) then
+            summary%status = status_failed
+            summary%message = 'the recorder could not write'
+            exit
+         end if
+         if (state%span%info /= qp_solved) then
+            summary%status = status_failed
+            summary%message = qp_message(state%span%info)//' at t = '// &
+               & trim(real_text(real(state%step, wp)*reduced%dt))//' s'
+            exit
+         end if
+         kinetic = 0.5_wp*reduced_mass_product(reduced, state%d)/reduced%dt2
+         cap = 1.0e8_wp*(0.5_wp*scene%length*(scene%amplitude*scene%omega)**2 + abs(state%energy0) &
+            & + abs(state%work) + abs(state%dissipated))
+         if (.not. ieee_is_finite(kinetic) .or. kinetic > cap) then
+            summary%status = status_diverged
+            summary%message = 'the solution blew up (kinetic energy beyond 1e8 times the energy supplied) '// &
+               & 'before t = '//trim(real_text(real(state%step - 1, wp)*reduced%dt))//' s'
+            exit
+         end if
+         call recorder%progress(state%step - 1, steps)
+      end do
+      summary%cpu_seconds = state%cpu_seconds
+      summary%steps = state%step - 1
+      summary%t_final = real(summary%steps, wp)*reduced%dt
+      summary%impacts = state%impacts
+      summary%max_violation = state%max_violation
+      if (summary%status == status_running) summary%status = status_complete
+   end subroutine run_reduced
+
+   !> Advance from state%step through step `last` (computing q^{last+1}), recording on the way.
+   !> `done` is the last step done: `last`, unless the QP of a step fails (state%span%info).
+   subroutine advance_reduced(scene, reduced, state, recorder, last, done)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      !> Its reduced model.
+      type(reduced_model_type), intent(in) :: reduced
+      !> State, advanced.
+      type(reduced_state_type), intent(inout) :: state
+      !> Receives the records.
+      class(recorder_type), intent(inout) :: recorder
+      !> Last step to do.
+      integer(ik), intent(in) :: last
+      !> Last step done.
+      integer(ik), intent(out) :: done
+      integer(ik) :: step, next_record, next_snapshot
+      integer :: pt, col, s, i
+      real(wp) :: sigma_next, weight, c, gd, tip_value, r_step, r_prev, old_tip, old_dtip
+      real(wp) :: u_tip_prev, d_tip_prev, u_old_su, phi_prev, phi_now, phi_next, dt2, row(n_columns)
+      logical :: contact, recording, span, enforce
+
+      s = reduced%size
+      dt2 = reduced%dt2
+      pt = tip_coordinate(reduced)
+      span = reduced%stops%m > 0
+      enforce = scene%law == law_signorini
+      next_record = next_multiple(state%step, int(scene%record_every, ik))
+      next_snapshot = huge(step)
+      if (scene%snapshot_every > 0) next_snapshot = next_multiple(state%step, int(scene%snapshot_every, ik))
+      done = state%step - 1
+      u_old_su = 0
+      u_tip_prev = 0
+      d_tip_prev = 0
+      phi_prev = support_position(real(state%step - 1, wp)*reduced%dt, scene%amplitude, scene%omega)
+      phi_now = support_position(real(state%step, wp)*reduced%dt, scene%amplitude, scene%omega)
+      do step = state%step, last
+         sigma_next = load_average(step + 1, reduced%dt, scene%omega, scene%centered_load)
+         weight = reduced%beta*sigma_next + (1 - 2*reduced%beta)*state%sigma_now + reduced%beta*state%sigma_prev
+         recording = step == next_record
+         call reduced_stiffness_product(reduced, state%q, state%sq)
+         if (recording) then
+            u_old_su = dot_product(state%q, state%sq)
+            u_tip_prev = dot_product(reduced%tip_row, state%q)
+            d_tip_prev = dot_product(reduced%tip_row, state%d)
+         end if
+         do i = 1, s
+            state%x(i) = dt2*(weight*reduced%load(i) - state%sq(i))
+         end do
+         r_prev = state%reaction
+         if (span) then
+            phi_next = support_position(real(step + 1, wp)*reduced%dt, scene%amplitude, scene%omega)
+            call block_solve(reduced%a_solver, state%x)
+            call span_contact(reduced%stops, state%span, state%q, state%d, state%x, phi_next, enforce, state%span%info)
+            if (state%span%info /= qp_solved) exit
+            call correction(reduced, state%span, state%x, c, col)
+            if (col > 0) then
+               call update(state%x, c, reduced%z(:, col), state%d, state%q)
+            else
+               call update(state%x, 0.0_wp, reduced%z(:, 1), state%d, state%q)
+            end if
+            gd = dot_product(reduced%load, state%d)
+            contact = state%span%contact
+            if (enforce) call span_settle(reduced%stops, state%span, state%q, state%d, state%max_violation)
+            r_step = 0
+            if (reduced%stops%tip > 0) r_step = state%span%lambda(reduced%stops%tip)/dt2
+            if (contact .and. .not. state%in_contact) state%impacts = state%impacts + 1
+            state%in_contact = contact
+            state%work = state%work + 0.5_wp*weight*(gd + state%gd_prev)
+            call span_energy(reduced%stops, state%span, state%d, dt2, phi_next - phi_prev, state%dissipated, &
+               & state%work)
+            state%reaction = r_step
+            if (recording) then
+               state%span%record_u = state%span%u_prev + reduced%stops%lift*phi_now
+               state%span%record_reaction = scene%mass_per_length*state%stop_reaction
+               call recorder%record_stops(state%span%record_u, state%span%record_reaction)
+            end if
+            state%stop_reaction = state%span%lambda/dt2
+            phi_prev = phi_now
+            phi_now = phi_next
+         else
+            if (scene%law == law_compliance) state%x(pt) = state%x(pt) + &
+               & dt2*((1 - 2*reduced%beta)*state%p_now + reduced%beta*state%p_prev)
+            call block_solve(reduced%a_solver, state%x)
+            old_tip = state%q(pt)
+            old_dtip = state%d(pt)
+            call contact_law(scene, reduced, state, old_tip + (old_dtip + state%x(pt)), c, tip_value, r_step, contact)
+            call update(state%x, c, reduced%z(:, reduced%tip_stop), state%d, state%q)
+            gd = dot_product(reduced%load, state%d)
+            if (scene%law == law_signorini .and. contact) then
+               state%q(pt) = tip_value
+               state%d(pt) = tip_value - old_tip
+            end if
+            if (scene%law /= law_none) state%max_violation = max(state%max_violation, violation(state%q(pt), scene))
+            if (contact .and. .not. state%in_contact) state%impacts = state%impacts + 1
+            state%in_contact = contact
+            state%work = state%work + 0.5_wp*weight*(gd + state%gd_prev)
+            state%dissipated = state%dissipated - 0.5_wp*r_step*(state%d(pt) + old_dtip)
+            state%reaction = r_step
+         end if
+         state%gd_prev = gd
+         state%sigma_prev = state%sigma_now
+         state%sigma_now = sigma_next
+         if (recording) then
+            next_record = next_record + scene%record_every
+            row = 0
+            row(col_t) = real(step, wp)*reduced%dt
+            row(col_u) = u_tip_prev
+            row(col_v) = (dot_product(reduced%tip_row, state%d) + d_tip_prev)/(2*reduced%dt)
+            row(col_reaction) = scene%mass_per_length*r_prev
+            row(col_work) = scene%mass_per_length*state%work
+            row(col_dissipated) = scene%mass_per_length*state%dissipated
+            call reduced_stiffness_product(reduced, state%q, state%sq)
+            row(col_energy) = scene%mass_per_length*energy(reduced, reduced_mass_product(reduced, state%d), &
+               & dot_product(state%q, state%sq), dot_product(state%d, state%sq), u_old_su)
+            call recorder%record(row)
+         end if
+         if (step == next_snapshot) then
+            next_snapshot = next_snapshot + scene%snapshot_every
+            state%x = state%q - state%d
+            call physical_shape(reduced, state%x, real(step, wp)*reduced%dt, scene, state%shape)
+            call recorder%snapshot(real(step, wp)*reduced%dt, state%shape)
+         end if
+         done = step
+      end do
+      state%step = done + 1
+   end subroutine advance_reduced
+
+   !> The update of a step: d^n = d^{n-1} + x + c z, q^{n+1} = q^n + d^n.
+   pure subroutine update(x, c, z, d, q)
+      real(wp), intent(in) :: x(:), z(:)
+      real(wp), intent(in) :: c
+      real(wp), intent(inout) :: d(:), q(:)
+      integer :: i
+      do i = 1, size(d)
+         d(i) = d(i) + x(i) + c*z(i)
+         q(i) = q(i) + d(i)
+      end do
+   end subroutine update
+
+   !> The correction A_r^{-1} P_r lambda of a step with stops along the span: one active stop, its
+   !> column `col` and multiplier c (the loop's rank-one update, as the tip's); more, the
+   !> correction folded into x (col = 0, c = 0); none, col = 0, c = 0.
+   pure subroutine correction(reduced, work, x, c, col)
+      type(reduced_model_type), intent(in) :: reduced
+      type(span_work_type), intent(in) :: work
+      real(wp), intent(inout) :: x(:)
+      real(wp), intent(out) :: c
+      integer, intent(out) :: col
+      integer :: i, j, a, k
+      real(wp) :: acc
+      c = 0
+      col = 0
+      k = 0
+      if (work%contact) k = work%qp%n_active
+      if (k == 1) then
+         col = work%qp%active(1)
+         c = work%lambda(col)
+      else if (k > 1) then
+         do i = 1, size(x)
+            acc = x(i)
+            do j = 1, k
+               a = work%qp%active(j)
+               acc = acc + work%lambda(a)*reduced%z(i, a)
+            end do
+            x(i) = acc
+         end do
+      end if
+   end subroutine correction
+
+   !> The contact law at the tip coordinate: from the trial tip value, the multiple c of z_r to
+   !> add, the tip value, the reaction per unit mass of the step and whether it is in contact.
+   subroutine contact_law(scene, reduced, state, trial, c, tip_value, r_step, contact)
+      type(scene_type), intent(in) :: scene
+      type(reduced_model_type), intent(in) :: reduced
+      type(reduced_state_type), intent(inout) :: state
+      real(wp), intent(in) :: trial
+      real(wp), intent(out) :: c, tip_value, r_step
+      logical, intent(out) :: contact
+      real(wp) :: p_next, z_tip
+      z_tip = reduced%z(tip_coordinate(reduced), reduced%tip_stop)
+      select case (scene%law)
+      case (law_signorini)
+         call project_tip(trial, scene%lower, scene%upper, z_tip, c, tip_value)
+         contact = c /= 0
+         r_step = c/reduced%dt2
+      case (law_compliance)
+         tip_value = solve_spring_tip(trial, scene%lower, scene%upper, scene%stiffness_per_mass, &
+            & reduced%dt2*reduced%beta*z_tip)
+         p_next = spring_force(tip_value, scene%lower, scene%upper, scene%stiffness_per_mass)
+         c = reduced%dt2*reduced%beta*p_next
+         r_step = reduced%beta*p_next + (1 - 2*reduced%beta)*state%p_now + reduced%beta*state%p_prev
+         state%p_prev = state%p_now
+         state%p_now = p_next
+         contact = r_step /= 0
+      case default
+         c = 0
+         tip_value = trial
+         r_step = 0
+         contact = .false.
+      end select
+   end subroutine contact_law
+
+   !> Index of the tip value in q (r + tip_stop), 0 when the tip is not a stop coordinate.
+   pure function tip_coordinate(reduced) result(pt)
+      type(reduced_model_type), intent(in) :: reduced
+      integer :: pt
+      pt = 0
+      if (reduced%tip_stop > 0) pt = reduced%r + reduced%tip_stop
+   end function tip_coordinate
+
+   !> Discrete energy E^{n+1/2} per unit mass from d.M_r d, q.S_r q, d.S_r q (q = q^{n+1}, d = d^n)
+   !> and q^n.S_r q^n.
+   pure function energy(reduced, dmd, usu, dsu, u_old_s_u_old) result(e)
+      type(reduced_model_type), intent(in) :: reduced
+      real(wp), intent(in) :: dmd, usu, dsu, u_old_s_u_old
+      real(wp) :: e
+      e = 0.5_wp*dmd/reduced%dt2 + 0.5_wp*(reduced%beta*usu + reduced%beta*u_old_s_u_old &
+         & + (1 - 2*reduced%beta)*(usu - dsu))
+   end function energy
+
+   !> Violation of the stops by a tip value (m).
+   pure function violation(u_tip, scene) result(v)
+      real(wp), intent(in) :: u_tip
+      type(scene_type), intent(in) :: scene
+      real(wp) :: v
+      v = max(u_tip - scene%upper, scene%lower - u_tip, 0.0_wp)
+   end function violation
+
+   !> Physical displacement (T q)(x_i) + h(x_i) phi(t) at the nodes x_0..x_J, O(J (r + m)).
+   pure subroutine physical_shape(reduced, q, t, scene, shape)
+      type(reduced_model_type), intent(in) :: reduced
+      real(wp), intent(in) :: q(:), t
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(out) :: shape(:)
+      integer :: k, i
+      shape = reduced%lift*support_position(t, scene%amplitude, scene%omega)
+      do k = 1, reduced%size
+         do i = 2, size(shape)
+            shape(i) = shape(i) + reduced%basis(2*i - 3, k)*q(k)
+         end do
+      end do
+   end subroutine physical_shape
+
+   !> The first multiple of `every` at or after `step`.
+   pure function next_multiple(step, every) result(m)
+      integer(ik), intent(in) :: step, every
+      integer(ik) :: m
+      m = ((step + every - 1)/every)*every
+   end function next_multiple
+
+   !> Text of a real for messages.
+   function real_text(x) result(s)
+      real(wp), intent(in) :: x
+      character(len=32) :: s
+      write (s, '(g0.6)') x
+   end function real_text
+end module beamstops_reduced_scheme
