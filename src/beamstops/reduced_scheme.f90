@@ -33,6 +33,18 @@ module beamstops_reduced_scheme
    !> Steps between progress reports and divergence checks.
    integer(ik), parameter :: reduced_block_steps = 8192_ik
 
+   ! The load averages step after step by rotation, as the full loop's: a private copy of the
+   ! load_rotation that the physics branch moves into beamstops_forcing (same names, same
+   ! arithmetic); after the merge, use beamstops_forcing's and delete this one.
+   type :: load_rotation
+      integer(ik) :: k = 0
+      real(wp) :: sigma = 0, cosine = 0
+      real(wp) :: cos_step = 1, sin_step = 0
+      real(wp) :: dt = 0, omega = 0
+      logical :: centered = .true.
+   end type load_rotation
+   integer(ik), parameter :: restart_every = 64
+
    !> Everything the reduced loop carries from step n to step n + 1.
    type :: reduced_state_type
       !> Index n of the next step (the step that computes q^{n+1}).
@@ -264,6 +276,7 @@ contains
       real(wp) :: sigma_next, weight, c, gd, tip_value, r_step, r_prev, old_tip, old_dtip
       real(wp) :: u_tip_prev, d_tip_prev, u_old_su, phi_prev, phi_now, phi_next, dt2, row(n_columns)
       logical :: contact, recording, span, enforce
+      type(load_rotation) :: loads
 
       s = reduced%size
       dt2 = reduced%dt2
@@ -279,8 +292,10 @@ contains
       d_tip_prev = 0
       phi_prev = support_position(real(state%step - 1, wp)*reduced%dt, scene%amplitude, scene%omega)
       phi_now = support_position(real(state%step, wp)*reduced%dt, scene%amplitude, scene%omega)
+      call start_loads(loads, state%step + 1, reduced%dt, scene%omega, scene%centered_load)
       do step = state%step, last
-         sigma_next = load_average(step + 1, reduced%dt, scene%omega, scene%centered_load)
+         sigma_next = loads%sigma
+         call next_load(loads)
          weight = reduced%beta*sigma_next + (1 - 2*reduced%beta)*state%sigma_now + reduced%beta*state%sigma_prev
          recording = step == next_record
          call reduced_stiffness_product(reduced, state%q, state%sq)
@@ -370,6 +385,56 @@ contains
       end do
       state%step = done + 1
    end subroutine advance_reduced
+
+   !> load_rotation at step k: from load_average at the last multiple of restart_every, then
+   !> rotated, so that the value of every step is the same however the run is cut into calls.
+   pure subroutine start_loads(loads, k, dt, omega, centered)
+      type(load_rotation), intent(out) :: loads
+      integer(ik), intent(in) :: k
+      real(wp), intent(in) :: dt, omega
+      logical, intent(in) :: centered
+      loads%dt = dt
+      loads%omega = omega
+      loads%centered = centered
+      call restart_loads(loads, (k/restart_every)*restart_every)
+      do while (loads%k < k)
+         call next_load(loads)
+      end do
+   end subroutine start_loads
+
+   !> load_rotation at step k, exact: load_average and the same centre and factor for the cosine.
+   pure subroutine restart_loads(loads, k)
+      type(load_rotation), intent(inout) :: loads
+      integer(ik), intent(in) :: k
+      real(wp) :: centre, x, factor
+      centre = real(k, wp)*loads%dt
+      if (.not. loads%centered) centre = (real(k, wp) + 0.5_wp)*loads%dt
+      x = 0.5_wp*loads%omega*loads%dt
+      if (abs(x) < 1.0e-8_wp) then
+         factor = 1 - x**2/6
+      else
+         factor = sin(x)/x
+      end if
+      loads%k = k
+      loads%sigma = load_average(k, loads%dt, loads%omega, loads%centered)
+      loads%cosine = factor*cos(loads%omega*centre)
+      loads%cos_step = cos(loads%omega*loads%dt)
+      loads%sin_step = sin(loads%omega*loads%dt)
+   end subroutine restart_loads
+
+   !> load_rotation moved on to step k + 1.
+   pure subroutine next_load(loads)
+      type(load_rotation), intent(inout) :: loads
+      real(wp) :: sigma
+      if (mod(loads%k + 1, restart_every) == 0) then
+         call restart_loads(loads, loads%k + 1)
+         return
+      end if
+      sigma = loads%sigma*loads%cos_step + loads%cosine*loads%sin_step
+      loads%cosine = loads%cosine*loads%cos_step - loads%sigma*loads%sin_step
+      loads%sigma = sigma
+      loads%k = loads%k + 1
+   end subroutine next_load
 
    !> The update of a step: d^n = d^{n-1} + x + c z, q^{n+1} = q^n + d^n.
    pure subroutine update(x, c, z, d, q)

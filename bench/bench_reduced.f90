@@ -1,0 +1,197 @@
+!> Reduced (modal) models (SPEC 11): cost and accuracy against the number of modes r.
+!>
+!>   bench_reduced cost J STEPS EVERY r1 r2 ...  ns per step of the reduced loop (paper's scene, tip
+!>                                            stops, beta = 1/2, a record every EVERY steps to a
+!>                                            recorder that keeps nothing) for each r, and of the
+!>                                            full engine's loop; plus the time to build each model
+!>   bench_reduced error J DT r1 r2 ...       largest tip difference to the full model (same J, dt)
+!>                                            over t <= 0.08 s (before the first impact) and over
+!>                                            t <= 0.2 s, for each r
+!>
+!> Prints `key value` lines. Timings are wall-clock (system_clock), best of three.
+program bench_reduced
+   use, intrinsic :: iso_fortran_env, only: int64, error_unit
+   use beamstops_kinds, only: wp, ik
+   use beamstops_error, only: error_type
+   use beamstops_scene, only: scene_type, steps_of, record_count
+   use beamstops_model, only: model_type, build_model
+   use beamstops_run, only: prepare_run, simulate
+   use beamstops_summary, only: run_summary
+   use beamstops_recorder_array, only: array_recorder
+   use beamstops_recorder, only: col_t, col_u
+   use beamstops_reduced, only: reduced_model_type, build_reduced, stop_unknowns
+   use beamstops_reduced_scheme, only: simulate_reduced
+   use bench_null_recorder, only: null_recorder
+   implicit none
+
+   character(len=64) :: what
+   integer :: nargs
+   nargs = command_argument_count()
+   what = argument(1, 'cost')
+   select case (trim(what))
+   case ('cost')
+      call bench_cost(int_argument(2, 19), int_argument(3, 100000), int_argument(4, 1))
+   case ('error')
+      call bench_error(int_argument(2, 19), real_argument(3, 1.0e-5_wp))
+   case default
+      write (error_unit, '(a)') 'usage: bench_reduced cost|error ...'
+      error stop 2
+   end select
+
+contains
+
+   !> The paper's scene (tip stops, beta = 1/2, centred load) with J elements.
+   function paper_scene(elements, dt, t_end) result(scene)
+      integer, intent(in) :: elements
+      real(wp), intent(in) :: dt, t_end
+      type(scene_type) :: scene
+      scene%elements = elements
+      scene%dt = dt
+      scene%t_end = t_end
+      scene%beta = 0.5_wp
+   end function paper_scene
+
+   subroutine bench_cost(elements, steps, every)
+      integer, intent(in) :: elements, steps, every
+      type(scene_type) :: scene
+      type(model_type) :: model
+      type(reduced_model_type) :: reduced
+      type(null_recorder) :: rec
+      type(run_summary) :: summary
+      type(error_type), allocatable :: error
+      integer(int64) :: t0, t1, rate
+      real(wp) :: best, build
+      integer :: k, rep, r
+      scene = paper_scene(elements, 1.0e-6_wp, steps*1.0e-6_wp)
+      scene%record_every = every
+      call system_clock(t0, rate)
+      call prepare_run(scene, 'bench', model, error)
+      call system_clock(t1)
+      call fail_on(error)
+      call put_int('elements', elements)
+      call put('full_build_s', real(t1 - t0, wp)/rate)
+      best = huge(1.0_wp)
+      do rep = 1, 3
+         call system_clock(t0)
+         call simulate(scene, model, rec, summary, error)
+         call system_clock(t1)
+         call fail_on(error)
+         best = min(best, real(t1 - t0, wp)/rate)
+      end do
+      call put('full_ns_per_step', 1.0e9_wp*best/steps)
+      do k = 5, command_argument_count()
+         r = int_argument(k, 1)
+         if (r > 2*elements - stop_unknowns(scene)) cycle
+         scene%modes = r
+         call system_clock(t0)
+         call build_reduced(scene, model, reduced, error)
+         call system_clock(t1)
+         call fail_on(error)
+         build = real(t1 - t0, wp)/rate
+         best = huge(1.0_wp)
+         do rep = 1, 3
+            call system_clock(t0)
+            call simulate_reduced(scene, reduced, rec, summary, error)
+            call system_clock(t1)
+            call fail_on(error)
+            best = min(best, real(t1 - t0, wp)/rate)
+         end do
+         write (*, '(a, i0, a, es10.3, a, f10.2)') 'r ', r, ' build_s ', build, ' ns_per_step ', 1.0e9_wp*best/steps
+      end do
+      if (rec%sink == 12345.678_wp) print *, rec%sink
+   end subroutine bench_cost
+
+   subroutine bench_error(elements, dt)
+      integer, intent(in) :: elements
+      real(wp), intent(in) :: dt
+      type(scene_type) :: scene
+      type(model_type) :: model
+      type(reduced_model_type) :: reduced
+      type(array_recorder) :: full, red
+      type(run_summary) :: summary
+      type(error_type), allocatable :: error
+      real(wp) :: before, through
+      integer(ik) :: j
+      integer :: k, r
+      scene = paper_scene(elements, dt, 0.2_wp)
+      call prepare_run(scene, 'bench', model, error)
+      call fail_on(error)
+      call full%reserve(record_count(scene), 0_ik, elements + 1)
+      call simulate(scene, model, full, summary, error)
+      call fail_on(error)
+      call put_int('elements', elements)
+      call put('dt', dt)
+      call put_int('full_impacts_to_0.2s', int(summary%impacts))
+      do k = 4, command_argument_count()
+         r = int_argument(k, 1)
+         if (r > 2*elements - stop_unknowns(scene)) cycle
+         scene%modes = r
+         call build_reduced(scene, model, reduced, error)
+         call fail_on(error)
+         if (allocated(red%rows)) deallocate (red%rows, red%snap_t, red%snap_u, red%stops_u, red%stops_reaction)
+         call red%reserve(record_count(scene), 0_ik, elements + 1)
+         call simulate_reduced(scene, reduced, red, summary, error)
+         call fail_on(error)
+         before = 0
+         through = 0
+         do j = 1, full%filled
+            if (full%rows(col_t, j) <= 0.08_wp) before = max(before, abs(full%rows(col_u, j) - red%rows(col_u, j)))
+            through = max(through, abs(full%rows(col_u, j) - red%rows(col_u, j)))
+         end do
+         write (*, '(a, i0, a, es10.3, a, es10.3, a, i0)') 'r ', r, ' tip_error_to_0.08s_m ', before, &
+            & ' tip_error_to_0.2s_m ', through, ' impacts ', summary%impacts
+      end do
+   end subroutine bench_error
+
+   subroutine fail_on(error)
+      type(error_type), allocatable, intent(in) :: error
+      if (allocated(error)) then
+         write (error_unit, '(a)') error%message
+         error stop 1
+      end if
+   end subroutine fail_on
+
+   subroutine put(key, value)
+      character(len=*), intent(in) :: key
+      real(wp), intent(in) :: value
+      write (*, '(a, 1x, es12.5)') key, value
+   end subroutine put
+
+   subroutine put_int(key, value)
+      character(len=*), intent(in) :: key
+      integer, intent(in) :: value
+      write (*, '(a, 1x, i0)') key, value
+   end subroutine put_int
+
+   function argument(i, default) result(s)
+      integer, intent(in) :: i
+      character(len=*), intent(in) :: default
+      character(len=64) :: s
+      if (command_argument_count() >= i) then
+         call get_command_argument(i, s)
+      else
+         s = default
+      end if
+   end function argument
+
+   function int_argument(i, default) result(v)
+      integer, intent(in) :: i, default
+      integer :: v
+      character(len=64) :: s
+      v = default
+      if (command_argument_count() < i) return
+      call get_command_argument(i, s)
+      read (s, *) v
+   end function int_argument
+
+   function real_argument(i, default) result(v)
+      integer, intent(in) :: i
+      real(wp), intent(in) :: default
+      real(wp) :: v
+      character(len=64) :: s
+      v = default
+      if (command_argument_count() < i) return
+      call get_command_argument(i, s)
+      read (s, *) v
+   end function real_argument
+end program bench_reduced
