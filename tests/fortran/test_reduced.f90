@@ -10,7 +10,7 @@ module test_reduced
    use testing
    use test_support, only: run_recorded, band_eigenvalues, dense_eigenvalues, solve_spd, int_text
    use beamstops, only: ik, scene_type, array_recorder, run_summary, law_none, law_signorini, law_compliance, &
-      & validate_scene, record_count, stop_count, status_complete, model_type, build_model
+      & validate_scene, record_count, stop_count, status_complete, model_type, build_model, prepare_run, simulate
    use beamstops_band, only: cholesky_factor, cholesky_solve, band_to_dense
    use beamstops_forcing, only: load_average
    use beamstops_reduced, only: reduced_model_type, prepare_reduced, build_reduced, validate_reduced, &
@@ -37,6 +37,7 @@ contains
          & new_unittest('KKT of the tip projection at every step, in reduced coordinates', test_kkt_steps), &
          & new_unittest('three stops, r = 8: KKT in the records, balance closed', test_span_kkt), &
          & new_unittest('no contact: the energy balance closes to round-off', test_energy_free), &
+         & new_unittest('snapshots: u = T q at the nodes, the full run''s with all modes', test_snapshots), &
          & new_unittest('&mesh modes: range checks with messages', test_validate) &
          & ]
    end subroutine collect_reduced
@@ -470,6 +471,66 @@ contains
          end do
       end do
    end subroutine test_energy_free
+
+   !> Snapshots every 500 steps (the tube with its three stops, t <= 0.1 s): the reduced run's
+   !> physical shape at the nodes against the full run's, all modes; with r = 10, the stops'
+   !> nodes of the snapshots are the recorded values at the stops.
+   subroutine test_snapshots(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(model_type) :: model
+      type(reduced_model_type) :: reduced
+      type(array_recorder) :: full, red
+      type(run_summary) :: summary
+      integer(ik) :: j, k
+      integer :: i, pass
+      real(wp) :: diff
+      scene = tube_scene(0.1_wp)
+      scene%snapshot_every = 500
+      call validate_scene(scene, 'test scene', error)
+      if (allocated(error)) return
+      call full%reserve(record_count(scene), 11_ik, scene%elements + 1, 3)
+      call prepare_run_full(scene, model, full, summary, error)
+      if (allocated(error)) return
+      do pass = 1, 2
+         scene%modes = merge(2*scene%elements - 3, 10, pass == 1)
+         call build_reduced(scene, model, reduced, error)
+         if (allocated(error)) return
+         if (allocated(red%rows)) deallocate (red%rows, red%snap_t, red%snap_u, red%stops_u, red%stops_reaction)
+         call red%reserve(record_count(scene), 11_ik, scene%elements + 1, 3)
+         call simulate_reduced(scene, reduced, red, summary, error)
+         if (allocated(error)) return
+         call check(error, int(red%snaps), 11, 'snapshots taken'); if (allocated(error)) return
+         call check(error, all(red%snap_t(:11) == full%snap_t(:11)), 'snapshot times'); if (allocated(error)) return
+         if (pass == 1) then
+            diff = maxval(abs(red%snap_u(:, :11) - full%snap_u(:, :11)))/maxval(abs(full%snap_u(:, :11)))
+            call note('all modes: largest snapshot difference / scale '//real_text(diff))
+            call check(error, diff, 0.0_wp, 'snapshots of the full and the reduced run', thr=1e-9_wp)
+            if (allocated(error)) return
+         else
+            do k = 1, 11
+               j = nint(red%snap_t(k)/scene%dt, ik)/scene%record_every + 1
+               do i = 1, 3
+                  call check(error, red%snap_u(scene%stop_nodes(i) + 1, k), red%stops_u(i, j), 'r = 10: snapshot '// &
+                     & int_text(k)//' at stop '//int_text(i), thr=1e-15_wp)
+                  if (allocated(error)) return
+               end do
+            end do
+         end if
+      end do
+   end subroutine test_snapshots
+
+   !> The full model of a scene and its run into `rec` (reserved by the caller).
+   subroutine prepare_run_full(scene, model, rec, summary, error)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(out) :: model
+      type(array_recorder), intent(inout) :: rec
+      type(run_summary), intent(out) :: summary
+      type(error_type), allocatable, intent(out) :: error
+      call prepare_run(scene, 'test scene', model, error)
+      if (allocated(error)) return
+      call simulate(scene, model, rec, summary, error)
+   end subroutine prepare_run_full
 
    subroutine test_validate(error)
       type(error_type), allocatable, intent(out) :: error
