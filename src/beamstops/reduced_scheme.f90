@@ -16,7 +16,8 @@ module beamstops_reduced_scheme
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
    use beamstops_scene, only: scene_type, steps_of, law_none, law_signorini, law_compliance
-   use beamstops_reduced, only: reduced_model_type, block_solve, reduced_stiffness_product, reduced_mass_product
+   use beamstops_reduced, only: reduced_model_type, block_solver_type, block_solve, reduced_stiffness_product, &
+      & reduced_mass_product
    use beamstops_clock, only: thread_cpu_seconds
    use beamstops_forcing, only: load_average, support_position
    use beamstops_contact_tip_projection, only: project_tip
@@ -53,6 +54,12 @@ module beamstops_reduced_scheme
       real(wp), allocatable :: q(:), d(:)
       !> S_r q^n, and the right-hand side / increment of a step (r + m).
       real(wp), allocatable :: sq(:), x(:)
+      !> B^T D^{-1} y_a of a step, and the multipliers of the stops acting in it (m).
+      real(wp), allocatable :: acc(:), multiplier(:)
+      !> The stop coordinates (1..m) acting in a step: active(1:n_active) (m).
+      integer, allocatable :: active(:)
+      !> Number of stops acting in the step.
+      integer :: n_active = 0
       !> Snapshot buffer: physical displacement at the nodes x_0..x_J (J + 1).
       real(wp), allocatable :: shape(:)
       !> Load averages sigma_{n-1}, sigma_n.
@@ -122,6 +129,7 @@ contains
       dt = reduced%dt
       pt = tip_coordinate(reduced)
       allocate (state%q(s), state%d(s), state%sq(s), state%x(s), state%shape(size(reduced%x)))
+      allocate (state%acc(reduced%m), state%multiplier(reduced%m), state%active(reduced%m))
       state%q = reduced%q0 + dt*reduced%v0
       if (scene%taylor_start) then
          call reduced_stiffness_product(reduced, reduced%q0, state%sq)
@@ -298,28 +306,32 @@ contains
          call next_load(loads)
          weight = reduced%beta*sigma_next + (1 - 2*reduced%beta)*state%sigma_now + reduced%beta*state%sigma_prev
          recording = step == next_record
-         call reduced_stiffness_product(reduced, state%q, state%sq)
          if (recording) then
+            call reduced_stiffness_product(reduced, state%q, state%sq)
             u_old_su = dot_product(state%q, state%sq)
             u_tip_prev = dot_product(reduced%tip_row, state%q)
             d_tip_prev = dot_product(reduced%tip_row, state%d)
          end if
-         do i = 1, s
-            state%x(i) = dt2*(weight*reduced%load(i) - state%sq(i))
-         end do
+         ! x = A_r^{-1} dt^2 (weight l_r - S_r q): the modal part left as D^{-1} y_a (modal_rhs), the
+         ! stop part complete; the modal part is finished by modal_update with the contact's
+         ! correction.
+         call modal_rhs(reduced%r, reduced%m, reduced%a_solver%dinv, reduced%a_solver%bt, reduced%lambda, &
+            & reduced%load, state%q, dt2, weight, state%x, state%acc)
+         call stop_rhs(reduced, state%q, dt2, weight, state%acc, state%x)
          r_prev = state%reaction
          if (span) then
             phi_next = support_position(real(step + 1, wp)*reduced%dt, scene%amplitude, scene%omega)
-            call block_solve(reduced%a_solver, state%x)
+            call stop_solve(reduced%a_solver, state%x)
             call span_contact(reduced%stops, state%span, state%q, state%d, state%x, phi_next, enforce, state%span%info)
             if (state%span%info /= qp_solved) exit
-            call correction(reduced, state%span, state%x, c, col)
-            if (col > 0) then
-               call update(state%x, c, reduced%z(:, col), state%d, state%q)
-            else
-               call update(state%x, 0.0_wp, reduced%z(:, 1), state%d, state%q)
+            state%n_active = 0
+            if (state%span%contact) then
+               state%n_active = state%span%qp%n_active
+               state%active(:state%n_active) = state%span%qp%active(:state%n_active)
+               state%multiplier(:state%n_active) = state%span%lambda(state%active(:state%n_active))
             end if
-            gd = dot_product(reduced%load, state%d)
+            call modal_update(reduced%r, reduced%m, reduced%size, reduced%a_solver%wt, reduced%z, reduced%load, &
+               & state%n_active, state%active, state%multiplier, state%x, state%d, state%q, gd)
             contact = state%span%contact
             if (enforce) call span_settle(reduced%stops, state%span, state%q, state%d, state%max_violation)
             r_step = 0
@@ -341,12 +353,18 @@ contains
          else
             if (scene%law == law_compliance) state%x(pt) = state%x(pt) + &
                & dt2*((1 - 2*reduced%beta)*state%p_now + reduced%beta*state%p_prev)
-            call block_solve(reduced%a_solver, state%x)
+            call stop_solve(reduced%a_solver, state%x)
             old_tip = state%q(pt)
             old_dtip = state%d(pt)
             call contact_law(scene, reduced, state, old_tip + (old_dtip + state%x(pt)), c, tip_value, r_step, contact)
-            call update(state%x, c, reduced%z(:, reduced%tip_stop), state%d, state%q)
-            gd = dot_product(reduced%load, state%d)
+            state%n_active = 0
+            if (c /= 0) then
+               state%n_active = 1
+               state%active(1) = reduced%tip_stop
+               state%multiplier(1) = c
+            end if
+            call modal_update(reduced%r, reduced%m, reduced%size, reduced%a_solver%wt, reduced%z, reduced%load, &
+               & state%n_active, state%active, state%multiplier, state%x, state%d, state%q, gd)
             if (scene%law == law_signorini .and. contact) then
                state%q(pt) = tip_value
                state%d(pt) = tip_value - old_tip
@@ -435,6 +453,125 @@ contains
       loads%sigma = sigma
       loads%k = loads%k + 1
    end subroutine next_load
+
+   !> First pass over the modal coordinates: x_a = D^{-1} dt^2 (weight l_a - Lambda a) and
+   !> acc = B^T x_a, in one sweep (O(r m)).
+   pure subroutine modal_rhs(r, m, dinv, bt, lambda, load, q, dt2, weight, x, acc)
+      integer, intent(in) :: r, m
+      real(wp), intent(in) :: dinv(r), bt(m, r), lambda(r), load(r + m), q(r + m), dt2, weight
+      real(wp), intent(inout) :: x(r + m)
+      real(wp), intent(out) :: acc(m)
+      integer :: i, j
+      real(wp) :: xi
+      acc = 0
+      if (m == 1) then
+         do i = 1, r
+            xi = dinv(i)*(dt2*(weight*load(i) - lambda(i)*q(i)))
+            x(i) = xi
+            acc(1) = acc(1) + bt(1, i)*xi
+         end do
+      else
+         do i = 1, r
+            xi = dinv(i)*(dt2*(weight*load(i) - lambda(i)*q(i)))
+            x(i) = xi
+            do j = 1, m
+               acc(j) = acc(j) + bt(j, i)*xi
+            end do
+         end do
+      end if
+   end subroutine modal_rhs
+
+   !> The stop part of the right-hand side less B^T D^{-1} y_a: dt^2 (weight l_p - K_pp p) - acc.
+   pure subroutine stop_rhs(reduced, q, dt2, weight, acc, x)
+      type(reduced_model_type), intent(in) :: reduced
+      real(wp), intent(in) :: q(:), dt2, weight, acc(:)
+      real(wp), intent(inout) :: x(:)
+      integer :: j, k, r
+      real(wp) :: kq
+      r = reduced%r
+      do j = 1, reduced%m
+         kq = 0
+         do k = 1, reduced%m
+            kq = kq + reduced%stiffness_pp(j, k)*q(r + k)
+         end do
+         x(r + j) = dt2*(weight*reduced%load(r + j) - kq) - acc(j)
+      end do
+   end subroutine stop_rhs
+
+   !> x_p = H^{-1} x_p (R^T R = H) in place.
+   pure subroutine stop_solve(solver, x)
+      type(block_solver_type), intent(in) :: solver
+      real(wp), intent(inout) :: x(:)
+      integer :: i, j, r, m
+      real(wp) :: acc
+      r = solver%r
+      m = solver%m
+      do j = 1, m
+         acc = x(r + j)
+         do i = 1, j - 1
+            acc = acc - solver%hfac(i, j)*x(r + i)
+         end do
+         x(r + j) = acc/solver%hfac(j, j)
+      end do
+      do j = m, 1, -1
+         acc = x(r + j)
+         do i = j + 1, m
+            acc = acc - solver%hfac(j, i)*x(r + i)
+         end do
+         x(r + j) = acc/solver%hfac(j, j)
+      end do
+   end subroutine stop_solve
+
+   !> Second pass, the update: x_a = D^{-1} y_a - W x_p, plus the contact's correction
+   !> sum_k multiplier_k z(:, active_k) on every coordinate; d^n = d^{n-1} + x, q^{n+1} = q^n + d^n,
+   !> and gd = l_r . d^n, in one sweep (O(r (m + n_active))).
+   pure subroutine modal_update(r, m, s, wt, z, load, n_active, active, multiplier, x, d, q, gd)
+      integer, intent(in) :: r, m, s, n_active
+      real(wp), intent(in) :: wt(m, r), z(s, m), load(s)
+      integer, intent(in) :: active(m)
+      real(wp), intent(in) :: multiplier(m)
+      real(wp), intent(inout) :: x(s), d(s), q(s)
+      real(wp), intent(out) :: gd
+      integer :: i, j, a
+      real(wp) :: xi
+      gd = 0
+      if (m == 1 .and. n_active == 0) then
+         do i = 1, r
+            d(i) = d(i) + (x(i) - wt(1, i)*x(r + 1))
+            q(i) = q(i) + d(i)
+            gd = gd + load(i)*d(i)
+         end do
+      else if (m == 1) then
+         do i = 1, r
+            d(i) = d(i) + ((x(i) - wt(1, i)*x(r + 1)) + multiplier(1)*z(i, 1))
+            q(i) = q(i) + d(i)
+            gd = gd + load(i)*d(i)
+         end do
+      else
+         do i = 1, r
+            xi = x(i)
+            do j = 1, m
+               xi = xi - wt(j, i)*x(r + j)
+            end do
+            do j = 1, n_active
+               a = active(j)
+               xi = xi + multiplier(j)*z(i, a)
+            end do
+            d(i) = d(i) + xi
+            q(i) = q(i) + d(i)
+            gd = gd + load(i)*d(i)
+         end do
+      end if
+      do i = r + 1, s
+         xi = x(i)
+         do j = 1, n_active
+            xi = xi + multiplier(j)*z(i, active(j))
+         end do
+         d(i) = d(i) + xi
+         q(i) = q(i) + d(i)
+         gd = gd + load(i)*d(i)
+      end do
+   end subroutine modal_update
 
    !> The update of a step: d^n = d^{n-1} + x + c z, q^{n+1} = q^n + d^n.
    pure subroutine update(x, c, z, d, q)
