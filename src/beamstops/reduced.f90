@@ -70,6 +70,8 @@ module beamstops_reduced
       real(wp), allocatable :: hfac(:, :)
       !> B^T and W^T (m, r): the layouts of the time loop's sweeps over the modes.
       real(wp), allocatable :: bt(:, :), wt(:, :)
+      !> 1/R_jj (m): the time loop multiplies instead of dividing.
+      real(wp), allocatable :: rdiag(:)
    end type block_solver_type
 
    !> The reduced model of a scene: the basis, the blocks of M_r and S_r, the solvers of A_r and
@@ -465,6 +467,7 @@ contains
       do j = 1, m
          self%hfac(j + 1:, j) = 0
       end do
+      self%rdiag = [(1/self%hfac(j, j), j=1, m)]
    end subroutine new_block_solver
 
    !> Solve [D B; B^T E] x = y in place, O(r m + m^2), allocation-free:

@@ -506,19 +506,23 @@ contains
       real(wp) :: acc
       r = solver%r
       m = solver%m
+      if (m == 1) then
+         x(r + 1) = x(r + 1)*(solver%rdiag(1)*solver%rdiag(1))
+         return
+      end if
       do j = 1, m
          acc = x(r + j)
          do i = 1, j - 1
             acc = acc - solver%hfac(i, j)*x(r + i)
          end do
-         x(r + j) = acc/solver%hfac(j, j)
+         x(r + j) = acc*solver%rdiag(j)
       end do
       do j = m, 1, -1
          acc = x(r + j)
          do i = j + 1, m
             acc = acc - solver%hfac(j, i)*x(r + i)
          end do
-         x(r + j) = acc/solver%hfac(j, j)
+         x(r + j) = acc*solver%rdiag(j)
       end do
    end subroutine stop_solve
 
@@ -628,7 +632,13 @@ contains
       z_tip = reduced%z(tip_coordinate(reduced), reduced%tip_stop)
       select case (scene%law)
       case (law_signorini)
-         call project_tip(trial, scene%lower, scene%upper, z_tip, c, tip_value)
+         if (trial >= scene%lower .and. trial <= scene%upper) then
+            ! Between the stops: project_tip's c = 0 and tip value = trial, without its division.
+            c = 0
+            tip_value = trial
+         else
+            call project_tip(trial, scene%lower, scene%upper, z_tip, c, tip_value)
+         end if
          contact = c /= 0
          r_step = c/reduced%dt2
       case (law_compliance)
