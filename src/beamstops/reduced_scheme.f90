@@ -280,7 +280,7 @@ contains
       !> Last step done.
       integer(ik), intent(out) :: done
       integer(ik) :: step, next_record, next_snapshot
-      integer :: pt, col, s, i
+      integer :: pt, s
       real(wp) :: sigma_next, weight, c, gd, tip_value, r_step, r_prev, old_tip, old_dtip
       real(wp) :: u_tip_prev, d_tip_prev, u_old_su, phi_prev, phi_now, phi_next, dt2, row(n_columns)
       logical :: contact, recording, span, enforce
@@ -576,18 +576,6 @@ contains
          gd = gd + load(i)*d(i)
       end do
    end subroutine modal_update
-
-   !> The update of a step: d^n = d^{n-1} + x + c z, q^{n+1} = q^n + d^n.
-   pure subroutine update(x, c, z, d, q)
-      real(wp), intent(in) :: x(:), z(:)
-      real(wp), intent(in) :: c
-      real(wp), intent(inout) :: d(:), q(:)
-      integer :: i
-      do i = 1, size(d)
-         d(i) = d(i) + x(i) + c*z(i)
-         q(i) = q(i) + d(i)
-      end do
-   end subroutine update
 
    !> The correction A_r^{-1} P_r lambda of a step with stops along the span: one active stop, its
    !> column `col` and multiplier c (the loop's rank-one update, as the tip's); more, the
