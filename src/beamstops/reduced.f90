@@ -50,9 +50,12 @@ module beamstops_reduced
    public :: check_stability_reduced, block_solve, reduced_stiffness_product, reduced_mass_product
    public :: reduced_matrices, expand, stop_unknowns, max_reduced_unknowns
 
-   !> Largest number of full unknowns n = 2J for which a reduced basis is built (dsbgvx keeps an
-   !> n x n orthogonal matrix and its reduction costs O(n^3) with the eigenvectors).
-   integer, parameter :: max_reduced_unknowns = 4000
+   !> Largest number of full unknowns n = 2J for which a reduced basis is built (the eigenvalues
+   !> by dsbgvx cost O(n^2)).
+   integer, parameter :: max_reduced_unknowns = 40000
+   !> Largest number of interior unknowns for which dsbgvx computes the eigenvectors too (it
+   !> keeps an n x n orthogonal matrix, O(n^3) work); beyond, inverse iteration.
+   integer, parameter :: dense_modes_limit = 4000
 
    !> A symmetric positive definite matrix [D B; B^T E] with D diagonal (r), B (r x m), E (m x m),
    !> ready to solve: D^{-1}, W = D^{-1} B and the Cholesky factor R (upper, R^T R = H) of the Schur
@@ -132,6 +135,20 @@ module beamstops_reduced
          real(wp), intent(in) :: vl, vu, abstol
          integer, intent(out) :: m, iwork(*), ifail(*), info
       end subroutine dsbgvx
+      subroutine dgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
+         import :: wp
+         integer, intent(in) :: m, n, kl, ku, ldab
+         real(wp), intent(inout) :: ab(ldab, *)
+         integer, intent(out) :: ipiv(*), info
+      end subroutine dgbtrf
+      subroutine dgbtrs(trans, n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
+         import :: wp
+         character, intent(in) :: trans
+         integer, intent(in) :: n, kl, ku, nrhs, ldab, ipiv(*), ldb
+         real(wp), intent(in) :: ab(ldab, *)
+         real(wp), intent(inout) :: b(ldb, *)
+         integer, intent(out) :: info
+      end subroutine dgbtrs
       subroutine dpotrf(uplo, n, a, lda, info)
          import :: wp
          character, intent(in) :: uplo
@@ -184,7 +201,7 @@ contains
          allocate (error)
          error%message = source//': &mesh modes = '//fmt_int(int(scene%modes, ik))//' with elements = '// &
             & fmt_int(int(n/2, ik))//' is out of range; allowed: modes = 0, or elements <= '// &
-            & fmt_int(int(max_reduced_unknowns/2, ik))//' for a reduced model (its modes are computed by dsbgvx, O(n^3))'
+            & fmt_int(int(max_reduced_unknowns/2, ik))//' for a reduced model (its frequencies are computed by dsbgvx, O(n^2))'
          return
       end if
       if (scene%checkpoint_every > 0) then
@@ -214,7 +231,7 @@ contains
    end subroutine prepare_reduced
 
    !> Build the reduced model of a scene (scene%modes = r >= 1) from its full model.
-   subroutine build_reduced(scene, model, reduced, error)
+   subroutine build_reduced(scene, model, reduced, error, inverse_iteration)
       !> Validated scene.
       type(scene_type), intent(in) :: scene
       !> Its full model (build_model).
@@ -223,9 +240,13 @@ contains
       type(reduced_model_type), intent(out) :: reduced
       !> Set when r is out of range or LAPACK fails.
       type(error_type), allocatable, intent(out) :: error
+      !> The eigenvectors by inverse iteration (.true.) or by dsbgvx (.false.); default: by
+      !> inverse iteration when n - m > dense_modes_limit or r <= (n - m)/4 with n - m > 600.
+      logical, intent(in), optional :: inverse_iteration
       real(wp), allocatable :: phi_i(:, :), psi_i(:, :), mt(:, :), st(:, :), col(:), w(:)
       integer, allocatable :: interior(:)
       integer :: n, m, r, ni, j, k
+      logical :: by_iteration
 
       n = model%n
       r = scene%modes
@@ -257,7 +278,9 @@ contains
       reduced%lift = model%lift
 
       interior = interior_unknowns(n, reduced%b)
-      call fixed_interface_modes(model%stiffness, model%mass, interior, r, reduced%lambda, phi_i, error)
+      by_iteration = ni > dense_modes_limit .or. (ni > 600 .and. 4*r <= ni)
+      if (present(inverse_iteration)) by_iteration = inverse_iteration
+      call fixed_interface_modes(model%stiffness, model%mass, interior, r, by_iteration, reduced%lambda, phi_i, error)
       if (allocated(error)) return
       call constraint_modes(model%stiffness, interior, reduced%b, psi_i, error)
       if (allocated(error)) return
@@ -340,21 +363,34 @@ contains
       end do
    end function band_restriction
 
-   !> The first r eigenpairs of (S_ii, M_ii) by dsbgvx, eigenvectors M_ii-normalized (n - m, r).
-   subroutine fixed_interface_modes(stiffness, mass, interior, r, lambda, phi, error)
+   !> The first r eigenpairs of (S_ii, M_ii), eigenvectors M_ii-normalized (n - m, r): all by
+   !> dsbgvx with its n x n orthogonal matrix (O(n^3): small meshes, or many modes), or the
+   !> eigenvalues by dsbgvx alone (O(n^2)) and each eigenvector by inverse iteration with the
+   !> band LU factor of S_ii - lambda_k M_ii (O(n) a mode).
+   subroutine fixed_interface_modes(stiffness, mass, interior, r, by_inverse_iteration, lambda, phi, error)
       real(wp), intent(in) :: stiffness(:, :), mass(:, :)
       integer, intent(in) :: interior(:), r
+      logical, intent(in) :: by_inverse_iteration
       real(wp), allocatable, intent(out) :: lambda(:), phi(:, :)
       type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: sa(:, :), ma(:, :), q(:, :), w(:), work(:)
+      real(wp), allocatable :: sa(:, :), ma(:, :), sb(:, :), mb(:, :), q(:, :), w(:), work(:)
       integer, allocatable :: iwork(:), ifail(:)
       integer :: ni, found, info, stat
-      character :: range
+      character :: range, jobz
       ni = size(interior)
       allocate (sa(kd + 1, ni), ma(kd + 1, ni))
       sa = band_restriction(stiffness, interior)
       ma = band_restriction(mass, interior)
-      allocate (q(ni, ni), w(ni), phi(ni, r), work(7*ni), iwork(5*ni), ifail(ni), stat=stat)
+      jobz = 'V'
+      if (by_inverse_iteration) then
+         jobz = 'N'
+         sb = sa
+         mb = ma
+         allocate (q(1, 1), stat=stat)
+      else
+         allocate (q(ni, ni), stat=stat)
+      end if
+      if (stat == 0) allocate (w(ni), phi(ni, r), work(7*ni), iwork(5*ni), ifail(ni), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, 'reduced model: not enough memory for the eigenvectors of '//fmt_int(int(ni, ik))// &
             & ' unknowns')
@@ -362,7 +398,7 @@ contains
       end if
       range = 'I'
       if (r == ni) range = 'A'
-      call dsbgvx('V', range, 'U', ni, kd, kd, sa, kd + 1, ma, kd + 1, q, ni, 0.0_wp, 0.0_wp, 1, r, &
+      call dsbgvx(jobz, range, 'U', ni, kd, kd, sa, kd + 1, ma, kd + 1, q, size(q, 1), 0.0_wp, 0.0_wp, 1, r, &
          & 2*tiny(1.0_wp), found, w, phi, ni, work, iwork, ifail, info)
       if (info /= 0 .or. found /= r) then
          call fatal_error(error, 'reduced model: dsbgvx found '//fmt_int(int(found, ik))//' of '//fmt_int(int(r, ik))// &
@@ -370,7 +406,62 @@ contains
          return
       end if
       lambda = w(1:r)
+      if (by_inverse_iteration) call inverse_iteration(sb, mb, lambda, phi, error)
    end subroutine fixed_interface_modes
+
+   !> Eigenvectors of (S, M) (band storage) for known eigenvalues, ascending: for each, three
+   !> steps of inverse iteration x <- (S - lambda M)^{-1} M x with the band LU factor (dgbtrf),
+   !> M-orthogonalized against the vectors already found for eigenvalues within 1e-6 of it
+   !> (a safeguard for equal eigenvalues; the stops hold values, not slopes, so the segments
+   !> between them stay coupled and the beam's are distinct), M-normalized.
+   subroutine inverse_iteration(s, m, lambda, phi, error)
+      real(wp), intent(in) :: s(:, :), m(:, :), lambda(:)
+      real(wp), intent(out) :: phi(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: kl = kd, ku = kd, ldab = 2*kl + ku + 1, steps = 3
+      real(wp), allocatable :: ab(:, :), x(:), y(:)
+      integer, allocatable :: ipiv(:)
+      real(wp) :: shift, golden
+      integer :: n, i, j, k, it, info, attempt
+      n = size(s, 2)
+      allocate (ab(ldab, n), x(n), y(n), ipiv(n))
+      golden = (sqrt(5.0_wp) - 1)/2
+      do k = 1, size(lambda)
+         shift = lambda(k)
+         do attempt = 1, 4
+            ab = 0
+            do j = 1, n
+               do i = max(1, j - kd), j
+                  ab(kl + ku + 1 + i - j, j) = s(kd + 1 + i - j, j) - shift*m(kd + 1 + i - j, j)
+                  ab(kl + ku + 1 + j - i, i) = ab(kl + ku + 1 + i - j, j)
+               end do
+            end do
+            call dgbtrf(n, n, kl, ku, ab, ldab, ipiv, info)
+            if (info == 0) exit
+            ! An exactly singular shift: move it by a few ulps.
+            shift = shift*(1 + 8*epsilon(1.0_wp)) + tiny(1.0_wp)
+         end do
+         if (info /= 0) then
+            call fatal_error(error, 'reduced model: dgbtrf: S - lambda M singular for mode '//fmt_int(int(k, ik)))
+            return
+         end if
+         ! A start with components along every mode (a fixed pseudo-random sequence).
+         x = [(modulo(golden*real(i + 7919*k, wp), 1.0_wp) - 0.5_wp, i=1, n)]
+         do it = 1, steps
+            call band_matvec(m, x, y)
+            call dgbtrs('N', n, kl, ku, 1, ab, ldab, ipiv, y, n, info)
+            x = y/maxval(abs(y))
+            do j = 1, k - 1
+               if (abs(lambda(j) - lambda(k)) > 1.0e-6_wp*abs(lambda(k))) cycle
+               call band_matvec(m, phi(:, j), y)
+               x = x - dot_product(x, y)*phi(:, j)
+            end do
+            call band_matvec(m, x, y)
+            x = x/sqrt(dot_product(x, y))
+         end do
+         phi(:, k) = x
+      end do
+   end subroutine inverse_iteration
 
    !> Each mode phi M-normalized again and its eigenvalue replaced by the Rayleigh quotient
    !> phi^T S phi with the band products: dsbgvx's eigenvalues carry an absolute error of
