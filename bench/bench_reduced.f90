@@ -11,7 +11,7 @@
 !> Prints `key value` lines. Timings are the thread's CPU time (beamstops_clock; on a shared
 !> machine less noisy than wall-clock), best of three.
 program bench_reduced
-   use, intrinsic :: iso_fortran_env, only: int64, error_unit
+   use, intrinsic :: iso_fortran_env, only: error_unit
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type
    use beamstops_scene, only: scene_type, steps_of, record_count
@@ -27,8 +27,6 @@ program bench_reduced
    implicit none
 
    character(len=64) :: what
-   integer :: nargs
-   nargs = command_argument_count()
    what = argument(1, 'cost')
    select case (trim(what))
    case ('cost')

@@ -283,6 +283,7 @@ contains
       integer :: pt, s
       real(wp) :: sigma_next, weight, c, gd, tip_value, r_step, r_prev, old_tip, old_dtip
       real(wp) :: u_tip_prev, d_tip_prev, u_old_su, phi_prev, phi_now, phi_next, dt2, row(n_columns)
+      real(wp) :: usu, dsu, dmd
       logical :: contact, recording, span, enforce
       type(load_rotation) :: loads
 
@@ -307,10 +308,9 @@ contains
          weight = reduced%beta*sigma_next + (1 - 2*reduced%beta)*state%sigma_now + reduced%beta*state%sigma_prev
          recording = step == next_record
          if (recording) then
-            call reduced_stiffness_product(reduced, state%q, state%sq)
-            u_old_su = dot_product(state%q, state%sq)
-            u_tip_prev = dot_product(reduced%tip_row, state%q)
-            d_tip_prev = dot_product(reduced%tip_row, state%d)
+            u_old_su = stiffness_norm2(reduced, state%q)
+            u_tip_prev = tip_value_of(reduced, state%q)
+            d_tip_prev = tip_value_of(reduced, state%d)
          end if
          ! x = A_r^{-1} dt^2 (weight l_r - S_r q): the modal part left as D^{-1} y_a (modal_rhs), the
          ! stop part complete; the modal part is finished by modal_update with the contact's
@@ -384,13 +384,14 @@ contains
             row = 0
             row(col_t) = real(step, wp)*reduced%dt
             row(col_u) = u_tip_prev
-            row(col_v) = (dot_product(reduced%tip_row, state%d) + d_tip_prev)/(2*reduced%dt)
+            row(col_v) = (tip_value_of(reduced, state%d) + d_tip_prev)/(2*reduced%dt)
             row(col_reaction) = scene%mass_per_length*r_prev
             row(col_work) = scene%mass_per_length*state%work
             row(col_dissipated) = scene%mass_per_length*state%dissipated
-            call reduced_stiffness_product(reduced, state%q, state%sq)
-            row(col_energy) = scene%mass_per_length*energy(reduced, reduced_mass_product(reduced, state%d), &
-               & dot_product(state%q, state%sq), dot_product(state%d, state%sq), u_old_su)
+            call energy_terms(reduced%r, reduced%m, reduced%lambda, reduced%a_solver%bt, state%q, state%d, state%acc, &
+               & usu, dsu, dmd)
+            call stop_energy_terms(reduced, state%q, state%d, usu, dsu, dmd)
+            row(col_energy) = scene%mass_per_length*energy(reduced, dmd, usu, dsu, u_old_su)
             call recorder%record(row)
          end if
          if (step == next_snapshot) then
@@ -454,6 +455,90 @@ contains
       loads%k = loads%k + 1
    end subroutine next_load
 
+   !> The tip value of a reduced vector: its tip coordinate when the tip is a stop, else T(tip, :) q.
+   pure function tip_value_of(reduced, q) result(u)
+      type(reduced_model_type), intent(in) :: reduced
+      real(wp), intent(in) :: q(:)
+      real(wp) :: u
+      if (reduced%tip_stop > 0) then
+         u = q(reduced%r + reduced%tip_stop)
+      else
+         u = dot_product(reduced%tip_row, q)
+      end if
+   end function tip_value_of
+
+   !> q^T S_r q = sum lambda_k a_k^2 + p^T K_pp p.
+   pure function stiffness_norm2(reduced, q) result(qsq)
+      type(reduced_model_type), intent(in) :: reduced
+      real(wp), intent(in) :: q(:)
+      real(wp) :: qsq
+      integer :: r, i, j
+      real(wp) :: acc
+      r = reduced%r
+      qsq = 0
+      do i = 1, r
+         qsq = qsq + reduced%lambda(i)*q(i)*q(i)
+      end do
+      do j = 1, reduced%m
+         acc = 0
+         do i = 1, reduced%m
+            acc = acc + reduced%stiffness_pp(i, j)*q(r + i)
+         end do
+         qsq = qsq + q(r + j)*acc
+      end do
+   end function stiffness_norm2
+
+   !> The modal parts of q.S_r q, d.S_r q and d.M_r d in one sweep (the coupling's B d_a kept in
+   !> dmd as d_p . (B^T d_a), twice).
+   pure subroutine energy_terms(r, m, lambda, bt, q, d, bd, usu, dsu, dmd)
+      integer, intent(in) :: r, m
+      real(wp), intent(in) :: lambda(r), bt(m, r), q(r + m), d(r + m)
+      !> Workspace (m).
+      real(wp), intent(out) :: bd(m)
+      real(wp), intent(out) :: usu, dsu, dmd
+      integer :: i, j
+      real(wp) :: b1
+      usu = 0
+      dsu = 0
+      dmd = 0
+      bd = 0
+      b1 = 0
+      do i = 1, r
+         usu = usu + lambda(i)*q(i)*q(i)
+         dsu = dsu + lambda(i)*d(i)*q(i)
+         dmd = dmd + d(i)*d(i)
+         b1 = b1 + bt(1, i)*d(i)
+         do j = 2, m
+            bd(j) = bd(j) + bt(j, i)*d(i)
+         end do
+      end do
+      bd(1) = b1
+      do j = 1, m
+         dmd = dmd + 2*d(r + j)*bd(j)
+      end do
+   end subroutine energy_terms
+
+   !> The stop block's parts of q.S_r q, d.S_r q and d.M_r d, added (O(m^2)).
+   pure subroutine stop_energy_terms(reduced, q, d, usu, dsu, dmd)
+      type(reduced_model_type), intent(in) :: reduced
+      real(wp), intent(in) :: q(:), d(:)
+      real(wp), intent(inout) :: usu, dsu, dmd
+      integer :: r, i, j
+      real(wp) :: kq, md
+      r = reduced%r
+      do j = 1, reduced%m
+         kq = 0
+         md = 0
+         do i = 1, reduced%m
+            kq = kq + reduced%stiffness_pp(i, j)*q(r + i)
+            md = md + reduced%mass_pp(i, j)*d(r + i)
+         end do
+         usu = usu + q(r + j)*kq
+         dsu = dsu + d(r + j)*kq
+         dmd = dmd + d(r + j)*md
+      end do
+   end subroutine stop_energy_terms
+
    !> First pass over the modal coordinates: x_a = D^{-1} dt^2 (weight l_a - Lambda a) and
    !> acc = B^T x_a, in one sweep (O(r m)).
    pure subroutine modal_rhs(r, m, dinv, bt, lambda, load, q, dt2, weight, x, acc)
@@ -462,14 +547,16 @@ contains
       real(wp), intent(inout) :: x(r + m)
       real(wp), intent(out) :: acc(m)
       integer :: i, j
-      real(wp) :: xi
+      real(wp) :: xi, a1
       acc = 0
       if (m == 1) then
+         a1 = 0
          do i = 1, r
             xi = dinv(i)*(dt2*(weight*load(i) - lambda(i)*q(i)))
             x(i) = xi
-            acc(1) = acc(1) + bt(1, i)*xi
+            a1 = a1 + bt(1, i)*xi
          end do
+         acc(1) = a1
       else
          do i = 1, r
             xi = dinv(i)*(dt2*(weight*load(i) - lambda(i)*q(i)))
