@@ -56,6 +56,8 @@ module beamstops_reduced
    !> Largest number of interior unknowns for which dsbgvx computes the eigenvectors too (it
    !> keeps an n x n orthogonal matrix, O(n^3) work); beyond, inverse iteration.
    integer, parameter :: dense_modes_limit = 4000
+   !> Largest number of entries of the basis T, n (r + m) (2 GB).
+   real(wp), parameter :: max_basis_entries = 2.5e8_wp
 
    !> A symmetric positive definite matrix [D B; B^T E] with D diagonal (r), B (r x m), E (m x m),
    !> ready to solve: D^{-1}, W = D^{-1} B and the Cholesky factor R (upper, R^T R = H) of the Schur
@@ -204,6 +206,14 @@ contains
             & fmt_int(int(max_reduced_unknowns/2, ik))//' for a reduced model (its frequencies are computed by dsbgvx, O(n^2))'
          return
       end if
+      if (real(n, wp)*real(scene%modes + m, wp) > max_basis_entries) then
+         allocate (error)
+         error%message = source//': &mesh modes = '//fmt_int(int(scene%modes, ik))//' with elements = '// &
+            & fmt_int(int(n/2, ik))//' is out of range; allowed: modes <= '// &
+            & fmt_int(int(max_basis_entries/real(n, wp), ik) - m)//' for this mesh (the basis T keeps 2*elements x '// &
+            & '(modes + stops) values, at most '//fmt_int(int(max_basis_entries, ik))//')'
+         return
+      end if
       if (scene%checkpoint_every > 0) then
          allocate (error)
          error%message = source//': &output checkpoint_every = '//fmt_int(scene%checkpoint_every)// &
@@ -245,7 +255,7 @@ contains
       logical, intent(in), optional :: inverse_iteration
       real(wp), allocatable :: phi_i(:, :), psi_i(:, :), mt(:, :), st(:, :), col(:), w(:)
       integer, allocatable :: interior(:)
-      integer :: n, m, r, ni, j, k
+      integer :: n, m, r, ni, j, k, stat
       logical :: by_iteration
 
       n = model%n
@@ -285,7 +295,12 @@ contains
       call constraint_modes(model%stiffness, interior, reduced%b, psi_i, error)
       if (allocated(error)) return
 
-      allocate (reduced%basis(n, r + m))
+      allocate (reduced%basis(n, r + m), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, 'reduced model: not enough memory for the basis T ('//fmt_int(int(n, ik))//' x '// &
+            & fmt_int(int(r + m, ik))//')')
+         return
+      end if
       reduced%basis = 0
       do k = 1, r
          reduced%basis(interior, k) = phi_i(:, k)
@@ -303,9 +318,16 @@ contains
          call band_matvec(model%mass, reduced%basis(:, r + j), mt(:, j))
          call band_matvec(model%stiffness, reduced%basis(:, r + j), st(:, j))
       end do
-      reduced%coupling = matmul(transpose(reduced%basis(:, 1:r)), mt)
-      reduced%mass_pp = matmul(transpose(reduced%basis(:, r + 1:)), mt)
-      reduced%stiffness_pp = matmul(transpose(reduced%basis(:, r + 1:)), st)
+      allocate (reduced%coupling(r, m), reduced%mass_pp(m, m), reduced%stiffness_pp(m, m))
+      do j = 1, m
+         do k = 1, r
+            reduced%coupling(k, j) = dot_product(reduced%basis(:, k), mt(:, j))
+         end do
+         do k = 1, m
+            reduced%mass_pp(k, j) = dot_product(reduced%basis(:, r + k), mt(:, j))
+            reduced%stiffness_pp(k, j) = dot_product(reduced%basis(:, r + k), st(:, j))
+         end do
+      end do
       reduced%mass_pp = 0.5_wp*(reduced%mass_pp + transpose(reduced%mass_pp))
       reduced%stiffness_pp = 0.5_wp*(reduced%stiffness_pp + transpose(reduced%stiffness_pp))
 

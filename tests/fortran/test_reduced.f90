@@ -631,6 +631,15 @@ contains
       call note(error%message)
       deallocate (error)
       scene%checkpoint_every = 0
+      scene%modes = 20000
+      call validate_reduced(scene, 40000, 1, 'in.nml', error)
+      if (.not. allocated(error)) then
+         call test_failed(error, 'a basis of 40000 x 20001 refused')
+         return
+      end if
+      call note(error%message)
+      deallocate (error)
+      scene%modes = 3
       call validate_reduced(scene, 100000, 1, 'in.nml', error)
       if (.not. allocated(error)) then
          call test_failed(error, 'a reduced model of 100000 unknowns refused')
