@@ -4,6 +4,8 @@
 !>                                            stops, beta = 1/2, a record every EVERY steps to a
 !>                                            recorder that keeps nothing) for each r, and of the
 !>                                            full engine's loop; plus the time to build each model
+!>   bench_reduced tube J STEPS EVERY r1 r2 ...  the same for the tube of input/tube_supports.nml
+!>                                            (stops at J/3, 2J/3 and the tip; J a multiple of 3)
 !>   bench_reduced error J DT r1 r2 ...       largest tip difference to the full model (same J, dt)
 !>                                            over t <= 0.08 s (before the first impact) and over
 !>                                            t <= 0.2 s, for each r
@@ -31,6 +33,8 @@ program bench_reduced
    select case (trim(what))
    case ('cost')
       call bench_cost(int_argument(2, 19), int_argument(3, 100000), int_argument(4, 1))
+   case ('tube')
+      call bench_cost(int_argument(2, 30), int_argument(3, 100000), int_argument(4, 1), tube=.true.)
    case ('error')
       call bench_error(int_argument(2, 19), real_argument(3, 1.0e-5_wp))
    case default
@@ -51,8 +55,9 @@ contains
       scene%beta = 0.5_wp
    end function paper_scene
 
-   subroutine bench_cost(elements, steps, every)
+   subroutine bench_cost(elements, steps, every, tube)
       integer, intent(in) :: elements, steps, every
+      logical, intent(in), optional :: tube
       type(scene_type) :: scene
       type(model_type) :: model
       type(reduced_model_type) :: reduced
@@ -63,6 +68,17 @@ contains
       real(wp) :: best, build
       integer :: k, rep, r
       scene = paper_scene(elements, 1.0e-6_wp, steps*1.0e-6_wp)
+      if (present(tube)) then
+         scene%beta = 0.25_wp
+         scene%length = 1.5_wp
+         scene%amplitude = 0.002_wp
+         scene%omega = 40.0_wp
+         scene%dt = 2e-5_wp
+         scene%t_end = steps*scene%dt
+         scene%stop_nodes = [elements/3, 2*elements/3, elements]
+         scene%stop_lower = [-0.002_wp, -0.002_wp, -0.004_wp]
+         scene%stop_upper = [0.002_wp, 0.002_wp, 0.004_wp]
+      end if
       scene%record_every = every
       t0 = thread_cpu_seconds()
       call prepare_run(scene, 'bench', model, error)
