@@ -6,6 +6,9 @@
 !>                                            full engine's loop; plus the time to build each model
 !>   bench_reduced tube J STEPS EVERY r1 r2 ...  the same for the tube of input/tube_supports.nml
 !>                                            (stops at J/3, 2J/3 and the tip; J a multiple of 3)
+!>   bench_reduced stats J DT T0 T1 r1 r2 ...  power the stops take (W), RMS tip (m) and impacts
+!>                                            per second over [T0, T1] (paper's scene, beta = 1/2,
+!>                                            a record every 10 steps), full model then each r
 !>   bench_reduced error J DT r1 r2 ...       largest tip difference to the full model (same J, dt)
 !>                                            over t <= 0.08 s (before the first impact) and over
 !>                                            t <= 0.2 s, for each r
@@ -21,7 +24,7 @@ program bench_reduced
    use beamstops_run, only: prepare_run, simulate
    use beamstops_summary, only: run_summary
    use beamstops_recorder_array, only: array_recorder
-   use beamstops_recorder, only: col_t, col_u
+   use beamstops_recorder, only: col_t, col_u, col_dissipated
    use beamstops_reduced, only: reduced_model_type, build_reduced, stop_unknowns
    use beamstops_reduced_scheme, only: simulate_reduced
    use bench_null_recorder, only: null_recorder
@@ -35,10 +38,13 @@ program bench_reduced
       call bench_cost(int_argument(2, 19), int_argument(3, 100000), int_argument(4, 1))
    case ('tube')
       call bench_cost(int_argument(2, 30), int_argument(3, 100000), int_argument(4, 1), tube=.true.)
+   case ('stats')
+      call bench_stats(int_argument(2, 19), real_argument(3, 1.0e-5_wp), real_argument(4, 2.0_wp), &
+         & real_argument(5, 22.0_wp))
    case ('error')
       call bench_error(int_argument(2, 19), real_argument(3, 1.0e-5_wp))
    case default
-      write (error_unit, '(a)') 'usage: bench_reduced cost|error ...'
+      write (error_unit, '(a)') 'usage: bench_reduced cost|tube|stats|error ...'
       error stop 2
    end select
 
@@ -158,6 +164,64 @@ contains
             & ' tip_error_to_0.2s_m ', through, ' impacts ', summary%impacts
       end do
    end subroutine bench_error
+
+   subroutine bench_stats(elements, dt, t0, t1)
+      integer, intent(in) :: elements
+      real(wp), intent(in) :: dt, t0, t1
+      type(scene_type) :: scene
+      type(model_type) :: model
+      type(reduced_model_type) :: reduced
+      type(array_recorder) :: rec
+      type(run_summary) :: summary
+      type(error_type), allocatable :: error
+      integer :: k, r
+      scene = paper_scene(elements, dt, t1)
+      scene%record_every = 10
+      call prepare_run(scene, 'bench', model, error)
+      call fail_on(error)
+      call put_int('elements', elements)
+      call put('dt', dt)
+      call rec%reserve(record_count(scene), 0_ik, elements + 1)
+      call simulate(scene, model, rec, summary, error)
+      call fail_on(error)
+      call report('full', rec, summary, t0, t1)
+      do k = 6, command_argument_count()
+         r = int_argument(k, 1)
+         if (r > 2*elements - stop_unknowns(scene)) cycle
+         scene%modes = r
+         call build_reduced(scene, model, reduced, error)
+         call fail_on(error)
+         deallocate (rec%rows, rec%snap_t, rec%snap_u, rec%stops_u, rec%stops_reaction)
+         call rec%reserve(record_count(scene), 0_ik, elements + 1)
+         call simulate_reduced(scene, reduced, rec, summary, error)
+         call fail_on(error)
+         write (*, '(a, i0, a)', advance='no') 'r ', r, ' '
+         call report('', rec, summary, t0, t1)
+      end do
+   end subroutine bench_stats
+
+   subroutine report(name, rec, summary, t0, t1)
+         character(len=*), intent(in) :: name
+         type(array_recorder), intent(in) :: rec
+         type(run_summary), intent(in) :: summary
+         real(wp), intent(in) :: t0, t1
+         integer(ik) :: j, i0, i1
+         real(wp) :: power, rms
+         i0 = 0
+         i1 = 0
+         rms = 0
+         do j = 1, rec%filled
+            if (rec%rows(col_t, j) >= t0 .and. i0 == 0) i0 = j
+            if (rec%rows(col_t, j) >= t0) then
+               rms = rms + rec%rows(col_u, j)**2
+               i1 = j
+            end if
+         end do
+         rms = sqrt(rms/real(i1 - i0 + 1, wp))
+         power = (rec%rows(col_dissipated, i1) - rec%rows(col_dissipated, i0))/(rec%rows(col_t, i1) - rec%rows(col_t, i0))
+         write (*, '(a, a, f8.4, a, f8.5, a, f9.2, a, f8.2)') name, ' stop_power_W ', power, ' rms_tip_m ', rms, &
+            & ' impacts_per_s ', real(summary%impacts, wp)/t1, ' cpu_s ', summary%cpu_seconds
+   end subroutine report
 
    subroutine fail_on(error)
       type(error_type), allocatable, intent(in) :: error
