@@ -73,8 +73,6 @@ module beamstops_reduced
       real(wp), allocatable :: w(:, :)
       !> Upper Cholesky factor R of H (m, m), zero below the diagonal.
       real(wp), allocatable :: hfac(:, :)
-      !> B^T and W^T (m, r): the layouts of the time loop's sweeps over the modes.
-      real(wp), allocatable :: bt(:, :), wt(:, :)
       !> 1/R_jj (m): the time loop multiplies instead of dividing.
       real(wp), allocatable :: rdiag(:)
    end type block_solver_type
@@ -567,8 +565,6 @@ contains
       do j = 1, m
          self%w(:, j) = self%dinv*b(:, j)
       end do
-      self%bt = transpose(b)
-      self%wt = transpose(self%w)
       self%hfac = e - matmul(transpose(b), self%w)
       self%hfac = 0.5_wp*(self%hfac + transpose(self%hfac))
       call dpotrf('U', m, self%hfac, m, info)

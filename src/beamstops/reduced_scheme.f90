@@ -315,7 +315,7 @@ contains
          ! x = A_r^{-1} dt^2 (weight l_r - S_r q): the modal part left as D^{-1} y_a (modal_rhs), the
          ! stop part complete; the modal part is finished by modal_update with the contact's
          ! correction.
-         call modal_rhs(reduced%r, reduced%m, reduced%a_solver%dinv, reduced%a_solver%bt, reduced%lambda, &
+         call modal_rhs(reduced%r, reduced%m, reduced%a_solver%dinv, reduced%a_solver%b, reduced%lambda, &
             & reduced%load, state%q, dt2, weight, state%x, state%acc)
          call stop_rhs(reduced, state%q, dt2, weight, state%acc, state%x)
          r_prev = state%reaction
@@ -330,7 +330,7 @@ contains
                state%active(:state%n_active) = state%span%qp%active(:state%n_active)
                state%multiplier(:state%n_active) = state%span%lambda(state%active(:state%n_active))
             end if
-            call modal_update(reduced%r, reduced%m, reduced%size, reduced%a_solver%wt, reduced%z, reduced%load, &
+            call modal_update(reduced%r, reduced%m, reduced%size, reduced%a_solver%w, reduced%z, reduced%load, &
                & state%n_active, state%active, state%multiplier, state%x, state%d, state%q, gd)
             contact = state%span%contact
             if (enforce) call stops_settle(reduced%stops, state%span, state%q, state%d, state%max_violation)
@@ -363,7 +363,7 @@ contains
                state%active(1) = reduced%tip_stop
                state%multiplier(1) = c
             end if
-            call modal_update(reduced%r, reduced%m, reduced%size, reduced%a_solver%wt, reduced%z, reduced%load, &
+            call modal_update(reduced%r, reduced%m, reduced%size, reduced%a_solver%w, reduced%z, reduced%load, &
                & state%n_active, state%active, state%multiplier, state%x, state%d, state%q, gd)
             if (scene%law == law_signorini .and. contact) then
                state%q(pt) = tip_value
@@ -388,7 +388,7 @@ contains
             row(col_reaction) = scene%mass_per_length*r_prev
             row(col_work) = scene%mass_per_length*state%work
             row(col_dissipated) = scene%mass_per_length*state%dissipated
-            call energy_terms(reduced%r, reduced%m, reduced%lambda, reduced%a_solver%bt, state%q, state%d, state%acc, &
+            call energy_terms(reduced%r, reduced%m, reduced%lambda, reduced%a_solver%b, state%q, state%d, state%acc, &
                & usu, dsu, dmd)
             call stop_energy_terms(reduced, state%q, state%d, usu, dsu, dmd)
             row(col_energy) = scene%mass_per_length*energy(reduced, dmd, usu, dsu, u_old_su)
@@ -490,9 +490,9 @@ contains
 
    !> The modal parts of q.S_r q, d.S_r q and d.M_r d in one sweep (the coupling's B d_a kept in
    !> dmd as d_p . (B^T d_a), twice).
-   pure subroutine energy_terms(r, m, lambda, bt, q, d, bd, usu, dsu, dmd)
+   pure subroutine energy_terms(r, m, lambda, b, q, d, bd, usu, dsu, dmd)
       integer, intent(in) :: r, m
-      real(wp), intent(in) :: lambda(r), bt(m, r), q(r + m), d(r + m)
+      real(wp), intent(in) :: lambda(r), b(r, m), q(r + m), d(r + m)
       !> Workspace (m).
       real(wp), intent(out) :: bd(m)
       real(wp), intent(out) :: usu, dsu, dmd
@@ -507,12 +507,12 @@ contains
          usu = usu + lambda(i)*q(i)*q(i)
          dsu = dsu + lambda(i)*d(i)*q(i)
          dmd = dmd + d(i)*d(i)
-         b1 = b1 + bt(1, i)*d(i)
-         do j = 2, m
-            bd(j) = bd(j) + bt(j, i)*d(i)
-         end do
+         b1 = b1 + b(i, 1)*d(i)
       end do
       bd(1) = b1
+      do j = 2, m
+         bd(j) = dot_product(b(:, j), d(1:r))
+      end do
       do j = 1, m
          dmd = dmd + 2*d(r + j)*bd(j)
       end do
@@ -541,29 +541,31 @@ contains
 
    !> First pass over the modal coordinates: x_a = D^{-1} dt^2 (weight l_a - Lambda a) and
    !> acc = B^T x_a, in one sweep (O(r m)).
-   pure subroutine modal_rhs(r, m, dinv, bt, lambda, load, q, dt2, weight, x, acc)
+   pure subroutine modal_rhs(r, m, dinv, b, lambda, load, q, dt2, weight, x, acc)
       integer, intent(in) :: r, m
-      real(wp), intent(in) :: dinv(r), bt(m, r), lambda(r), load(r + m), q(r + m), dt2, weight
+      real(wp), intent(in) :: dinv(r), b(r, m), lambda(r), load(r + m), q(r + m), dt2, weight
       real(wp), intent(inout) :: x(r + m)
       real(wp), intent(out) :: acc(m)
       integer :: i, j
       real(wp) :: xi, a1
-      acc = 0
       if (m == 1) then
          a1 = 0
          do i = 1, r
             xi = dinv(i)*(dt2*(weight*load(i) - lambda(i)*q(i)))
             x(i) = xi
-            a1 = a1 + bt(1, i)*xi
+            a1 = a1 + b(i, 1)*xi
          end do
          acc(1) = a1
       else
          do i = 1, r
-            xi = dinv(i)*(dt2*(weight*load(i) - lambda(i)*q(i)))
-            x(i) = xi
-            do j = 1, m
-               acc(j) = acc(j) + bt(j, i)*xi
+            x(i) = dinv(i)*(dt2*(weight*load(i) - lambda(i)*q(i)))
+         end do
+         do j = 1, m
+            a1 = 0
+            do i = 1, r
+               a1 = a1 + b(i, j)*x(i)
             end do
+            acc(j) = a1
          end do
       end if
    end subroutine modal_rhs
@@ -616,39 +618,47 @@ contains
    !> Second pass, the update: x_a = D^{-1} y_a - W x_p, plus the contact's correction
    !> sum_k multiplier_k z(:, active_k) on every coordinate; d^n = d^{n-1} + x, q^{n+1} = q^n + d^n,
    !> and gd = l_r . d^n, in one sweep (O(r (m + n_active))).
-   pure subroutine modal_update(r, m, s, wt, z, load, n_active, active, multiplier, x, d, q, gd)
+   pure subroutine modal_update(r, m, s, w, z, load, n_active, active, multiplier, x, d, q, gd)
       integer, intent(in) :: r, m, s, n_active
-      real(wp), intent(in) :: wt(m, r), z(s, m), load(s)
+      real(wp), intent(in) :: w(r, m), z(s, m), load(s)
       integer, intent(in) :: active(m)
       real(wp), intent(in) :: multiplier(m)
       real(wp), intent(inout) :: x(s), d(s), q(s)
       real(wp), intent(out) :: gd
       integer :: i, j, a
-      real(wp) :: xi
+      real(wp) :: xi, xp, c
       gd = 0
       if (m == 1 .and. n_active == 0) then
+         xp = x(r + 1)
          do i = 1, r
-            d(i) = d(i) + (x(i) - wt(1, i)*x(r + 1))
+            d(i) = d(i) + (x(i) - w(i, 1)*xp)
             q(i) = q(i) + d(i)
             gd = gd + load(i)*d(i)
          end do
       else if (m == 1) then
+         xp = x(r + 1)
+         c = multiplier(1)
          do i = 1, r
-            d(i) = d(i) + ((x(i) - wt(1, i)*x(r + 1)) + multiplier(1)*z(i, 1))
+            d(i) = d(i) + ((x(i) - w(i, 1)*xp) + c*z(i, 1))
             q(i) = q(i) + d(i)
             gd = gd + load(i)*d(i)
          end do
       else
+         do j = 1, m
+            xp = x(r + j)
+            do i = 1, r
+               x(i) = x(i) - w(i, j)*xp
+            end do
+         end do
+         do j = 1, n_active
+            a = active(j)
+            c = multiplier(j)
+            do i = 1, r
+               x(i) = x(i) + c*z(i, a)
+            end do
+         end do
          do i = 1, r
-            xi = x(i)
-            do j = 1, m
-               xi = xi - wt(j, i)*x(r + j)
-            end do
-            do j = 1, n_active
-               a = active(j)
-               xi = xi + multiplier(j)*z(i, a)
-            end do
-            d(i) = d(i) + xi
+            d(i) = d(i) + x(i)
             q(i) = q(i) + d(i)
             gd = gd + load(i)*d(i)
          end do
