@@ -31,6 +31,7 @@ contains
          & new_unittest('all modes, tip stops, beta = 1/2: the full engine to round-off up to 0.2 s', test_full_tip), &
          & new_unittest('all modes, compliance, beta = 1/4: the full engine to round-off before the first contact', test_full_compliance), &
          & new_unittest('all modes, tube supports (three stops): the full engine to round-off', test_full_span), &
+         & new_unittest('all modes, two supports, the tip free (a modal coordinate): the full engine', test_full_supports), &
          & new_unittest('all modes, no stops, beta = 0.3, paper''s load, Euler start: the full engine', test_full_free), &
          & new_unittest('frequencies of (S_r, M_r) decrease to the full ones as r grows', test_frequencies), &
          & new_unittest('static response to loads at the stops exact for any r', test_static), &
@@ -191,6 +192,18 @@ contains
       scene%t_end = 0.2_wp
       call compare_full(scene, 0.085_wp, 1e-10_wp, 0.0_wp, error)
    end subroutine test_full_compliance
+
+   !> The tube's two supports alone: the tip is not a stop coordinate, its records come from the
+   !> row of T at the tip.
+   subroutine test_full_supports(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      scene = tube_scene(0.2_wp)
+      scene%stop_nodes = [10, 20]
+      scene%stop_lower = [-0.002_wp, -0.002_wp]
+      scene%stop_upper = [0.002_wp, 0.002_wp]
+      call compare_full(scene, 0.02_wp, 1e-10_wp, 1e-6_wp, error)
+   end subroutine test_full_supports
 
    subroutine test_full_free(error)
       type(error_type), allocatable, intent(out) :: error
