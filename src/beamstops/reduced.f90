@@ -5,10 +5,13 @@
 !> node value 2i-1 with stops along the span) stay physical coordinates; the other unknowns
 !> (the interior set i, n - m of them) are spanned by
 !>  - Phi (n x r): the first r fixed-interface modes, (S_ii - omega^2 M_ii) phi_i = 0 with the
-!>    b unknowns held at zero, mass-normalized (Phi^T M Phi = I), by LAPACK dsbgvx on the band
-!>    matrices with the b rows and columns removed. Removing rows and columns of a band matrix
-!>    never widens it (the distance between two kept unknowns can only shrink), so S_ii and
-!>    M_ii keep the half-bandwidth kd = 3 of S and M, whatever b: no reordering is needed;
+!>    b unknowns held at zero, mass-normalized (Phi^T M Phi = I), from the band matrices with
+!>    the b rows and columns removed: eigenvalues by LAPACK dsbgvx, eigenvectors by dsbgvx too
+!>    (small meshes, many modes) or by inverse iteration with the band LU of S_ii - lambda M_ii
+!>    (O(n) a mode), then each eigenvalue replaced by its Rayleigh quotient with the band
+!>    products. Removing rows and columns of a band matrix never widens it (the distance between
+!>    two kept unknowns can only shrink), so S_ii and M_ii keep the half-bandwidth kd = 3 of S
+!>    and M, whatever b: no reordering is needed;
 !>  - Psi (n x m): the static constraint modes, Psi_b = I, Psi_i = -S_ii^{-1} S_ib.
 !>
 !> In q = (a, p) (a: r modal amplitudes, p: the m stop values), u = T q and
@@ -19,8 +22,9 @@
 !> with Lambda = diag(omega_k^2), B = Phi^T M Psi, M_pp = Psi^T M Psi, K_pp = Psi^T S Psi (the
 !> Schur complement S_bb - S_bi S_ii^{-1} S_ib): the modal-constraint stiffness coupling
 !> Phi^T S Psi = Phi_i^T (S_ii Psi_i + S_ib) vanishes. These blocks are what the model stores
-!> (Lambda from dsbgvx, I and 0 exact, B, M_pp, K_pp computed): the reduced operators are the
-!> T^T M T and T^T S T of the stored T to round-off. So A_r = M_r + dt^2 beta S_r has a
+!> (Lambda the Rayleigh quotients, I and 0 exact, B, M_pp, K_pp computed): the reduced
+!> operators are the T^T M T and T^T S T of the stored T to round-off (tests: 1e-12 of their
+!> largest entry), so r = n - m gives the full model's results to round-off. So A_r = M_r + dt^2 beta S_r has a
 !> diagonal modal block D = I + dt^2 beta Lambda and is solved through the m x m Schur
 !> complement H = E - B^T D^{-1} B, E = M_pp + dt^2 beta K_pp (factored once by dpotrf):
 !> O(r m + m^2) a solve instead of O((r + m)^2) with a dense factor.
@@ -34,6 +38,8 @@
 !> fixed-interface modes: p0 = u0(b), a0 = Phi^T M (u0 - Psi p0) (and the same for v0). With
 !> r = n - m, T is square and invertible, this is q0 = T^{-1} u0 exactly, and the reduced model is
 !> the full one in another basis: the scheme gives the full model's results to round-off.
+!>
+!> (The LAPACK interfaces below belong in beamstops_lapack once the branches are merged.)
 module beamstops_reduced
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_positive_inf
    use beamstops_kinds, only: wp, ik
@@ -41,7 +47,7 @@ module beamstops_reduced
    use beamstops_strings, only: fmt_int
    use beamstops_scene, only: scene_type, stop_count, law_compliance, fmt_real
    use beamstops_band, only: kd, band_matvec, cholesky_factor, cholesky_solve
-   use beamstops_model, only: model_type, build_model, check_stability
+   use beamstops_model, only: model_type, build_model
    use beamstops_contact_span_stops, only: span_stops_type
    use beamstops_contact_box_qp, only: box_qp_type, new_box_qp
    implicit none
