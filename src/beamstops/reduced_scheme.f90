@@ -280,14 +280,13 @@ contains
       !> Last step done.
       integer(ik), intent(out) :: done
       integer(ik) :: step, next_record, next_snapshot
-      integer :: pt, s
+      integer :: pt
       real(wp) :: sigma_next, weight, c, gd, tip_value, r_step, r_prev, old_tip, old_dtip
       real(wp) :: u_tip_prev, d_tip_prev, u_old_su, phi_prev, phi_now, phi_next, dt2, row(n_columns)
       real(wp) :: usu, dsu, dmd
       logical :: contact, recording, span, enforce
       type(load_rotation) :: loads
 
-      s = reduced%size
       dt2 = reduced%dt2
       pt = tip_coordinate(reduced)
       span = reduced%stops%m > 0
