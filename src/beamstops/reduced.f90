@@ -6,9 +6,10 @@
 !> (the interior set i, n - m of them) are spanned by
 !>  - Phi (n x r): the first r fixed-interface modes, (S_ii - omega^2 M_ii) phi_i = 0 with the
 !>    b unknowns held at zero, mass-normalized (Phi^T M Phi = I), from the band matrices with
-!>    the b rows and columns removed: eigenvalues by LAPACK dsbgvx, eigenvectors by dsbgvx too
-!>    (small meshes, many modes) or by inverse iteration with the band LU of S_ii - lambda M_ii
-!>    (O(n) a mode), then each eigenvalue replaced by its Rayleigh quotient with the band
+!>    the b rows and columns removed: eigenvalues by LAPACK dsbgvx (O(n^2)), eigenvectors by
+!>    inverse iteration with the band LU of S_ii - lambda M_ii (O(n) a mode, and accurate
+!>    relative to each mode's own scale, where dsbgvx's vectors are accurate only to
+!>    eps lambda_max), then each eigenvalue replaced by its Rayleigh quotient with the band
 !>    products. Removing rows and columns of a band matrix never widens it (the distance between
 !>    two kept unknowns can only shrink), so S_ii and M_ii keep the half-bandwidth kd = 3 of S
 !>    and M, whatever b: no reordering is needed;
@@ -59,8 +60,8 @@ module beamstops_reduced
    !> Largest number of full unknowns n = 2J for which a reduced basis is built (the eigenvalues
    !> by dsbgvx cost O(n^2)).
    integer, parameter :: max_reduced_unknowns = 40000
-   !> Largest number of interior unknowns for which dsbgvx computes the eigenvectors too (it
-   !> keeps an n x n orthogonal matrix, O(n^3) work); beyond, inverse iteration.
+   !> Largest number of interior unknowns for which dsbgvx may be asked for the eigenvectors too
+   !> (it keeps an n x n orthogonal matrix, O(n^3) work).
    integer, parameter :: dense_modes_limit = 4000
    !> Largest number of entries of the basis T, n (r + m) (2 GB).
    real(wp), parameter :: max_basis_entries = 2.5e8_wp
@@ -254,8 +255,8 @@ contains
       type(reduced_model_type), intent(out) :: reduced
       !> Set when r is out of range or LAPACK fails.
       type(error_type), allocatable, intent(out) :: error
-      !> The eigenvectors by inverse iteration (.true.) or by dsbgvx (.false.); default: by
-      !> inverse iteration when n - m > dense_modes_limit or r <= (n - m)/4 with n - m > 600.
+      !> The eigenvectors by inverse iteration (.true., the default) or by dsbgvx (.false.; only
+      !> up to dense_modes_limit interior unknowns).
       logical, intent(in), optional :: inverse_iteration
       real(wp), allocatable :: phi_i(:, :), psi_i(:, :), mt(:, :), st(:, :), col(:), w(:)
       integer, allocatable :: interior(:)
@@ -292,8 +293,11 @@ contains
       reduced%lift = model%lift
 
       interior = interior_unknowns(n, reduced%b)
-      by_iteration = ni > dense_modes_limit .or. (ni > 600 .and. 4*r <= ni)
-      if (present(inverse_iteration)) by_iteration = inverse_iteration
+      ! Inverse iteration by default: its modes are accurate relative to their own scale (at
+      ! J = 1000, phi_2^T S phi_1 = 5e-8 lambda_2), dsbgvx's only to eps lambda_max in absolute
+      ! terms (7e-5 lambda_2), and the modal block of S_r is taken diagonal. It is also O(n) a mode.
+      by_iteration = .true.
+      if (present(inverse_iteration)) by_iteration = inverse_iteration .or. ni > dense_modes_limit
       call fixed_interface_modes(model%stiffness, model%mass, interior, r, by_iteration, reduced%lambda, phi_i, error)
       if (allocated(error)) return
       call constraint_modes(model%stiffness, interior, reduced%b, psi_i, error)
@@ -389,10 +393,10 @@ contains
       end do
    end function band_restriction
 
-   !> The first r eigenpairs of (S_ii, M_ii), eigenvectors M_ii-normalized (n - m, r): all by
-   !> dsbgvx with its n x n orthogonal matrix (O(n^3): small meshes, or many modes), or the
+   !> The first r eigenpairs of (S_ii, M_ii), eigenvectors M_ii-normalized (n - m, r): the
    !> eigenvalues by dsbgvx alone (O(n^2)) and each eigenvector by inverse iteration with the
-   !> band LU factor of S_ii - lambda_k M_ii (O(n) a mode).
+   !> band LU factor of S_ii - lambda_k M_ii (O(n) a mode), or (on request) all by dsbgvx with
+   !> its n x n orthogonal matrix (O(n^3)).
    subroutine fixed_interface_modes(stiffness, mass, interior, r, by_inverse_iteration, lambda, phi, error)
       real(wp), intent(in) :: stiffness(:, :), mass(:, :)
       integer, intent(in) :: interior(:), r
