@@ -179,7 +179,7 @@ contains
       scene%beta = 0.5_wp
       scene%dt = 1e-5_wp
       scene%t_end = 0.2_wp
-      call compare_full(scene, 0.085_wp, 1e-10_wp, 1e-5_wp, error)
+      call compare_full(scene, 0.085_wp, 1e-10_wp, 1e-6_wp, error)
    end subroutine test_full_tip
 
    subroutine test_full_compliance(error)
