@@ -218,16 +218,32 @@ def study(folder: Optional[Path] = None, *, quick: bool = False, three_level: bo
 
 
 def _options(parser: argparse.ArgumentParser) -> None:
+    from .workprecision import qoi_options
+
     parser.add_argument("--no-three-level", action="store_true",
                         help="skip the three-level form in the round-off comparison")
+    qoi_options(parser)
 
 
 def _run(folder: Path, args: argparse.Namespace) -> Path:
-    study(folder, quick=args.quick, three_level=not args.no_three_level, quiet=args.quiet)
-    return folder / "convergence.md"
+    from . import qoi_convergence
+    from .qoi import HalfWidth
+    from .workprecision import split_qois
+
+    pointwise, statistical = split_qois(args.qoi)
+    printed = folder / "convergence.md"
+    if statistical:
+        qoi_convergence.study(folder, qois=statistical, quick=args.quick, half_width=HalfWidth.parse(args.half_width),
+                              transient=args.transient, window=args.stat_window, reference_window=args.reference_window,
+                              members=args.members, quiet=args.quiet)
+        printed = folder / "qoi_convergence.md"
+    if pointwise:
+        study(folder, quick=args.quick, three_level=not args.no_three_level, quiet=args.quiet)
+        printed = folder / "convergence.md"
+    return printed
 
 
-#: ``converge [-o DIR] [--quick] [--no-three-level]``; ``main`` is scripts/convergence.py.
+#: ``converge [-o DIR] [--quick] [--no-three-level] [--qoi NAME ...] [--half-width H]``; ``main`` is scripts/convergence.py.
 COMMAND = StudyCommand("convergence", _options, _run, name="converge",
                        help="convergence tables in Δt and h (markdown and CSV)",
                        description="Convergence tables in Δt and h against finer reference runs.",

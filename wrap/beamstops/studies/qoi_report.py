@@ -31,7 +31,7 @@ def unit_of(runs: Sequence[Measured], qoi: str) -> str:
 def row_columns(first: Sequence[str], unit: str) -> list[str]:
     """Columns of a table of runs against a reference (after the table's own ``first`` columns)."""
     u = f" ({unit})" if unit else ""
-    return list(first) + ["window (s)", "CPU (s)", f"value{u}", f"half-width{u}", f"|v − v_ref|{u}",
+    return list(first) + ["window (s)", "CPU (s)", f"value{u}", f"half-width{u}", f"abs(v − v_ref){u}",
                           f"h + h_ref{u}", "within the reference's interval", f"h*{u}", "T* (s)", "cost* (s)"]
 
 

@@ -42,7 +42,7 @@ class Settings:
 
     def describe(self) -> str:
         return (f"transient {self.transient:g} s, window {self.window:g} s (references: {self.reference_window:g} s), "
-                f"{self.batches} batch means; the first law's reference also across {self.members} members "
+                f"{self.batches} batch means; one reference also across {self.members} members "
                 f"(initial displacements perturbed by {self.perturbation:g} m)")
 
 
