@@ -113,13 +113,28 @@ def draw(table: Table, path: Path, windows: Sequence[float]) -> Path:
 
 def qoi_options(parser: argparse.ArgumentParser) -> None:
     """``--qoi`` and the statistical runs' options (shared with ``converge``)."""
-    from .qoi import POINTWISE, QOIS
+    from .qoi import POINTWISE, QOIS, HalfWidth, statistic_name
 
-    parser.add_argument("--qoi", nargs="+", default=[POINTWISE], metavar="NAME",
+    def name(text: str) -> str:
+        if text != POINTWISE:
+            try:
+                statistic_name(text)
+            except ValueError as exc:
+                raise argparse.ArgumentTypeError(str(exc)) from None
+        return text
+
+    def half_width(text: str) -> str:
+        try:
+            HalfWidth.parse(text)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+        return text
+
+    parser.add_argument("--qoi", nargs="+", type=name, default=[POINTWISE], metavar="NAME",
                         help=f"quantities of interest: {POINTWISE!r} (default: the tip against a reference over "
                              f"[0, W], today's study) or statistics of the engine after a transient: "
                              f"{', '.join(QOIS)} (or an engine statistic's own name)")
-    parser.add_argument("--half-width", default="2%", metavar="H",
+    parser.add_argument("--half-width", type=half_width, default="2%", metavar="H",
                         help="requested 95 %% half-width h* of each QoI: a percentage of the reference's value "
                              "(default 2%%) or a number in the QoI's unit")
     parser.add_argument("--transient", type=float, help="start of the statistics' window (s; default 2, quick 0.5)")
