@@ -51,12 +51,17 @@ def test_intervals_positive(quick_tables: tuple[Path, dict[str, object]]) -> Non
 
 def test_power_agrees_at_two_time_steps() -> None:
     """Physics: the stop power (Signorini, e = 0) at Δt = 4e-5 and 1e-5 agree within their intervals
-    while the trajectories differ by millimetres; without stops the power is exactly zero."""
+    while the trajectories differ by millimetres, the fraction of time in contact does not converge;
+    without stops the power is exactly zero."""
     base = Scene(beta=0.5)
     a = qoi.measure(base.replace(dt=4e-5), 0.5, 3.0, batches=10).estimate("stop_power")
     b = qoi.measure(base.replace(dt=1e-5), 0.5, 3.0, batches=10).estimate("stop_power")
     assert a.unit == "W" and a.value > 0.2 and b.value > 0.2 and 0 < a.half_width < a.value
     assert a.agrees(b), (a, b)
+    # The time in contact is not a converged statistic (SPEC 12: chatter resolved differently with Δt).
+    fa = qoi.measure(base.replace(dt=4e-5), 0.5, 3.0, batches=10).estimate("contact_fraction")
+    fb = qoi.measure(base.replace(dt=1e-5), 0.5, 3.0, batches=10).estimate("contact_fraction")
+    assert fa.value > fb.value and not fa.agrees(fb), (fa, fb)
     free = qoi.measure(base.replace(dt=4e-5, law="none"), 0.5, 1.0, batches=5).estimate("stop_power")
     assert free.value == 0
 

@@ -10,7 +10,10 @@ Errors (all from engine runs, compared here):
   the coarse field is written exactly on the reference mesh (:func:`common.prolong`).
 
 ``python -m beamstops converge`` and ``scripts/convergence.py`` write the tables
-(markdown and CSV) of :func:`study` into out/convergence.
+(markdown and CSV) of :func:`study` into out/convergence. With ``--qoi NAME ...`` they run the
+convergence of statistics after a transient instead (:mod:`beamstops.studies.qoi_convergence`:
+value ± 95 % half-width against Δt and J with a fine reference's interval); ``--qoi tip`` (the
+default) keeps these pointwise tables.
 """
 
 from __future__ import annotations

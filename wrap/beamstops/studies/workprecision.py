@@ -8,6 +8,12 @@ against one fine reference run of the Signorini scheme (β = 1/2, centred) over 
 the first contact period (w = 0.2 s, where the paper sees runs agree by eye); the cost
 is the engine's ``cpu_seconds`` (the time loop's CPU time). Read the chart horizontally:
 at a given error, the leftmost curve is the fastest method.
+
+With ``--qoi NAME ...`` (statistics of the engine: stop_power, impulse_rate, shock_rate,
+contact_fraction, tip_rms, ...) the chart is the statistical one of
+:mod:`beamstops.studies.qoi_workprecision` (CPU against the 95 % half-width after a transient, one
+curve per contact law, the cost to reach ``--half-width``); ``--qoi tip`` (the default) is the
+pointwise study above, and both can be asked for at once.
 """
 
 from __future__ import annotations
