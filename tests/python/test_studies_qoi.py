@@ -117,3 +117,16 @@ def test_cli_refuses_bad_options(tmp_path: Path, options: list[str], capsys: pyt
     assert exit_.value.code == 2
     assert not (tmp_path / "never").exists()
     assert "--" in capsys.readouterr().err
+
+
+def test_projection_checked_by_a_run(quick_tables: tuple[Path, dict[str, object]]) -> None:
+    """The window T* projected from h ∝ 1/sqrt(T) gives a half-width near h* when run."""
+    _, tables = quick_tables
+    table = tables["stop_power"]
+    rows = [row for row in table.rows if str(row[0]).endswith("(check at T*)")]  # type: ignore[attr-defined]
+    assert len(rows) == 1
+    col = {name: i for i, name in enumerate(table.columns)}  # type: ignore[attr-defined]
+    half = rows[0][next(i for n, i in col.items() if n.startswith("half-width"))]
+    target = rows[0][next(i for n, i in col.items() if n.startswith("h*"))]
+    assert rows[0][col["window (s)"]] > 20 * 2.0  # far longer than the quick window
+    assert 0.5 < half / target < 2.0, (half, target)

@@ -102,7 +102,7 @@ def _cell(x: float, digits: int = 3) -> str:
     return f"{x:.{digits}g}" if math.isfinite(x) else "–"
 
 
-def headline(results: Sequence[LawRuns], qoi: str, half_width: HalfWidth) -> str:
+def headline(results: Sequence[LawRuns], qoi: str, half_width: HalfWidth, checked: Optional[Measured] = None) -> str:
     """Per law: the reference (and its ensemble), and the cheapest run that agrees with the reference
     together with the window and CPU time it would need for h*."""
     t = qoi_table(results, qoi, half_width)
@@ -133,8 +133,27 @@ def headline(results: Sequence[LawRuns], qoi: str, half_width: HalfWidth) -> str
         if r.law.note and statistic_name(qoi) in ("shocks_per_second", "contact_fraction", "rebounds_per_shock",
                                                   "shock_duration_mean"):
             text += f" (note: {r.law.note})"
+        if checked is not None and r is results[0]:
+            est = checked.estimate(qoi)
+            text += (f". Check of the projection: a run of {checked.window:g} s at Δt = {checked.scene.dt:g} s gave "
+                     f"{est} (h/h* = {est.half_width / half_width.target(ref):.2f}, CPU {checked.cpu_seconds:.3g} s), "
+                     f"{'within' if est.agrees(ref) else 'outside'} the reference's interval")
         lines.append(text + ".")
     return "\n".join(lines) + "\n"
+
+
+def check(result: LawRuns, qoi: str, half_width: HalfWidth, s: Settings, cpu_cap: float) -> Optional[Measured]:
+    """Test the projection: run the law's cheapest run within the reference's interval again with
+    the window T* it was projected to need for h* (None when none qualifies or cost* > ``cpu_cap``)."""
+    t = qoi_table([result], qoi, half_width)
+    col = {name: i for i, name in enumerate(t.columns)}
+    picks = [(float(row[col["cost* (s)"]]), float(row[col["T* (s)"]]), m)
+             for row, m in zip(t.rows, result.runs) if row[col["within the reference's interval"]] == "yes"]
+    picks = [p for p in picks if math.isfinite(p[0]) and p[0] <= cpu_cap]
+    if not picks:
+        return None
+    _, t_star, m = min(picks, key=lambda p: p[0])
+    return measure(m.scene, s.transient, float(math.ceil(t_star)), batches=s.batches)
 
 
 def draw_work_precision(results: Sequence[LawRuns], qoi: str, half_width: HalfWidth, path: Path) -> Path:
@@ -211,20 +230,31 @@ def write_runs(results: Sequence[LawRuns], path: Path) -> Path:
 def study(folder: Optional[Path] = None, *, qois: Sequence[str] = ("stop_power",), quick: bool = False,
           half_width: HalfWidth = HalfWidth(0.02, True), transient: Optional[float] = None,
           window: Optional[float] = None, reference_window: Optional[float] = None, members: Optional[int] = None,
-          quiet: bool = False) -> dict[str, Table]:
-    """Run the laws once and write the tables and charts of every QoI; return {qoi: table}."""
+          check_cpu: Optional[float] = None, quiet: bool = False) -> dict[str, Table]:
+    """Run the laws once and write the tables and charts of every QoI; return {qoi: table}.
+
+    The first QoI's projection is checked on the first law: its cheapest run within the reference's
+    interval is run again with the window T* (when its cost* ≤ ``check_cpu`` s, default 30, quick 3);
+    the run is a row "(check at T*)" of that QoI's table.
+    """
     for q in qois:
         statistic_name(q)  # refuse unknown names before running anything
     folder = out_dir(folder, "work_precision_statistics")
     s, chosen = settings(quick, transient, window, reference_window, members)
     base = Scene(beta=0.5)
     results = run_laws(base, chosen, s, quiet)
+    checked = check(results[0], qois[0], half_width, s, check_cpu if check_cpu is not None else (3.0 if quick else 30.0))
     write_runs(results, folder / "statistics_runs.csv")
     tables: dict[str, Table] = {}
     heads, texts = [], []
     notes = "; ".join(f"{law.label}: {law.note}" for law in chosen if law.note)
     for q in qois:
         t = qoi_table(results, q, half_width)
+        if checked is not None and q == qois[0]:
+            ref = results[0].reference
+            extra = table("", ["law", "Δt (s)"], [([f"{results[0].law.label} (check at T*)", checked.scene.dt], checked)],
+                          ([ref.scene.dt], ref), q, half_width)
+            t.rows.insert(len(results[0].runs) + 1 + (ref.members > 1), extra.rows[0])
         t.note = (f"paper's scene (J = {base.elements}, β = {base.beta:g}, centred load), {s.describe()}. "
                   "Each law against its own reference (its finest Δt, longer window); within: |v − v_ref| ≤ h + h_ref; "
                   "T* = T (h/h*)², cost* = CPU (transient + T*)/(transient + T); CPU: the engine's cpu_seconds "
@@ -232,10 +262,11 @@ def study(folder: Optional[Path] = None, *, qois: Sequence[str] = ("stop_power",
         t.write(folder, f"work_precision_{q}")
         draw_work_precision(results, q, half_width, folder / f"work_precision_{q}.png")
         draw_convergence(results, q, folder / f"work_precision_{q}_dt.png")
-        heads.append(headline(results, q, half_width))
+        heads.append(headline(results, q, half_width, checked if q == qois[0] else None))
         texts.append(t.markdown())
         tables[q] = t
     total = sum(m.cpu_seconds * m.members for r in results for m in r.runs + [r.reference])
+    total += checked.cpu_seconds if checked is not None else 0.0
     summary = [f"# Work-precision under impacts ({', '.join(qois)})", "",
                f"Paper's scene (J = {base.elements}, β = {base.beta:g}), {s.describe()}. Laws: "
                + ", ".join(law.label for law in chosen) + f". Engine CPU of all runs: {total:.3g} s.", ""]
