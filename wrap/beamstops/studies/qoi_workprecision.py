@@ -163,6 +163,9 @@ def draw_work_precision(results: Sequence[LawRuns], qoi: str, half_width: HalfWi
     fig = Figure(figsize=(18, 5.5), layout="constrained")
     axes = [fig.add_subplot(1, 3, k + 1) for k in range(3)]
     styles = ["o-", "s-", "^-", "D-", "v-", "x-"]
+    first_bad = {ax: next((i for i, r in enumerate(results)
+                           if any(not m.estimate(qoi).agrees(r.reference.estimate(qoi)) for m in r.runs)), -1)
+                 for ax in axes}
     for i, r in enumerate(results):
         ref = r.reference.estimate(qoi)
         est = [m.estimate(qoi) for m in r.runs]
@@ -172,10 +175,15 @@ def draw_work_precision(results: Sequence[LawRuns], qoi: str, half_width: HalfWi
         t = qoi_table([r], qoi, half_width)
         cost = np.array([float(row[t.columns.index("cost* (s)")]) for row in t.rows[:len(r.runs)]])
         dts = np.array([m.scene.dt for m in r.runs])
+        outside = np.array([not e.agrees(ref) for e in est])
         for ax, x, y in ((axes[0], cpu, h), (axes[1], cpu, dist), (axes[2], dts, cost)):
             keep = np.isfinite(y) & (y > 0)
             if keep.any():
                 ax.loglog(x[keep], y[keep], styles[i % len(styles)], label=r.law.label, markersize=5)
+            bad = keep & outside
+            if bad.any():
+                ax.loglog(x[bad], y[bad], "kx", markersize=9,
+                          label="outside the reference's interval" if i == first_bad[ax] else None)
     unit = next((m.estimate(qoi).unit for r in results for m in r.runs if m.estimate(qoi).unit), "")
     unit = "" if unit == "1" else f" ({unit})"
     name = statistic_name(qoi)
