@@ -15,11 +15,12 @@ its cost from the engine's ``cpu_seconds``. This module only names, runs and com
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Optional
 
 from ..engine import run
+from ..observations import Statistic
 from ..result import IncompleteRunError, Result
 from ..scene import Scene
 
@@ -135,13 +136,10 @@ class Measured:
         return self.ensemble.get(statistic_name(qoi))
 
 
-def _scalars(table: dict[str, object]) -> dict[str, Estimate]:
-    out: dict[str, Estimate] = {}
-    for name, stat in table.items():
-        value, half = stat.value, stat.half_width  # type: ignore[attr-defined]
-        if value.size == 1:  # one stop (the tip's), the tip or the run; histograms are left out
-            out[name] = Estimate(float(value[0]), float(half[0]), str(stat.unit))  # type: ignore[attr-defined]
-    return out
+def _scalars(table: Mapping[str, Statistic]) -> dict[str, Estimate]:
+    """The one-entry statistics (one stop, the tip or the run) as estimates; histograms are left out."""
+    return {name: Estimate(float(stat.value[0]), float(stat.half_width[0]), stat.unit)
+            for name, stat in table.items() if stat.value.size == 1}
 
 
 def measure(scene: Scene, transient: float, window: float, *, batches: int = 20, members: int = 1,

@@ -12,7 +12,7 @@ from typing import Any, Optional
 from .common import Table
 from .qoi import Estimate, HalfWidth, Measured, cost_for, statistic_name, window_for
 
-__all__ = ["row_columns", "rows", "yes_no", "errorbar_panel", "unit_of"]
+__all__ = ["row_columns", "rows", "table", "yes_no", "errorbar_panel", "unit_of"]
 
 
 def yes_no(flag: bool) -> str:
