@@ -13,13 +13,14 @@ program tester
    use test_scheme, only: collect_scheme
    use test_box_qp, only: collect_box_qp
    use test_stops, only: collect_stops
+   use test_lockstep, only: collect_lockstep
    implicit none
    character(len=64) :: suite
    type(unittest_type), allocatable :: tests(:)
    integer :: failures
 
    if (command_argument_count() /= 1) then
-      write (error_unit, '(a)') 'usage: tester SUITE (harness, hermite, eigen, projection, energy, order, scheme, namelist, box_qp, stops)'
+      write (error_unit, '(a)') 'usage: tester SUITE (harness, hermite, eigen, projection, energy, order, scheme, namelist, box_qp, stops, lockstep)'
       error stop 2
    end if
    call get_command_argument(1, suite)
@@ -34,6 +35,7 @@ program tester
    case ('namelist'); call collect_namelist(tests)
    case ('box_qp'); call collect_box_qp(tests)
    case ('stops'); call collect_stops(tests)
+   case ('lockstep'); call collect_lockstep(tests)
    case default
       write (error_unit, '(a)') 'tester: unknown suite '''//trim(suite)//''''
       error stop 2

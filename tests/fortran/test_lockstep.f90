@@ -1,0 +1,284 @@
+!> Lockstep ensembles (SPEC 13, beamstops_lockstep): every member of a group run in lockstep
+!> equals the same scene run alone (simulate, the one-scene fused path) bit for bit: every
+!> column of every record, every snapshot, the summary. Groups of K = 1, 3, 5, 8, 13 (not
+!> multiples of the vector width) whose members differ in omega, amplitude, tip stops, load
+!> rule, start and record cadences; without contact, with Signorini stops and with
+!> compliance; runs long enough to cross blocks (block_steps), load restarts and contacts,
+!> and cut by checkpoints. Groups that cannot share A are refused with a message naming the
+!> member and the key.
+module test_lockstep
+   use, intrinsic :: iso_fortran_env, only: int64
+   use testing
+   use beamstops, only: ik, scene_type, model_type, array_recorder, run_summary, validate_scene, prepare_run, &
+      & simulate, record_count, snapshot_count, law_none, law_signorini, law_compliance, status_complete, &
+      & prepare_lockstep, simulate_lockstep
+   use beamstops_recorder, only: n_columns
+   implicit none
+   private
+   public :: collect_lockstep
+
+   !> Columns of a record, for messages.
+   character(len=10), parameter :: column_names(n_columns) = [character(len=10) :: 't', 'u', 'v', 'reaction', &
+      & 'energy', 'work', 'dissipated']
+
+contains
+
+   !> Tests of the suite.
+   subroutine collect_lockstep(tests)
+      !> The suite's tests.
+      type(unittest_type), allocatable, intent(out) :: tests(:)
+      tests = [ &
+         & new_unittest('K = 1, Signorini, beta = 1/2', test_one), &
+         & new_unittest('K = 3, no stops, beta = 1/4, different omega and amplitude', test_free_three), &
+         & new_unittest('K = 5, Signorini, beta = 1/2, different stops, omega, amplitude, cadences', test_signorini_five), &
+         & new_unittest('K = 8, compliance 1e8, beta = 1/4', test_compliance_eight), &
+         & new_unittest('K = 13, Signorini, beta = 1/4, paper''s load for some, checkpoints cut the blocks', &
+         & test_signorini_thirteen), &
+         & new_unittest('K = 8, J = 100, Signorini, beta = 1/2', test_fine_eight), &
+         & new_unittest('members that do not share A are refused', test_refused) &
+         & ]
+   end subroutine collect_lockstep
+
+   !> The paper's scene on J elements, dt, beta, a law, t_end.
+   function base_scene(elements, dt, beta, law, t_end) result(scene)
+      integer, intent(in) :: elements, law
+      real(wp), intent(in) :: dt, beta, t_end
+      type(scene_type) :: scene
+      scene%elements = elements
+      scene%dt = dt
+      scene%beta = beta
+      scene%law = law
+      scene%t_end = t_end
+      if (law == law_compliance) scene%stiffness_per_mass = 1.0e8_wp
+   end function base_scene
+
+   !> K members of a base scene, member k varied by k: omega, amplitude, stops, cadences; the
+   !> load rule and the start of some members switched when `vary_rules`.
+   function members_of(base, k_members, vary_rules) result(scenes)
+      type(scene_type), intent(in) :: base
+      integer, intent(in) :: k_members
+      logical, intent(in) :: vary_rules
+      type(scene_type) :: scenes(k_members)
+      integer :: k
+      real(wp) :: s
+      do k = 1, k_members
+         scenes(k) = base
+         s = real(k - 1, wp)/max(1, k_members - 1)
+         if (k_members > 1) then
+            scenes(k)%omega = 8.0_wp + 6.0_wp*s
+            scenes(k)%amplitude = 0.25_wp - 0.1_wp*s
+            scenes(k)%lower = -0.08_wp - 0.04_wp*mod(k, 3)
+            scenes(k)%upper = 0.07_wp + 0.05_wp*s
+         end if
+         scenes(k)%record_every = 1 + mod(k - 1, 4)*2
+         scenes(k)%snapshot_every = merge(0, 97*k, mod(k, 3) == 0)
+         if (vary_rules) then
+            scenes(k)%centered_load = mod(k, 2) == 1
+            scenes(k)%taylor_start = mod(k, 4) /= 2
+         end if
+      end do
+   end function members_of
+
+   !> Run the members in lockstep and each alone; compare them to the bit.
+   subroutine compare_group(scenes, error)
+      type(scene_type), intent(in) :: scenes(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(array_recorder), allocatable :: group(:)
+      type(array_recorder) :: alone
+      type(run_summary) :: summaries(size(scenes)), summary
+      type(model_type) :: model
+      integer :: k, nk
+      character(len=:), allocatable :: who
+
+      nk = size(scenes)
+      do k = 1, nk
+         call validate_scene(scenes(k), 'member '//int_text(k), error)
+         if (allocated(error)) return
+      end do
+      call prepare_lockstep(scenes, 'test group', model, error)
+      if (allocated(error)) return
+      allocate (group(nk))
+      do k = 1, nk
+         call reserve(group(k), scenes(k))
+      end do
+      call simulate_lockstep(scenes, model, group, summaries, error)
+      if (allocated(error)) return
+      do k = 1, nk
+         who = 'member '//int_text(k)//' of '//int_text(nk)
+         call run_alone(scenes(k), alone, summary, error)
+         if (allocated(error)) return
+         call check(error, summaries(k)%status == status_complete .and. summary%status == status_complete, &
+            & who//': both runs complete ('//summaries(k)%status//', '//summary%status//')')
+         if (allocated(error)) return
+         call same_summary(summaries(k), summary, who, error)
+         if (allocated(error)) return
+         call same_records(group(k), alone, who, error)
+         if (allocated(error)) return
+      end do
+   end subroutine compare_group
+
+   !> Room for every record and snapshot of a scene.
+   subroutine reserve(rec, scene)
+      type(array_recorder), intent(inout) :: rec
+      type(scene_type), intent(in) :: scene
+      call rec%reserve(record_count(scene), snapshot_count(scene), scene%elements + 1)
+   end subroutine reserve
+
+   !> The scene run alone: prepare_run and simulate (the one-scene fused path).
+   subroutine run_alone(scene, rec, summary, error)
+      type(scene_type), intent(in) :: scene
+      type(array_recorder), intent(out) :: rec
+      type(run_summary), intent(out) :: summary
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      call prepare_run(scene, 'test scene', model, error)
+      if (allocated(error)) return
+      call reserve(rec, scene)
+      call simulate(scene, model, rec, summary, error)
+   end subroutine run_alone
+
+   !> The summaries agree (but for the CPU time).
+   subroutine same_summary(a, b, who, error)
+      type(run_summary), intent(in) :: a, b
+      character(len=*), intent(in) :: who
+      type(error_type), allocatable, intent(out) :: error
+      call check(error, a%steps == b%steps .and. a%impacts == b%impacts, who//': steps '//int_text(a%steps)//' and '// &
+         & int_text(b%steps)//', impacts '//int_text(a%impacts)//' and '//int_text(b%impacts))
+      if (allocated(error)) return
+      call check(error, same_bits(a%max_violation, b%max_violation), who//': max_violation '// &
+         & real_text(a%max_violation)//' and '//real_text(b%max_violation))
+      if (allocated(error)) return
+      call check(error, same_bits(a%t_final, b%t_final), who//': t_final')
+   end subroutine same_summary
+
+   !> Every record and snapshot, bit for bit.
+   subroutine same_records(a, b, who, error)
+      type(array_recorder), intent(in) :: a, b
+      character(len=*), intent(in) :: who
+      type(error_type), allocatable, intent(out) :: error
+      integer(ik) :: i
+      integer :: c
+      call check(error, a%filled == b%filled .and. a%snaps == b%snaps, who//': '//int_text(a%filled)//' and '// &
+         & int_text(b%filled)//' records, '//int_text(a%snaps)//' and '//int_text(b%snaps)//' snapshots')
+      if (allocated(error)) return
+      do i = 1, a%filled
+         do c = 1, n_columns
+            if (same_bits(a%rows(c, i), b%rows(c, i))) cycle
+            call test_failed(error, who//': record '//int_text(i)//' (t = '//real_text(b%rows(1, i))//'), column '// &
+               & trim(column_names(c))//': lockstep '//real_text(a%rows(c, i))//', alone '//real_text(b%rows(c, i)))
+            return
+         end do
+      end do
+      do i = 1, a%snaps
+         if (.not. same_bits(a%snap_t(i), b%snap_t(i)) .or. &
+            & any(transfer(a%snap_u(:, i), 1_int64, size(a%snap_u, 1)) /= &
+            & transfer(b%snap_u(:, i), 1_int64, size(b%snap_u, 1)))) then
+            call test_failed(error, who//': snapshot '//int_text(i)//' (t = '//real_text(b%snap_t(i))//') differs')
+            return
+         end if
+      end do
+      call check(error, a%filled > 0, who//': records were kept')
+   end subroutine same_records
+
+   !> Two reals with the same bits.
+   elemental function same_bits(a, b) result(same)
+      real(wp), intent(in) :: a, b
+      logical :: same
+      same = transfer(a, 1_int64) == transfer(b, 1_int64)
+   end function same_bits
+
+   subroutine test_one(error)
+      type(error_type), allocatable, intent(out) :: error
+      call compare_group(members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.2_wp), 1, .false.), error)
+   end subroutine test_one
+
+   subroutine test_free_three(error)
+      type(error_type), allocatable, intent(out) :: error
+      call compare_group(members_of(base_scene(19, 1.0e-5_wp, 0.25_wp, law_none, 0.2_wp), 3, .true.), error)
+   end subroutine test_free_three
+
+   subroutine test_signorini_five(error)
+      type(error_type), allocatable, intent(out) :: error
+      call compare_group(members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.25_wp), 5, .false.), error)
+   end subroutine test_signorini_five
+
+   subroutine test_compliance_eight(error)
+      type(error_type), allocatable, intent(out) :: error
+      call compare_group(members_of(base_scene(19, 2.0e-6_wp, 0.25_wp, law_compliance, 0.04_wp), 8, .true.), error)
+   end subroutine test_compliance_eight
+
+   subroutine test_signorini_thirteen(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type), allocatable :: scenes(:)
+      integer :: k
+      scenes = members_of(base_scene(13, 2.0e-5_wp, 0.25_wp, law_signorini, 0.3_wp), 13, .true.)
+      do k = 1, size(scenes)
+         scenes(k)%checkpoint_every = 5000
+      end do
+      call compare_group(scenes, error)
+   end subroutine test_signorini_thirteen
+
+   subroutine test_fine_eight(error)
+      type(error_type), allocatable, intent(out) :: error
+      call compare_group(members_of(base_scene(100, 2.0e-6_wp, 0.5_wp, law_signorini, 0.03_wp), 8, .false.), error)
+   end subroutine test_fine_eight
+
+   !> Members that differ in what A depends on, in the law, in the steps, or with stops along
+   !> the span are refused, the message naming the member and the key.
+   subroutine test_refused(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scenes(3)
+      type(model_type) :: model
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      scenes(3)%dt = 2.0e-5_wp
+      call expect_refusal(scenes, 'member 3: &time dt', error)
+      if (allocated(error)) return
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      scenes(2)%elements = 20
+      call expect_refusal(scenes, 'member 2: &mesh elements', error)
+      if (allocated(error)) return
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      scenes(2)%law = law_compliance
+      scenes(2)%stiffness_per_mass = 1.0e8_wp
+      call expect_refusal(scenes, 'member 2: &stops law', error)
+      if (allocated(error)) return
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      scenes(3)%k2 = 300.0_wp
+      call expect_refusal(scenes, 'member 3: &beam k2', error)
+      if (allocated(error)) return
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      scenes(2)%t_end = 0.02_wp
+      call expect_refusal(scenes, 'member 2: &time steps', error)
+      if (allocated(error)) return
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      scenes(2)%stop_nodes = [10, 19]
+      scenes(2)%stop_lower = [-0.05_wp, -0.1_wp]
+      scenes(2)%stop_upper = [0.05_wp, 0.1_wp]
+      call expect_refusal(scenes, 'member 2 has stops along the span', error)
+      if (allocated(error)) return
+      scenes = members_of(base_scene(3, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      call expect_refusal(scenes, '&mesh elements = 3', error)
+      if (allocated(error)) return
+      call prepare_lockstep(scenes(1:0), 'test group', model, error)
+      call check(error, allocated(error), 'an empty group is refused')
+      if (allocated(error)) then
+         if (index(error%message, 'no members') > 0) deallocate (error)
+      end if
+   end subroutine test_refused
+
+   !> prepare_lockstep refuses the group with a message containing `expected`.
+   subroutine expect_refusal(scenes, expected, error)
+      type(scene_type), intent(in) :: scenes(:)
+      character(len=*), intent(in) :: expected
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(error_type), allocatable :: refusal
+      call prepare_lockstep(scenes, 'test group', model, refusal)
+      if (.not. allocated(refusal)) then
+         call test_failed(error, 'not refused: '//expected)
+         return
+      end if
+      call check(error, index(refusal%message, expected) > 0, 'the message "'//refusal%message// &
+         & '" names "'//expected//'"')
+   end subroutine expect_refusal
+end module test_lockstep
