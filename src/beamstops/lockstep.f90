@@ -32,7 +32,8 @@ module beamstops_lockstep
    use beamstops_band, only: band_matvec
    use beamstops_band_solve, only: band_solver, band_diagonals, prepare_solver, prepare_diagonals, diagonal_matvec, dot
    use beamstops_band_solve_lockstep, only: lockstep_forward, lockstep_forward_energy, lockstep_back, &
-      & lockstep_matvec, lockstep_dot, lockstep_min_unknowns, lockstep_work_columns
+      & lockstep_matvec, lockstep_dot, lockstep_min_unknowns, lockstep_work_columns, &
+      & lockstep_lanes, lockstep_update, lockstep_rhs
    use beamstops_state, only: state_type
    use beamstops_scheme, only: start_state, block_steps
    use beamstops_clock, only: thread_cpu_seconds
@@ -61,14 +62,16 @@ module beamstops_lockstep
    !> The state of K members, the member index first: what advance_fused keeps in a
    !> state_type and in its local variables, once per member.
    type :: members_type
-      !> Members K, unknowns n, index of the next step (shared).
-      integer :: k = 0, n = 0
+      !> Members K, unknowns n, chunks of lockstep_lanes members, lanes in all (K padded), index
+      !> of the next step (shared).
+      integer :: k = 0, n = 0, chunks = 0, p = 0
       integer(ik) :: step = 1
-      !> u^n, d^{n-1}, S u^n, right-hand side / solution, load vector g of each member (K, n).
-      real(wp), allocatable :: u(:, :), d(:, :), su(:, :), rhs(:, :), g(:, :)
-      !> Partial sums of the dot products (K, 8).
+      !> u^n, d^{n-1}, S u^n, right-hand side / solution, load vector g of each member (lanes, n,
+      !> chunks): member k is lane lane(k) of chunk chunk(k); the padding lanes stay zero.
+      real(wp), allocatable :: u(:, :, :), d(:, :, :), su(:, :, :), rhs(:, :, :), g(:, :, :)
+      !> Work array of the kernels (lanes, lockstep_work_columns).
       real(wp), allocatable :: partial(:, :)
-      !> Load averages sigma_{n-1}, sigma_n; g.d^{n-1}; spring forces p(u^{n-1}), p(u^n);
+      !> Per member, padded to p lanes: load averages sigma_{n-1}, sigma_n; g.d^{n-1}; spring forces p(u^{n-1}), p(u^n);
       !> work, energy taken by the stops, E^{1/2}, reaction of the last step, largest
       !> violation (K, per unit mass).
       real(wp), allocatable :: sigma_prev(:), sigma_now(:), gd_prev(:), p_prev(:), p_now(:), work(:), &
@@ -246,7 +249,7 @@ contains
                call finish_member(k, ms, model, summaries(k), t0)
                cycle
             end if
-            ms%vec_d = ms%d(k, :)
+            ms%vec_d = ms%d(lane(k), :, chunk(k))
             call band_matvec(model%mass, ms%vec_d, ms%vec_s)
             kinetic = 0.5_wp*dot_product(ms%vec_d, ms%vec_s)/model%dt2
             cap = 1.0e8_wp*(0.5_wp*scenes(k)%length*(scenes(k)%amplitude*scenes(k)%omega)**2 + abs(ms%energy0(k)) &
@@ -286,9 +289,9 @@ contains
       summary%max_violation = ms%max_violation(k)
       if (summary%status == status_running) summary%status = status_complete
       ms%active(k) = .false.
-      ms%u(k, :) = 0
-      ms%d(k, :) = 0
-      ms%g(k, :) = 0
+      ms%u(lane(k), :, chunk(k)) = 0
+      ms%d(lane(k), :, chunk(k)) = 0
+      ms%g(lane(k), :, chunk(k)) = 0
       ms%p_prev(k) = 0
       ms%p_now(k) = 0
    end subroutine finish_member
@@ -304,10 +307,10 @@ contains
       if (.not. allocated(state%u)) allocate (state%u(ms%n), state%d(ms%n), state%su(ms%n), state%rhs(ms%n), &
          & state%scratch(ms%n), state%shape(size(model%x)))
       state%step = ms%step
-      state%u = ms%u(k, :)
-      state%d = ms%d(k, :)
-      state%su = ms%su(k, :)
-      state%rhs = ms%rhs(k, :)
+      state%u = ms%u(lane(k), :, chunk(k))
+      state%d = ms%d(lane(k), :, chunk(k))
+      state%su = ms%su(lane(k), :, chunk(k))
+      state%rhs = ms%rhs(lane(k), :, chunk(k))
       state%sigma_prev = ms%sigma_prev(k)
       state%sigma_now = ms%sigma_now(k)
       state%gd_prev = ms%gd_prev(k)
@@ -341,7 +344,17 @@ contains
       n = model%n
       ms%k = nk
       ms%n = n
-      allocate (ms%u(nk, n), ms%d(nk, n), ms%su(nk, n), ms%rhs(nk, n), ms%g(nk, n), ms%partial(nk, lockstep_work_columns))
+      ms%chunks = (nk + lockstep_lanes - 1)/lockstep_lanes
+      ms%p = ms%chunks*lockstep_lanes
+      allocate (ms%u(lockstep_lanes, n, ms%chunks), ms%d(lockstep_lanes, n, ms%chunks), &
+         & ms%su(lockstep_lanes, n, ms%chunks), ms%rhs(lockstep_lanes, n, ms%chunks), &
+         & ms%g(lockstep_lanes, n, ms%chunks), ms%partial(lockstep_lanes, lockstep_work_columns))
+      ms%u = 0
+      ms%d = 0
+      ms%su = 0
+      ms%rhs = 0
+      ms%g = 0
+      nk = ms%p
       allocate (ms%sigma_prev(nk), ms%sigma_now(nk), ms%gd_prev(nk), ms%p_prev(nk), ms%p_now(nk), ms%work(nk), &
          & ms%dissipated(nk), ms%energy0(nk), ms%reaction(nk), ms%max_violation(nk), ms%in_contact(nk), &
          & ms%active(nk), ms%impacts(nk))
@@ -351,7 +364,10 @@ contains
          & ms%dsu(nk), ms%dmd(nk), ms%u_old_su(nk), ms%gd(nk), ms%contact(nk), ms%pending(nk), &
          & ms%next_record(nk), ms%next_snapshot(nk), ms%rows(n_columns, nk))
       allocate (ms%vec_u(n), ms%vec_d(n), ms%vec_su(n), ms%vec_s(n), ms%shape(size(model%x)))
-      ms%active = .true.
+      call zero_members(ms)
+      ms%active = .false.
+      ms%active(:ms%k) = .true.
+      nk = ms%k
 
       call load_shapes(scenes(1)%elements, model%h, scenes(1)%length, bh, b1)
       member = model
@@ -370,10 +386,10 @@ contains
             error%message = 'lockstep: member '//fmt_int(int(k, ik))//': '//error%message
             return
          end if
-         ms%g(k, :) = member%load
-         ms%u(k, :) = state%u
-         ms%d(k, :) = state%d
-         ms%su(k, :) = state%su
+         ms%g(lane(k), :, chunk(k)) = member%load
+         ms%u(lane(k), :, chunk(k)) = state%u
+         ms%d(lane(k), :, chunk(k)) = state%d
+         ms%su(lane(k), :, chunk(k)) = state%su
          ms%sigma_prev(k) = state%sigma_prev
          ms%sigma_now(k) = state%sigma_now
          ms%gd_prev(k) = state%gd_prev
@@ -389,6 +405,59 @@ contains
          ms%step = state%step
       end do
    end subroutine start_members
+
+   !> Every per-member value zero (the padding lanes keep them).
+   subroutine zero_members(ms)
+      type(members_type), intent(inout) :: ms
+      ms%sigma_prev = 0
+      ms%sigma_now = 0
+      ms%gd_prev = 0
+      ms%p_prev = 0
+      ms%p_now = 0
+      ms%work = 0
+      ms%dissipated = 0
+      ms%energy0 = 0
+      ms%reaction = 0
+      ms%max_violation = 0
+      ms%in_contact = .false.
+      ms%impacts = 0
+      ms%sigma = 0
+      ms%cosine = 0
+      ms%cos_step = 0
+      ms%sin_step = 0
+      ms%sigma_next = 0
+      ms%weight = 0
+      ms%coef = 0
+      ms%spring = 0
+      ms%trial = 0
+      ms%c = 0
+      ms%tip_value = 0
+      ms%r_step = 0
+      ms%u_tip_prev = 0
+      ms%d_tip_prev = 0
+      ms%r_prev = 0
+      ms%usu = 0
+      ms%dsu = 0
+      ms%dmd = 0
+      ms%u_old_su = 0
+      ms%gd = 0
+      ms%contact = .false.
+      ms%pending = .false.
+      ms%next_record = huge(1_ik)
+      ms%next_snapshot = huge(1_ik)
+   end subroutine zero_members
+
+   !> The lane of member k in its chunk.
+   pure integer function lane(k)
+      integer, intent(in) :: k
+      lane = mod(k - 1, lockstep_lanes) + 1
+   end function lane
+
+   !> The chunk of member k.
+   pure integer function chunk(k)
+      integer, intent(in) :: k
+      chunk = (k - 1)/lockstep_lanes + 1
+   end function chunk
 
    !> A member's load vector g = a (omega^2 (h, phi_i) + 8 k^2/L^4 (1, phi_i)), as build_model
    !> forms it.
@@ -433,7 +502,7 @@ contains
       class(recorder_type), intent(inout) :: recorders(:)
       integer(ik), intent(in) :: last
       integer(ik) :: step
-      integer :: k, j, n, tip, law
+      integer :: k, c, lo, hi, n, tip, law
       logical :: energy_wanted
       real(wp) :: beta, dt2
 
@@ -453,25 +522,23 @@ contains
          ms%sigma_next = ms%sigma
          call next_loads(ms, scenes, model)
          ms%weight = model%beta*ms%sigma_next + (1 - 2*model%beta)*ms%sigma_now + model%beta*ms%sigma_prev
-         ! the forward pass
-         call lockstep_matvec(ops%stiffness, ms%u, ms%su)
+         ! the forward pass, a chunk of members after the other
          ms%coef = model%dt2*ms%weight
          ms%spring = 0
          if (law == law_compliance) ms%spring = model%dt2*((1 - 2*model%beta)*ms%p_now + model%beta*ms%p_prev)
-         do j = 1, n
-            ms%rhs(:, j) = ms%coef*ms%g(:, j) - dt2*ms%su(:, j)
-         end do
-         ms%rhs(:, n - 1) = ms%rhs(:, n - 1) + ms%spring
          energy_wanted = any(ms%pending .or. ms%next_record == step)
-         if (energy_wanted) then
-            call lockstep_forward_energy(ops%solver, ops%mass, ms%u, ms%d, ms%su, ms%rhs, ms%usu, ms%dsu, ms%dmd, &
-               & ms%partial)
-         else
-            call lockstep_forward(ops%solver, ms%rhs)
-            ms%usu = 0
-            ms%dsu = 0
-            ms%dmd = 0
-         end if
+         do c = 1, ms%chunks
+            lo = (c - 1)*lockstep_lanes + 1
+            hi = c*lockstep_lanes
+            call lockstep_matvec(ops%stiffness, ms%u(:, :, c), ms%su(:, :, c))
+            call lockstep_rhs(n, ms%coef(lo:hi), ms%g(:, :, c), dt2, ms%su(:, :, c), ms%spring(lo:hi), ms%rhs(:, :, c))
+            if (energy_wanted) then
+               call lockstep_forward_energy(ops%solver, ops%mass, ms%u(:, :, c), ms%d(:, :, c), ms%su(:, :, c), &
+                  & ms%rhs(:, :, c), ms%usu(lo:hi), ms%dsu(lo:hi), ms%dmd(lo:hi), ms%partial)
+            else
+               call lockstep_forward(ops%solver, ms%rhs(:, :, c))
+            end if
+         end do
          if (energy_wanted) then
             do k = 1, ms%k
                if (.not. ms%pending(k)) cycle
@@ -480,20 +547,30 @@ contains
                if (ms%active(k)) call recorders(k)%record(ms%rows(:, k))
                ms%pending(k) = .false.
             end do
+         else
+            ms%usu = 0
+            ms%dsu = 0
+            ms%dmd = 0
          end if
          ms%u_old_su = ms%usu
-         call lockstep_back(ops%solver, ms%rhs, ms%partial)
-         ! the tip step: the contact law, the update and the bookkeeping (tip_step, close_step)
-         ms%d_tip_prev = ms%d(:, tip)
-         ms%u_tip_prev = ms%u(:, tip)
-         ms%trial = ms%u_tip_prev + (ms%d_tip_prev + ms%rhs(:, tip))
+         ! the back substitution and the tip step: the contact law, the update and the
+         ! bookkeeping (tip_step, close_step)
+         do c = 1, ms%chunks
+            lo = (c - 1)*lockstep_lanes + 1
+            hi = c*lockstep_lanes
+            call lockstep_back(ops%solver, ms%rhs(:, :, c), ms%partial)
+            ms%d_tip_prev(lo:hi) = ms%d(:, tip, c)
+            ms%u_tip_prev(lo:hi) = ms%u(:, tip, c)
+            ms%trial(lo:hi) = ms%u_tip_prev(lo:hi) + (ms%d_tip_prev(lo:hi) + ms%rhs(:, tip, c))
+         end do
          call contact_law(law, scenes, model, ms)
-         do j = 1, n
-            ms%d(:, j) = ms%d(:, j) + ms%rhs(:, j) + ms%c*model%z(j)
-            ms%u(:, j) = ms%u(:, j) + ms%d(:, j)
+         do c = 1, ms%chunks
+            lo = (c - 1)*lockstep_lanes + 1
+            hi = c*lockstep_lanes
+            call lockstep_update(n, ms%rhs(:, :, c), ms%c(lo:hi), model%z, ms%d(:, :, c), ms%u(:, :, c))
+            call lockstep_dot(n, ms%g(:, :, c), ms%d(:, :, c), ms%partial, ms%gd(lo:hi), model%dt2)
          end do
          ms%r_prev = ms%reaction
-         call lockstep_dot(ms%g, ms%d, ms%partial, ms%gd)
          call close_steps(law, scenes, tip, ms)
          ! records and snapshots
          do k = 1, ms%k
@@ -510,14 +587,16 @@ contains
       end do
       ! S u^{last+1}; it also completes the waiting records, as advance_fused does (one member
       ! at a time, with the one-member products and dot products).
-      call lockstep_matvec(ops%stiffness, ms%u, ms%su)
+      do c = 1, ms%chunks
+         call lockstep_matvec(ops%stiffness, ms%u(:, :, c), ms%su(:, :, c))
+      end do
       do k = 1, ms%k
          if (.not. ms%pending(k)) cycle
          ms%pending(k) = .false.
          if (.not. ms%active(k)) cycle
-         ms%vec_u = ms%u(k, :)
-         ms%vec_d = ms%d(k, :)
-         ms%vec_su = ms%su(k, :)
+         ms%vec_u = ms%u(lane(k), :, chunk(k))
+         ms%vec_d = ms%d(lane(k), :, chunk(k))
+         ms%vec_su = ms%su(lane(k), :, chunk(k))
          call diagonal_matvec(ops%mass, ms%vec_d, ms%vec_s)
          ms%rows(col_energy, k) = scenes(k)%mass_per_length*energy(model, dot(ms%vec_d, ms%vec_s), &
             & dot(ms%vec_u, ms%vec_su), dot(ms%vec_d, ms%vec_su), ms%u_old_su(k))
@@ -554,10 +633,10 @@ contains
             ms%contact(k) = ms%r_step(k) /= 0
          end do
       case default
-         ms%c = 0
-         ms%tip_value = ms%trial
-         ms%r_step = 0
-         ms%contact = .false.
+         ms%c(:ms%k) = 0
+         ms%tip_value(:ms%k) = ms%trial(:ms%k)
+         ms%r_step(:ms%k) = 0
+         ms%contact(:ms%k) = .false.
       end select
    end subroutine contact_law
 
@@ -572,14 +651,14 @@ contains
       integer :: k
       do k = 1, ms%k
          if (law == law_signorini .and. ms%contact(k)) then
-            ms%u(k, tip) = ms%tip_value(k)
-            ms%d(k, tip) = ms%tip_value(k) - ms%u_tip_prev(k)
+            ms%u(lane(k), tip, chunk(k)) = ms%tip_value(k)
+            ms%d(lane(k), tip, chunk(k)) = ms%tip_value(k) - ms%u_tip_prev(k)
          end if
-         if (law /= law_none) ms%max_violation(k) = max(ms%max_violation(k), violation(ms%u(k, tip), scenes(k)))
+         if (law /= law_none) ms%max_violation(k) = max(ms%max_violation(k), violation(ms%u(lane(k), tip, chunk(k)), scenes(k)))
          if (ms%contact(k) .and. .not. ms%in_contact(k)) ms%impacts(k) = ms%impacts(k) + 1
          ms%in_contact(k) = ms%contact(k)
          ms%work(k) = ms%work(k) + 0.5_wp*ms%weight(k)*(ms%gd(k) + ms%gd_prev(k))
-         ms%dissipated(k) = ms%dissipated(k) - 0.5_wp*ms%r_step(k)*(ms%d(k, tip) + ms%d_tip_prev(k))
+         ms%dissipated(k) = ms%dissipated(k) - 0.5_wp*ms%r_step(k)*(ms%d(lane(k), tip, chunk(k)) + ms%d_tip_prev(k))
          ms%reaction(k) = ms%r_step(k)
          ms%gd_prev(k) = ms%gd(k)
          ms%sigma_prev(k) = ms%sigma_now(k)
@@ -597,7 +676,7 @@ contains
       real(wp), intent(out) :: row(n_columns)
       row(col_t) = real(step, wp)*model%dt
       row(col_u) = ms%u_tip_prev(k)
-      row(col_v) = (ms%d(k, model%tip) + ms%d_tip_prev(k))/(2*model%dt)
+      row(col_v) = (ms%d(lane(k), model%tip, chunk(k)) + ms%d_tip_prev(k))/(2*model%dt)
       row(col_reaction) = scene%mass_per_length*ms%r_prev(k)
       row(col_energy) = 0
       row(col_work) = scene%mass_per_length*ms%work(k)
@@ -613,7 +692,7 @@ contains
       integer(ik), intent(in) :: step
       class(recorder_type), intent(inout) :: recorder
       real(wp) :: phi, t
-      ms%vec_s = ms%u(k, :) - ms%d(k, :)
+      ms%vec_s = ms%u(lane(k), :, chunk(k)) - ms%d(lane(k), :, chunk(k))
       t = real(step, wp)*model%dt
       phi = support_position(t, scene%amplitude, scene%omega)
       ms%shape = model%lift*phi

@@ -13,6 +13,11 @@ module test_lockstep
       & simulate, record_count, snapshot_count, law_none, law_signorini, law_compliance, status_complete, &
       & prepare_lockstep, simulate_lockstep
    use beamstops_recorder, only: n_columns
+   use beamstops_model, only: build_model
+   use beamstops_band_solve, only: band_solver, band_diagonals, prepare_solver, prepare_diagonals, diagonal_matvec, &
+      & forward_substitution, forward_substitution_energy, back_substitution, dot
+   use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_work_columns, lockstep_matvec, &
+      & lockstep_forward, lockstep_forward_energy, lockstep_back, lockstep_dot, lockstep_update
    implicit none
    private
    public :: collect_lockstep
@@ -28,6 +33,8 @@ contains
       !> The suite's tests.
       type(unittest_type), allocatable, intent(out) :: tests(:)
       tests = [ &
+         & new_unittest('kernels: each lane equals the one-member kernel to the bit, J = 4..13, 19, 20, 100, 101', &
+         & test_kernels), &
          & new_unittest('K = 1, Signorini, beta = 1/2', test_one), &
          & new_unittest('K = 3, no stops, beta = 1/4, different omega and amplitude', test_free_three), &
          & new_unittest('K = 5, Signorini, beta = 1/2, different stops, omega, amplitude, cadences', test_signorini_five), &
@@ -186,6 +193,92 @@ contains
       logical :: same
       same = transfer(a, 1_int64) == transfer(b, 1_int64)
    end function same_bits
+
+   !> The kernels of beamstops_band_solve_lockstep against those of beamstops_band_solve, lane by
+   !> lane, on random vectors: the product by S, both substitutions (with and without the
+   !> energy sums), the dot product, the update. The place to look first when the one-scene
+   !> path or the compiler changes: the lockstep kernels reproduce where the compiled
+   !> one-member kernels round (see the notes of beamstops_band_solve_lockstep).
+   subroutine test_kernels(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: meshes(14) = [4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 19, 20, 100, 101]
+      integer, parameter :: lanes = lockstep_lanes
+      type(scene_type) :: scene
+      type(model_type) :: model
+      type(band_solver) :: solver
+      type(band_diagonals) :: s, m
+      real(wp), allocatable :: x(:, :), y(:, :), b(:, :), u(:, :), d(:, :), v(:), w(:)
+      real(wp) :: work(lanes, lockstep_work_columns), usu(lanes), dsu(lanes), dmd(lanes), dd(lanes), c(lanes)
+      real(wp) :: e(3)
+      integer :: a, rep, k, n
+      character(len=:), allocatable :: where
+      do a = 1, size(meshes)
+         scene%elements = meshes(a)
+         scene%dt = 1.0e-5_wp
+         call build_model(scene, model, error)
+         if (allocated(error)) return
+         call prepare_solver(model%factor, solver)
+         call prepare_diagonals(model%stiffness, s)
+         call prepare_diagonals(model%mass, m)
+         n = model%n
+         if (allocated(x)) deallocate (x, y, b, u, d, v, w)
+         allocate (x(lanes, n), y(lanes, n), b(lanes, n), u(lanes, n), d(lanes, n), v(n), w(n))
+         do rep = 1, 20
+            call random_number(x)
+            call random_number(u)
+            call random_number(d)
+            call random_number(c)
+            x = x - 0.5_wp
+            u = u - 0.5_wp
+            d = d - 0.5_wp
+            where = 'J = '//int_text(meshes(a))//': '
+            call lockstep_matvec(s, x, y)
+            do k = 1, lanes
+               call diagonal_matvec(s, x(k, :), v)
+               if (.not. all(same_bits(v, y(k, :)))) call test_failed(error, where//'S x, lane '//int_text(k))
+            end do
+            b = x
+            call lockstep_forward(solver, b)
+            do k = 1, lanes
+               v = x(k, :)
+               call forward_substitution(solver, v)
+               if (.not. all(same_bits(v, b(k, :)))) call test_failed(error, where//'forward substitution, lane '//int_text(k))
+            end do
+            b = x
+            call lockstep_back(solver, b, work)
+            do k = 1, lanes
+               v = x(k, :)
+               call back_substitution(solver, v)
+               if (.not. all(same_bits(v, b(k, :)))) call test_failed(error, where//'back substitution, lane '//int_text(k))
+            end do
+            b = x
+            call lockstep_forward_energy(solver, m, u, d, y, b, usu, dsu, dmd, work)
+            do k = 1, lanes
+               v = x(k, :)
+               call forward_substitution_energy(solver, m, u(k, :), d(k, :), y(k, :), v, e(1), e(2), e(3))
+               if (.not. all(same_bits(v, b(k, :)))) call test_failed(error, where//'forward substitution with the '// &
+                  & 'energy sums, lane '//int_text(k))
+               if (.not. same_bits(e(1), usu(k))) call test_failed(error, where//'u.S u, lane '//int_text(k))
+               if (.not. same_bits(e(2), dsu(k))) call test_failed(error, where//'d.S u, lane '//int_text(k))
+               if (.not. same_bits(e(3), dmd(k))) call test_failed(error, where//'d.M d, lane '//int_text(k))
+            end do
+            call lockstep_dot(n, u, d, work, dd, 1.0_wp)
+            do k = 1, lanes
+               if (.not. same_bits(dot(u(k, :), d(k, :)), dd(k))) call test_failed(error, where//'dot, lane '//int_text(k))
+            end do
+            b = d
+            y = u
+            call lockstep_update(n, x, c, model%z, b, y)
+            do k = 1, lanes
+               v = d(k, :) + x(k, :) + c(k)*model%z
+               w = u(k, :) + v
+               if (.not. (all(same_bits(v, b(k, :))) .and. all(same_bits(w, y(k, :))))) &
+                  & call test_failed(error, where//'update, lane '//int_text(k))
+            end do
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine test_kernels
 
    subroutine test_one(error)
       type(error_type), allocatable, intent(out) :: error
