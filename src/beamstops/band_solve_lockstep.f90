@@ -32,7 +32,7 @@ module beamstops_band_solve_lockstep
    implicit none
    private
    public :: lockstep_forward, lockstep_forward_energy, lockstep_back, lockstep_matvec, lockstep_dot
-   public :: lockstep_rhs, lockstep_update
+   public :: lockstep_rhs, lockstep_update, lockstep_matvec_rhs
    public :: lockstep_min_unknowns, lockstep_work_columns, lockstep_lanes
 
    !> Fewest unknowns these routines handle (J >= 4).
@@ -338,6 +338,76 @@ contains
             partial(k, 8) = partial(k, 8) + x(k, j + 7)*y(k, j + 7)
          end do
       end do
+      call dot_tail(n, j, x, y, partial, s, positive)
+   end subroutine lockstep_dot
+
+   !> lockstep_matvec (S u) and lockstep_rhs (rhs = a g - b S u + spring e_{n-1}) in one pass.
+   pure subroutine lockstep_matvec_rhs(stiffness, u, a, g, b, spring, su, rhs)
+      !> S by diagonals.
+      type(band_diagonals), intent(in) :: stiffness
+      !> u of every lane (lanes, n).
+      real(wp), intent(in) :: u(lockstep_lanes, stiffness%n)
+      !> dt^2 times the load weight of every lane (lanes).
+      real(wp), intent(in) :: a(lockstep_lanes)
+      !> Load vectors (lanes, n).
+      real(wp), intent(in) :: g(lockstep_lanes, stiffness%n)
+      !> dt^2.
+      real(wp), intent(in) :: b
+      !> Force term of the tip row (lanes).
+      real(wp), intent(in) :: spring(lockstep_lanes)
+      !> S u (lanes, n).
+      real(wp), intent(out) :: su(lockstep_lanes, stiffness%n)
+      !> Right-hand sides (lanes, n).
+      real(wp), intent(out) :: rhs(lockstep_lanes, stiffness%n)
+      integer :: j, k, n
+      n = stiffness%n
+      associate (s => stiffness%a, x => u, y => su)
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            y(k, 1) = s(1, 0)*x(k, 1) + s(2, 1)*x(k, 2) + s(3, 2)*x(k, 3) + s(4, 3)*x(k, 4)
+            y(k, 2) = s(2, 1)*x(k, 1) + s(2, 0)*x(k, 2) + s(3, 1)*x(k, 3) + s(4, 2)*x(k, 4) + s(5, 3)*x(k, 5)
+            y(k, 3) = s(3, 2)*x(k, 1) + s(3, 1)*x(k, 2) + s(3, 0)*x(k, 3) + s(4, 1)*x(k, 4) + s(5, 2)*x(k, 5) &
+               & + s(6, 3)*x(k, 6)
+            rhs(k, 1) = a(k)*g(k, 1) - b*y(k, 1)
+            rhs(k, 2) = a(k)*g(k, 2) - b*y(k, 2)
+            rhs(k, 3) = a(k)*g(k, 3) - b*y(k, 3)
+         end do
+         do j = kd + 1, n - kd
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               y(k, j) = s(j, 3)*x(k, j - 3) + s(j, 2)*x(k, j - 2) + s(j, 1)*x(k, j - 1) + s(j, 0)*x(k, j) &
+                  & + s(j + 1, 1)*x(k, j + 1) + s(j + 2, 2)*x(k, j + 2) + s(j + 3, 3)*x(k, j + 3)
+               rhs(k, j) = a(k)*g(k, j) - b*y(k, j)
+            end do
+         end do
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            y(k, n - 2) = s(n - 2, 3)*x(k, n - 5) + s(n - 2, 2)*x(k, n - 4) + s(n - 2, 1)*x(k, n - 3) &
+               & + s(n - 2, 0)*x(k, n - 2) + s(n - 1, 1)*x(k, n - 1) + s(n, 2)*x(k, n)
+            y(k, n - 1) = s(n - 1, 3)*x(k, n - 4) + s(n - 1, 2)*x(k, n - 3) + s(n - 1, 1)*x(k, n - 2) &
+               & + s(n - 1, 0)*x(k, n - 1) + s(n, 1)*x(k, n)
+            y(k, n) = s(n, 3)*x(k, n - 3) + s(n, 2)*x(k, n - 2) + s(n, 1)*x(k, n - 1) + s(n, 0)*x(k, n)
+            rhs(k, n - 2) = a(k)*g(k, n - 2) - b*y(k, n - 2)
+            rhs(k, n - 1) = a(k)*g(k, n - 1) - b*y(k, n - 1)
+            rhs(k, n) = a(k)*g(k, n) - b*y(k, n)
+            rhs(k, n - 1) = rhs(k, n - 1) + spring(k)
+         end do
+      end associate
+   end subroutine lockstep_matvec_rhs
+
+   !> The end of a dot product from the eight partial sums and the rows j..n after them
+   !> (lockstep_dot).
+   pure subroutine dot_tail(n, first, x, y, partial, s, positive)
+      integer, intent(in) :: n, first
+      real(wp), intent(in) :: x(lockstep_lanes, n), y(lockstep_lanes, n)
+      real(wp), intent(inout) :: partial(lockstep_lanes, lockstep_work_columns)
+      real(wp), intent(out) :: s(lockstep_lanes)
+      real(wp), intent(in) :: positive
+      integer :: j, k
+      j = first
 !GCC$ ivdep
 !GCC$ vector
       do k = 1, lockstep_lanes
@@ -361,7 +431,7 @@ contains
             s(k) = s(k) + x(k, j)*y(k, j)
          end do
       end do
-   end subroutine lockstep_dot
+   end subroutine dot_tail
 
    !> The right-hand sides of a step, rhs = a g - b S u plus `spring` in the tip row n-1 (the
    !> forward pass of beamstops_scheme), of every lane.

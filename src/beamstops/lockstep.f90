@@ -33,13 +33,12 @@ module beamstops_lockstep
    use beamstops_band_solve, only: band_solver, band_diagonals, prepare_solver, prepare_diagonals, diagonal_matvec, dot
    use beamstops_band_solve_lockstep, only: lockstep_forward, lockstep_forward_energy, lockstep_back, &
       & lockstep_matvec, lockstep_dot, lockstep_min_unknowns, lockstep_work_columns, &
-      & lockstep_lanes, lockstep_update, lockstep_rhs
+      & lockstep_lanes, lockstep_matvec_rhs, lockstep_update
    use beamstops_state, only: state_type
    use beamstops_scheme, only: start_state, block_steps
    use beamstops_clock, only: thread_cpu_seconds
    use beamstops_forcing, only: load_average, support_position, lift_shape, lift_slope
-   use beamstops_contact_tip_projection, only: project_tip
-   use beamstops_contact_compliance, only: spring_force, solve_spring_tip
+      use beamstops_contact_compliance, only: spring_force, solve_spring_tip
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
       & col_work, col_dissipated
    use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running
@@ -84,6 +83,10 @@ module beamstops_lockstep
       !> (shared), f sin and f cos of omega c_k, cos and sin of omega dt (K).
       integer(ik) :: load_k = 0
       real(wp), allocatable :: sigma(:), cosine(:), cos_step(:), sin_step(:)
+      !> Tip stops of each member (padding lanes: -1, 1) (K).
+      real(wp), allocatable :: lower(:), upper(:)
+      !> Tip value and increment after the update (K).
+      real(wp), allocatable :: u_tip(:), d_tip(:)
       !> Values of the step (K).
       real(wp), allocatable :: sigma_next(:), weight(:), coef(:), spring(:), trial(:), c(:), tip_value(:), &
          & r_step(:), u_tip_prev(:), d_tip_prev(:), r_prev(:), usu(:), dsu(:), dmd(:), u_old_su(:), gd(:)
@@ -364,7 +367,12 @@ contains
          & ms%dsu(nk), ms%dmd(nk), ms%u_old_su(nk), ms%gd(nk), ms%contact(nk), ms%pending(nk), &
          & ms%next_record(nk), ms%next_snapshot(nk), ms%rows(n_columns, nk))
       allocate (ms%vec_u(n), ms%vec_d(n), ms%vec_su(n), ms%vec_s(n), ms%shape(size(model%x)))
+      allocate (ms%lower(nk), ms%upper(nk), ms%u_tip(nk), ms%d_tip(nk))
       call zero_members(ms)
+      ms%lower = -1
+      ms%upper = 1
+      ms%u_tip = 0
+      ms%d_tip = 0
       ms%active = .false.
       ms%active(:ms%k) = .true.
       nk = ms%k
@@ -387,6 +395,8 @@ contains
             return
          end if
          ms%g(lane(k), :, chunk(k)) = member%load
+         ms%lower(k) = scenes(k)%lower
+         ms%upper(k) = scenes(k)%upper
          ms%u(lane(k), :, chunk(k)) = state%u
          ms%d(lane(k), :, chunk(k)) = state%d
          ms%su(lane(k), :, chunk(k)) = state%su
@@ -501,20 +511,20 @@ contains
       type(members_type), intent(inout) :: ms
       class(recorder_type), intent(inout) :: recorders(:)
       integer(ik), intent(in) :: last
-      integer(ik) :: step
+      integer(ik) :: step, next_record, next_snapshot
       integer :: k, c, lo, hi, n, tip, law
-      logical :: energy_wanted
-      real(wp) :: beta, dt2
+      logical :: energy_wanted, pending
 
       n = ms%n
       tip = model%tip
       law = scenes(1)%law
-      beta = model%beta
-      dt2 = model%dt2
       do k = 1, ms%k
          call first_events(scenes(k), ms%step, ms%next_record(k), ms%next_snapshot(k))
       end do
+      next_record = minval(ms%next_record)
+      next_snapshot = minval(ms%next_snapshot)
       ms%pending = .false.
+      pending = .false.
       ms%u_old_su = 0
       ms%dmd = 0
       call start_loads(ms, ms%step + 1, scenes, model)
@@ -524,14 +534,13 @@ contains
          ms%weight = model%beta*ms%sigma_next + (1 - 2*model%beta)*ms%sigma_now + model%beta*ms%sigma_prev
          ! the forward pass, a chunk of members after the other
          ms%coef = model%dt2*ms%weight
-         ms%spring = 0
          if (law == law_compliance) ms%spring = model%dt2*((1 - 2*model%beta)*ms%p_now + model%beta*ms%p_prev)
-         energy_wanted = any(ms%pending .or. ms%next_record == step)
+         energy_wanted = pending .or. step == next_record
          do c = 1, ms%chunks
             lo = (c - 1)*lockstep_lanes + 1
             hi = c*lockstep_lanes
-            call lockstep_matvec(ops%stiffness, ms%u(:, :, c), ms%su(:, :, c))
-            call lockstep_rhs(n, ms%coef(lo:hi), ms%g(:, :, c), dt2, ms%su(:, :, c), ms%spring(lo:hi), ms%rhs(:, :, c))
+            call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), ms%coef(lo:hi), ms%g(:, :, c), model%dt2, &
+               & ms%spring(lo:hi), ms%su(:, :, c), ms%rhs(:, :, c))
             if (energy_wanted) then
                call lockstep_forward_energy(ops%solver, ops%mass, ms%u(:, :, c), ms%d(:, :, c), ms%su(:, :, c), &
                   & ms%rhs(:, :, c), ms%usu(lo:hi), ms%dsu(lo:hi), ms%dmd(lo:hi), ms%partial)
@@ -539,7 +548,7 @@ contains
                call lockstep_forward(ops%solver, ms%rhs(:, :, c))
             end if
          end do
-         if (energy_wanted) then
+         if (pending) then
             do k = 1, ms%k
                if (.not. ms%pending(k)) cycle
                ms%rows(col_energy, k) = scenes(k)%mass_per_length*energy(model, ms%dmd(k), ms%usu(k), ms%dsu(k), &
@@ -547,12 +556,13 @@ contains
                if (ms%active(k)) call recorders(k)%record(ms%rows(:, k))
                ms%pending(k) = .false.
             end do
-         else
-            ms%usu = 0
-            ms%dsu = 0
-            ms%dmd = 0
+            pending = .false.
          end if
-         ms%u_old_su = ms%usu
+         if (energy_wanted) then
+            ms%u_old_su = ms%usu
+         else
+            ms%u_old_su = 0
+         end if
          ! the back substitution and the tip step: the contact law, the update and the
          ! bookkeeping (tip_step, close_step)
          do c = 1, ms%chunks
@@ -569,21 +579,36 @@ contains
             hi = c*lockstep_lanes
             call lockstep_update(n, ms%rhs(:, :, c), ms%c(lo:hi), model%z, ms%d(:, :, c), ms%u(:, :, c))
             call lockstep_dot(n, ms%g(:, :, c), ms%d(:, :, c), ms%partial, ms%gd(lo:hi), model%dt2)
+            ms%u_tip(lo:hi) = ms%u(:, tip, c)
+            ms%d_tip(lo:hi) = ms%d(:, tip, c)
          end do
          ms%r_prev = ms%reaction
-         call close_steps(law, scenes, tip, ms)
+         call close_steps(law, ms)
+         if (law == law_signorini) then
+            do c = 1, ms%chunks
+               lo = (c - 1)*lockstep_lanes + 1
+               hi = c*lockstep_lanes
+               ms%u(:, tip, c) = ms%u_tip(lo:hi)
+               ms%d(:, tip, c) = ms%d_tip(lo:hi)
+            end do
+         end if
          ! records and snapshots
-         do k = 1, ms%k
-            if (step == ms%next_record(k)) then
-               ms%next_record(k) = ms%next_record(k) + scenes(k)%record_every
-               call fill_row(scenes(k), model, ms, k, step, ms%rows(:, k))
-               ms%pending(k) = .true.
-            end if
-            if (step == ms%next_snapshot(k)) then
-               ms%next_snapshot(k) = ms%next_snapshot(k) + scenes(k)%snapshot_every
-               if (ms%active(k)) call take_snapshot(scenes(k), model, ms, k, step, recorders(k))
-            end if
-         end do
+         if (step == next_record .or. step == next_snapshot) then
+            do k = 1, ms%k
+               if (step == ms%next_record(k)) then
+                  ms%next_record(k) = ms%next_record(k) + scenes(k)%record_every
+                  call fill_row(scenes(k), model, ms, k, step, ms%rows(:, k))
+                  ms%pending(k) = .true.
+                  pending = .true.
+               end if
+               if (step == ms%next_snapshot(k)) then
+                  ms%next_snapshot(k) = ms%next_snapshot(k) + scenes(k)%snapshot_every
+                  if (ms%active(k)) call take_snapshot(scenes(k), model, ms, k, step, recorders(k))
+               end if
+            end do
+            next_record = minval(ms%next_record)
+            next_snapshot = minval(ms%next_snapshot)
+         end if
       end do
       ! S u^{last+1}; it also completes the waiting records, as advance_fused does (one member
       ! at a time, with the one-member products and dot products).
@@ -604,22 +629,25 @@ contains
       end do
    end subroutine advance_members
 
-   !> The contact law at the tip of every member (beamstops_scheme's contact_law): from the
+   !> The contact law at the tip of every member (beamstops_scheme's contact_law and the
+   !> projection of beamstops_contact_tip_projection, written over the members): from the
    !> trial tip values, the multiple c of z, the tip value, the reaction of the step, contact.
+   !> Padding lanes: trial 0 between their stops -1 and 1, so c = 0.
    subroutine contact_law(law, scenes, model, ms)
       integer, intent(in) :: law
       type(scene_type), intent(in) :: scenes(:)
       type(model_type), intent(in) :: model
       type(members_type), intent(inout) :: ms
-      real(wp) :: p_next
-      integer :: k
+      real(wp) :: p_next, z_tip
+      integer :: k, c, lo, hi
+      z_tip = model%z(model%tip)
       select case (law)
       case (law_signorini)
-         do k = 1, ms%k
-            call project_tip(ms%trial(k), scenes(k)%lower, scenes(k)%upper, model%z(model%tip), ms%c(k), &
-               & ms%tip_value(k))
-            ms%contact(k) = ms%c(k) /= 0
-            ms%r_step(k) = ms%c(k)/model%dt2
+         do c = 1, ms%chunks
+            lo = (c - 1)*lockstep_lanes + 1
+            hi = c*lockstep_lanes
+            call project_lanes(ms%trial(lo:hi), ms%lower(lo:hi), ms%upper(lo:hi), z_tip, model%dt2, &
+               & ms%tip_value(lo:hi), ms%c(lo:hi), ms%contact(lo:hi), ms%r_step(lo:hi))
          end do
       case (law_compliance)
          do k = 1, ms%k
@@ -633,38 +661,94 @@ contains
             ms%contact(k) = ms%r_step(k) /= 0
          end do
       case default
-         ms%c(:ms%k) = 0
-         ms%tip_value(:ms%k) = ms%trial(:ms%k)
-         ms%r_step(:ms%k) = 0
-         ms%contact(:ms%k) = .false.
+         ms%c = 0
+         ms%tip_value = ms%trial
+         ms%r_step = 0
+         ms%contact = .false.
       end select
    end subroutine contact_law
 
-   !> After the update, for every member (beamstops_scheme's close_step): the exact tip value
-   !> (Signorini), the violation, impacts, the work of the load and the energy the stops take,
-   !> the load averages moved on.
-   subroutine close_steps(law, scenes, tip, ms)
+   !> After the update, for every member (beamstops_scheme's close_step, written over the
+   !> members, on the gathered tip values u_tip, d_tip): the exact tip value (Signorini), the
+   !> violation, impacts, the work of the load and the energy the stops take, the load averages
+   !> moved on.
+   subroutine close_steps(law, ms)
       integer, intent(in) :: law
-      type(scene_type), intent(in) :: scenes(:)
-      integer, intent(in) :: tip
       type(members_type), intent(inout) :: ms
-      integer :: k
-      do k = 1, ms%k
-         if (law == law_signorini .and. ms%contact(k)) then
-            ms%u(lane(k), tip, chunk(k)) = ms%tip_value(k)
-            ms%d(lane(k), tip, chunk(k)) = ms%tip_value(k) - ms%u_tip_prev(k)
-         end if
-         if (law /= law_none) ms%max_violation(k) = max(ms%max_violation(k), violation(ms%u(lane(k), tip, chunk(k)), scenes(k)))
-         if (ms%contact(k) .and. .not. ms%in_contact(k)) ms%impacts(k) = ms%impacts(k) + 1
-         ms%in_contact(k) = ms%contact(k)
-         ms%work(k) = ms%work(k) + 0.5_wp*ms%weight(k)*(ms%gd(k) + ms%gd_prev(k))
-         ms%dissipated(k) = ms%dissipated(k) - 0.5_wp*ms%r_step(k)*(ms%d(lane(k), tip, chunk(k)) + ms%d_tip_prev(k))
-         ms%reaction(k) = ms%r_step(k)
-         ms%gd_prev(k) = ms%gd(k)
-         ms%sigma_prev(k) = ms%sigma_now(k)
-         ms%sigma_now(k) = ms%sigma_next(k)
+      integer :: c, lo, hi
+      do c = 1, ms%chunks
+         lo = (c - 1)*lockstep_lanes + 1
+         hi = c*lockstep_lanes
+         call close_lanes(law, ms%contact(lo:hi), ms%tip_value(lo:hi), ms%u_tip_prev(lo:hi), ms%d_tip_prev(lo:hi), &
+            & ms%lower(lo:hi), ms%upper(lo:hi), ms%weight(lo:hi), ms%gd(lo:hi), ms%r_step(lo:hi), &
+            & ms%sigma_next(lo:hi), ms%u_tip(lo:hi), ms%d_tip(lo:hi), ms%max_violation(lo:hi), ms%impacts(lo:hi), &
+            & ms%in_contact(lo:hi), ms%work(lo:hi), ms%dissipated(lo:hi), ms%reaction(lo:hi), ms%gd_prev(lo:hi), &
+            & ms%sigma_prev(lo:hi), ms%sigma_now(lo:hi))
       end do
    end subroutine close_steps
+
+   !> The projection of the trial tip values on the stops of a chunk of lanes (beamstops_contact_
+   !> tip_projection's project_tip): tip value, multiple c of z, contact, reaction of the step.
+   pure subroutine project_lanes(trial, lower, upper, z_tip, dt2, tip_value, c, contact, r_step)
+      real(wp), intent(in) :: trial(lockstep_lanes), lower(lockstep_lanes), upper(lockstep_lanes), z_tip, dt2
+      real(wp), intent(out) :: tip_value(lockstep_lanes), c(lockstep_lanes), r_step(lockstep_lanes)
+      logical, intent(out) :: contact(lockstep_lanes)
+      integer :: k
+!GCC$ ivdep
+!GCC$ vector
+      do k = 1, lockstep_lanes
+         tip_value(k) = min(max(trial(k), lower(k)), upper(k))
+         c(k) = (tip_value(k) - trial(k))/z_tip
+         contact(k) = c(k) /= 0
+         r_step(k) = c(k)/dt2
+      end do
+   end subroutine project_lanes
+
+   !> close_steps for a chunk of lanes.
+   pure subroutine close_lanes(law, contact, tip_value, u_tip_prev, d_tip_prev, lower, upper, weight, gd, r_step, &
+      & sigma_next, u_tip, d_tip, max_violation, impacts, in_contact, work, dissipated, reaction, gd_prev, &
+      & sigma_prev, sigma_now)
+      integer, intent(in) :: law
+      logical, intent(in) :: contact(lockstep_lanes)
+      real(wp), intent(in) :: tip_value(lockstep_lanes), u_tip_prev(lockstep_lanes), d_tip_prev(lockstep_lanes), &
+         & lower(lockstep_lanes), upper(lockstep_lanes), weight(lockstep_lanes), gd(lockstep_lanes), &
+         & r_step(lockstep_lanes), sigma_next(lockstep_lanes)
+      real(wp), intent(inout) :: u_tip(lockstep_lanes), d_tip(lockstep_lanes), max_violation(lockstep_lanes), &
+         & work(lockstep_lanes), dissipated(lockstep_lanes), reaction(lockstep_lanes), gd_prev(lockstep_lanes), &
+         & sigma_prev(lockstep_lanes), sigma_now(lockstep_lanes)
+      integer(ik), intent(inout) :: impacts(lockstep_lanes)
+      logical, intent(inout) :: in_contact(lockstep_lanes)
+      integer :: k
+      if (law == law_signorini) then
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            if (contact(k)) then
+               u_tip(k) = tip_value(k)
+               d_tip(k) = tip_value(k) - u_tip_prev(k)
+            end if
+         end do
+      end if
+      if (law /= law_none) then
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            max_violation(k) = max(max_violation(k), max(u_tip(k) - upper(k), lower(k) - u_tip(k), 0.0_wp))
+         end do
+      end if
+!GCC$ ivdep
+!GCC$ vector
+      do k = 1, lockstep_lanes
+         if (contact(k) .and. .not. in_contact(k)) impacts(k) = impacts(k) + 1
+         in_contact(k) = contact(k)
+         work(k) = work(k) + 0.5_wp*weight(k)*(gd(k) + gd_prev(k))
+         dissipated(k) = dissipated(k) - 0.5_wp*r_step(k)*(d_tip(k) + d_tip_prev(k))
+         reaction(k) = r_step(k)
+         gd_prev(k) = gd(k)
+         sigma_prev(k) = sigma_now(k)
+         sigma_now(k) = sigma_next(k)
+      end do
+   end subroutine close_lanes
 
    !> Member k's record row of step n, the energy column left for later (fill_row).
    subroutine fill_row(scene, model, ms, k, step, row)
@@ -749,7 +833,7 @@ contains
          call restart_loads(ms, ms%load_k + 1, scenes, model)
          return
       end if
-      do m = 1, ms%k
+      do m = 1, ms%p
          sigma = ms%sigma(m)*ms%cos_step(m) + ms%cosine(m)*ms%sin_step(m)
          ms%cosine(m) = ms%cosine(m)*ms%cos_step(m) - ms%sigma(m)*ms%sin_step(m)
          ms%sigma(m) = sigma
@@ -782,14 +866,6 @@ contains
       e = 0.5_wp*dmd/model%dt2 + 0.5_wp*(model%beta*usu + model%beta*u_old_s_u_old &
          & + (1 - 2*model%beta)*(usu - dsu))
    end function energy
-
-   !> Violation of the stops by a tip value (m).
-   pure function violation(u_tip, scene) result(v)
-      real(wp), intent(in) :: u_tip
-      type(scene_type), intent(in) :: scene
-      real(wp) :: v
-      v = max(u_tip - scene%upper, scene%lower - u_tip, 0.0_wp)
-   end function violation
 
    !> Text of a real for messages.
    function real_text(x) result(s)
