@@ -42,6 +42,7 @@ contains
          & new_unittest('K = 13, Signorini, beta = 1/4, paper''s load for some, checkpoints cut the blocks', &
          & test_signorini_thirteen), &
          & new_unittest('K = 8, J = 100, Signorini, beta = 1/2', test_fine_eight), &
+         & new_unittest('a member whose recorder fails stops; the others go on, still bit for bit', test_failing_member), &
          & new_unittest('members that do not share A are refused', test_refused) &
          & ]
    end subroutine collect_lockstep
@@ -86,10 +87,12 @@ contains
       end do
    end function members_of
 
-   !> Run the members in lockstep and each alone; compare them to the bit.
-   subroutine compare_group(scenes, error)
+   !> Run the members in lockstep and each alone; compare them to the bit. With `contact`, some
+   !> member must have hit a stop.
+   subroutine compare_group(scenes, error, contact)
       type(scene_type), intent(in) :: scenes(:)
       type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: contact
       type(array_recorder), allocatable :: group(:)
       type(array_recorder) :: alone
       type(run_summary) :: summaries(size(scenes)), summary
@@ -122,6 +125,10 @@ contains
          call same_records(group(k), alone, who, error)
          if (allocated(error)) return
       end do
+      if (present(contact)) then
+         if (contact) call check(error, sum(summaries%impacts) > 0, 'some member hit a stop (impacts: '// &
+            & int_text(sum(summaries%impacts))//')')
+      end if
    end subroutine compare_group
 
    !> Room for every record and snapshot of a scene.
@@ -282,7 +289,8 @@ contains
 
    subroutine test_one(error)
       type(error_type), allocatable, intent(out) :: error
-      call compare_group(members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.2_wp), 1, .false.), error)
+      call compare_group(members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.2_wp), 1, .false.), error, &
+         & contact=.true.)
    end subroutine test_one
 
    subroutine test_free_three(error)
@@ -292,12 +300,14 @@ contains
 
    subroutine test_signorini_five(error)
       type(error_type), allocatable, intent(out) :: error
-      call compare_group(members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.25_wp), 5, .false.), error)
+      call compare_group(members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.25_wp), 5, .false.), error, &
+         & contact=.true.)
    end subroutine test_signorini_five
 
    subroutine test_compliance_eight(error)
       type(error_type), allocatable, intent(out) :: error
-      call compare_group(members_of(base_scene(19, 2.0e-6_wp, 0.25_wp, law_compliance, 0.04_wp), 8, .true.), error)
+      call compare_group(members_of(base_scene(19, 4.0e-6_wp, 0.25_wp, law_compliance, 0.15_wp), 8, .true.), error, &
+         & contact=.true.)
    end subroutine test_compliance_eight
 
    subroutine test_signorini_thirteen(error)
@@ -308,13 +318,50 @@ contains
       do k = 1, size(scenes)
          scenes(k)%checkpoint_every = 5000
       end do
-      call compare_group(scenes, error)
+      call compare_group(scenes, error, contact=.true.)
    end subroutine test_signorini_thirteen
 
    subroutine test_fine_eight(error)
       type(error_type), allocatable, intent(out) :: error
-      call compare_group(members_of(base_scene(100, 2.0e-6_wp, 0.5_wp, law_signorini, 0.03_wp), 8, .false.), error)
+      call compare_group(members_of(base_scene(100, 4.0e-6_wp, 0.5_wp, law_signorini, 0.12_wp), 8, .false.), error, &
+         & contact=.true.)
    end subroutine test_fine_eight
+
+   !> K = 3, member 2 records every third step into room for 3000 rows: member 2 ends 'failed' after the block in which its
+   !> recorder failed (as the same scene alone), members 1 and 3 complete and equal their runs
+   !> alone.
+   subroutine test_failing_member(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type), allocatable :: scenes(:)
+      type(array_recorder) :: group(3), alone
+      type(run_summary) :: summaries(3), summary
+      type(model_type) :: model
+      integer :: k
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.25_wp), 3, .false.)
+      call prepare_lockstep(scenes, 'test group', model, error)
+      if (allocated(error)) return
+      do k = 1, 3
+         call reserve(group(k), scenes(k))
+      end do
+      deallocate (group(2)%rows)
+      allocate (group(2)%rows(n_columns, 3000))
+      call simulate_lockstep(scenes, model, group, summaries, error)
+      if (allocated(error)) return
+      call check(error, summaries(2)%status == 'failed' .and. summaries(2)%steps == 16384, &
+         & 'member 2 failed at the end of its second block: '//summaries(2)%status//' after '// &
+         & int_text(summaries(2)%steps)//' steps')
+      if (allocated(error)) return
+      do k = 1, 3, 2
+         call run_alone(scenes(k), alone, summary, error)
+         if (allocated(error)) return
+         call check(error, summaries(k)%status == status_complete, 'member '//int_text(k)//' completes')
+         if (allocated(error)) return
+         call same_summary(summaries(k), summary, 'member '//int_text(k), error)
+         if (allocated(error)) return
+         call same_records(group(k), alone, 'member '//int_text(k), error)
+         if (allocated(error)) return
+      end do
+   end subroutine test_failing_member
 
    !> Members that differ in what A depends on, in the law, in the steps, or with stops along
    !> the span are refused, the message naming the member and the key.
