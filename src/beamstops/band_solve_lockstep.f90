@@ -32,7 +32,7 @@ module beamstops_band_solve_lockstep
    implicit none
    private
    public :: lockstep_forward, lockstep_forward_energy, lockstep_back, lockstep_matvec, lockstep_dot
-   public :: lockstep_rhs, lockstep_update, lockstep_matvec_rhs
+   public :: lockstep_rhs, lockstep_update, lockstep_matvec_rhs, lockstep_pass
    public :: lockstep_min_unknowns, lockstep_work_columns, lockstep_lanes
 
    !> Fewest unknowns these routines handle (J >= 4).
@@ -397,6 +397,201 @@ contains
          end do
       end associate
    end subroutine lockstep_matvec_rhs
+
+   !> One pass over the rows that ends step n-1 and starts step n, for a chunk of lanes: the
+   !> update of step n-1 (d += x + c z, u += d, the tip of the lanes in contact set on its stop
+   !> after g.d has taken its increment), g.d^{n-1}, then S u^n, the right-hand side and the
+   !> forward substitution of step n (with the energy sums when asked): lockstep_update,
+   !> lockstep_dot, lockstep_matvec_rhs and lockstep_forward(_energy) in one sweep, the update
+   !> three rows ahead of the product that needs them. The same operations as those routines,
+   !> row by row; only their interleaving differs, so that the chain of the substitution runs
+   !> beside the independent work of the other rows.
+   subroutine lockstep_pass(stiffness, solver, mass, energy, tip, c, z, g, override, tip_value, u_tip_prev, &
+      & a, b, spring, d, u, rhs, su, gd, usu, dsu, dmd, partial, work, positive)
+      !> S by diagonals.
+      type(band_diagonals), intent(in) :: stiffness
+      !> Solver from prepare_solver.
+      type(band_solver), intent(in) :: solver
+      !> M by diagonals.
+      type(band_diagonals), intent(in) :: mass
+      !> Whether the energy sums are wanted.
+      logical, intent(in) :: energy
+      !> The tip row (n-1).
+      integer, intent(in) :: tip
+      !> Multiples of z of step n-1 (lanes).
+      real(wp), intent(in) :: c(lockstep_lanes)
+      !> z = A^{-1} e_tip (n).
+      real(wp), intent(in) :: z(solver%n)
+      !> Load vectors (lanes, n).
+      real(wp), intent(in) :: g(lockstep_lanes, solver%n)
+      !> Lanes whose tip is set on its stop (Signorini contact of step n-1) (lanes).
+      logical, intent(in) :: override(lockstep_lanes)
+      !> Their tip values, and u^{n-1} at the tip (lanes).
+      real(wp), intent(in) :: tip_value(lockstep_lanes), u_tip_prev(lockstep_lanes)
+      !> dt^2 times the load weight of step n (lanes), dt^2, the force term of the tip row (lanes).
+      real(wp), intent(in) :: a(lockstep_lanes), b, spring(lockstep_lanes)
+      !> d^{n-2}, u^{n-1} on entry; d^{n-1}, u^n on return (lanes, n).
+      real(wp), intent(inout) :: d(lockstep_lanes, solver%n), u(lockstep_lanes, solver%n)
+      !> A^{-1} rhs of step n-1 on entry; D^{-2} w of step n on return (lanes, n).
+      real(wp), intent(inout) :: rhs(lockstep_lanes, solver%n)
+      !> S u^n (lanes, n).
+      real(wp), intent(out) :: su(lockstep_lanes, solver%n)
+      !> g.d^{n-1} (lanes).
+      real(wp), intent(out) :: gd(lockstep_lanes)
+      !> u^n.S u^n, d^{n-1}.S u^n, d^{n-1}.M d^{n-1} when `energy` (lanes).
+      real(wp), intent(out) :: usu(lockstep_lanes), dsu(lockstep_lanes), dmd(lockstep_lanes)
+      !> Work arrays (lanes, lockstep_work_columns).
+      real(wp), intent(out) :: partial(lockstep_lanes, lockstep_work_columns), work(lockstep_lanes, lockstep_work_columns)
+      !> Any positive number the compiler cannot see (add_rounded).
+      real(wp), intent(in) :: positive
+      real(wp) :: wa(lockstep_lanes), wb(lockstep_lanes), wc(lockstep_lanes), wn(lockstep_lanes), d_raw(lockstep_lanes)
+      real(wp) :: d_post(lockstep_lanes)
+      integer :: i, j, k, n, blocks, last
+      n = solver%n
+      blocks = 8*(n/8)
+      last = kd + ((n - kd)/3)*3
+      if (n - last == 1) last = n
+      partial(:, 1:8) = 0
+      d_raw = 0
+      associate (off => solver%off, inv_d2 => solver%inv_d2, m => mass%a, s => stiffness%a)
+         do i = 1, 6
+            call update_row(i)
+         end do
+         ! rows 1 to 3
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            su(k, 1) = s(1, 0)*u(k, 1) + s(2, 1)*u(k, 2) + s(3, 2)*u(k, 3) + s(4, 3)*u(k, 4)
+            su(k, 2) = s(2, 1)*u(k, 1) + s(2, 0)*u(k, 2) + s(3, 1)*u(k, 3) + s(4, 2)*u(k, 4) + s(5, 3)*u(k, 5)
+            su(k, 3) = s(3, 2)*u(k, 1) + s(3, 1)*u(k, 2) + s(3, 0)*u(k, 3) + s(4, 1)*u(k, 4) + s(5, 2)*u(k, 5) &
+               & + s(6, 3)*u(k, 6)
+            rhs(k, 1) = a(k)*g(k, 1) - b*su(k, 1)
+            rhs(k, 2) = a(k)*g(k, 2) - b*su(k, 2)
+            rhs(k, 3) = a(k)*g(k, 3) - b*su(k, 3)
+            wa(k) = rhs(k, 1)
+            wb(k) = rhs(k, 2) - off(3, 2)*wa(k)
+            wc(k) = rhs(k, 3) - off(2, 3)*wa(k) - off(3, 3)*wb(k)
+            rhs(k, 1) = wa(k)*inv_d2(1)
+            rhs(k, 2) = wb(k)*inv_d2(2)
+            rhs(k, 3) = wc(k)*inv_d2(3)
+         end do
+         if (energy) then
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               usu(k) = u(k, 1)*su(k, 1) + u(k, 2)*su(k, 2) + u(k, 3)*su(k, 3)
+               dsu(k) = d(k, 1)*su(k, 1) + d(k, 2)*su(k, 2) + d(k, 3)*su(k, 3)
+               dmd(k) = d(k, 1)*m(1, 0)*d(k, 1) + d(k, 2)*(m(2, 0)*d(k, 2) + 2*m(2, 1)*d(k, 1)) &
+                  & + d(k, 3)*(m(3, 0)*d(k, 3) + 2*(m(3, 1)*d(k, 2) + m(3, 2)*d(k, 1)))
+            end do
+         end if
+         ! rows 4 to n-3, the update three rows ahead
+         do j = kd + 1, n - kd
+            call update_row(j + 3)
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               su(k, j) = s(j, 3)*u(k, j - 3) + s(j, 2)*u(k, j - 2) + s(j, 1)*u(k, j - 1) + s(j, 0)*u(k, j) &
+                  & + s(j + 1, 1)*u(k, j + 1) + s(j + 2, 2)*u(k, j + 2) + s(j + 3, 3)*u(k, j + 3)
+               rhs(k, j) = a(k)*g(k, j) - b*su(k, j)
+               wn(k) = rhs(k, j) - off(1, j)*wa(k) - off(2, j)*wb(k) - off(3, j)*wc(k)
+               rhs(k, j) = wn(k)*inv_d2(j)
+               wa(k) = wb(k)
+               wb(k) = wc(k)
+               wc(k) = wn(k)
+            end do
+            if (energy .and. j <= last) then
+!GCC$ ivdep
+!GCC$ vector
+               do k = 1, lockstep_lanes
+                  usu(k) = usu(k) + u(k, j)*su(k, j)
+                  dsu(k) = dsu(k) + d(k, j)*su(k, j)
+                  dmd(k) = dmd(k) + d(k, j)*(m(j, 0)*d(k, j) + 2*(m(j, 1)*d(k, j - 1) + m(j, 2)*d(k, j - 2) &
+                     & + m(j, 3)*d(k, j - 3)))
+               end do
+            end if
+         end do
+         ! rows n-2 to n
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            su(k, n - 2) = s(n - 2, 3)*u(k, n - 5) + s(n - 2, 2)*u(k, n - 4) + s(n - 2, 1)*u(k, n - 3) &
+               & + s(n - 2, 0)*u(k, n - 2) + s(n - 1, 1)*u(k, n - 1) + s(n, 2)*u(k, n)
+            su(k, n - 1) = s(n - 1, 3)*u(k, n - 4) + s(n - 1, 2)*u(k, n - 3) + s(n - 1, 1)*u(k, n - 2) &
+               & + s(n - 1, 0)*u(k, n - 1) + s(n, 1)*u(k, n)
+            su(k, n) = s(n, 3)*u(k, n - 3) + s(n, 2)*u(k, n - 2) + s(n, 1)*u(k, n - 1) + s(n, 0)*u(k, n)
+            rhs(k, n - 2) = a(k)*g(k, n - 2) - b*su(k, n - 2)
+            rhs(k, n - 1) = a(k)*g(k, n - 1) - b*su(k, n - 1)
+            rhs(k, n) = a(k)*g(k, n) - b*su(k, n)
+            rhs(k, n - 1) = rhs(k, n - 1) + spring(k)
+         end do
+         do j = n - 2, n
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               wn(k) = rhs(k, j) - off(1, j)*wa(k) - off(2, j)*wb(k) - off(3, j)*wc(k)
+               rhs(k, j) = wn(k)*inv_d2(j)
+               wa(k) = wb(k)
+               wb(k) = wc(k)
+               wc(k) = wn(k)
+            end do
+            if (energy .and. j <= last) then
+!GCC$ ivdep
+!GCC$ vector
+               do k = 1, lockstep_lanes
+                  usu(k) = usu(k) + u(k, j)*su(k, j)
+                  dsu(k) = dsu(k) + d(k, j)*su(k, j)
+                  dmd(k) = dmd(k) + d(k, j)*(m(j, 0)*d(k, j) + 2*(m(j, 1)*d(k, j - 1) + m(j, 2)*d(k, j - 2) &
+                     & + m(j, 3)*d(k, j - 3)))
+               end do
+            end if
+         end do
+      end associate
+      if (energy .and. last == n - 2) then
+         call rounded_terms(n - 1, n, mass, u, d, su, usu, dsu, dmd, work, positive)
+         call rounded_terms(n, n, mass, u, d, su, usu, dsu, dmd, work, positive)
+      end if
+      ! g.d^{n-1}: the rows after the last eight, with the tip's increment before it was set
+      d_post = d(:, tip)
+      d(:, tip) = d_raw
+      if (tip <= blocks) d(:, tip) = d_post
+      call dot_tail(n, blocks + 1, g, d, partial, gd, positive)
+      d(:, tip) = d_post
+
+   contains
+
+      !> Row i of the update of step n-1, its term of g.d, and the tip set on its stop.
+      subroutine update_row(i)
+         integer, intent(in) :: i
+         integer :: p, q
+         if (i > n) return
+!GCC$ ivdep
+!GCC$ vector
+         do q = 1, lockstep_lanes
+            d(q, i) = d(q, i) + rhs(q, i) + c(q)*z(i)
+            u(q, i) = u(q, i) + d(q, i)
+         end do
+         if (i <= blocks) then
+            p = mod(i - 1, 8) + 1
+!GCC$ ivdep
+!GCC$ vector
+            do q = 1, lockstep_lanes
+               partial(q, p) = partial(q, p) + g(q, i)*d(q, i)
+            end do
+         end if
+         if (i == tip) then
+            d_raw = d(:, tip)
+!GCC$ ivdep
+!GCC$ vector
+            do q = 1, lockstep_lanes
+               if (override(q)) then
+                  u(q, tip) = tip_value(q)
+                  d(q, tip) = tip_value(q) - u_tip_prev(q)
+               end if
+            end do
+         end if
+      end subroutine update_row
+   end subroutine lockstep_pass
 
    !> The end of a dot product from the eight partial sums and the rows j..n after them
    !> (lockstep_dot).
