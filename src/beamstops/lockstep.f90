@@ -1,11 +1,7 @@
 !> Lockstep ensembles (SPEC 13): K members that share A = M + dt^2 beta S (the same mesh,
 !> beam, time step, beta, contact law and number of steps) advance together, the member index
-!> innermost, so that each multiply-add of the two substitutions of a step serves several
-!> members and the dependency chain of a step is paid once for all of them. Members sit in
-!> chunks of lockstep_lanes (8) lanes: arrays (lanes, n, chunks), member k in lane lane(k) of
-!> chunk chunk(k); the kernels (beamstops_band_solve_lockstep) take one chunk, a compile-time
-!> width that vectorizes with no loop of its own; the last chunk is padded with lanes at rest
-!> (zero load, zero state, stops -1 and 1), which stay at rest.
+!> innermost (arrays (K, n)), so that each multiply-add of the two substitutions of a step
+!> serves K members and the dependency chain of a step is paid once for all of them.
 !>
 !> A member may differ from the others in what does not enter A: the support (amplitude,
 !> omega, hence its load vector and initial velocity), the tip stops (lower, upper), the load
@@ -37,7 +33,7 @@ module beamstops_lockstep
    use beamstops_band_solve, only: band_solver, band_diagonals, prepare_solver, prepare_diagonals, diagonal_matvec, dot
    use beamstops_band_solve_lockstep, only: lockstep_forward, lockstep_forward_energy, lockstep_back, &
       & lockstep_matvec, lockstep_dot, lockstep_min_unknowns, lockstep_work_columns, &
-      & lockstep_lanes, lockstep_matvec_rhs, lockstep_update, lockstep_pass
+      & lockstep_lanes, lockstep_matvec_rhs, lockstep_update
    use beamstops_state, only: state_type
    use beamstops_scheme, only: start_state, block_steps
    use beamstops_clock, only: thread_cpu_seconds
@@ -89,12 +85,8 @@ module beamstops_lockstep
       real(wp), allocatable :: sigma(:), cosine(:), cos_step(:), sin_step(:)
       !> Tip stops of each member (padding lanes: -1, 1) (K).
       real(wp), allocatable :: lower(:), upper(:)
-      !> Tip value and increment after the update; the load weight of the step before (K).
-      real(wp), allocatable :: u_tip(:), d_tip(:), weight_prev(:)
-      !> Lanes whose tip is set on its stop at the update (Signorini contact) (K).
-      logical, allocatable :: override(:)
-      !> Work array of the sweep (lanes, lockstep_work_columns).
-      real(wp), allocatable :: work_lanes(:, :)
+      !> Tip value and increment after the update (K).
+      real(wp), allocatable :: u_tip(:), d_tip(:)
       !> Values of the step (K).
       real(wp), allocatable :: sigma_next(:), weight(:), coef(:), spring(:), trial(:), c(:), tip_value(:), &
          & r_step(:), u_tip_prev(:), d_tip_prev(:), r_prev(:), usu(:), dsu(:), dmd(:), u_old_su(:), gd(:)
@@ -375,10 +367,7 @@ contains
          & ms%dsu(nk), ms%dmd(nk), ms%u_old_su(nk), ms%gd(nk), ms%contact(nk), ms%pending(nk), &
          & ms%next_record(nk), ms%next_snapshot(nk), ms%rows(n_columns, nk))
       allocate (ms%vec_u(n), ms%vec_d(n), ms%vec_su(n), ms%vec_s(n), ms%shape(size(model%x)))
-      allocate (ms%lower(nk), ms%upper(nk), ms%u_tip(nk), ms%d_tip(nk), ms%weight_prev(nk), ms%override(nk))
-      allocate (ms%work_lanes(lockstep_lanes, lockstep_work_columns))
-      ms%weight_prev = 0
-      ms%override = .false.
+      allocate (ms%lower(nk), ms%upper(nk), ms%u_tip(nk), ms%d_tip(nk))
       call zero_members(ms)
       ms%lower = -1
       ms%upper = 1
@@ -514,10 +503,7 @@ contains
    end subroutine load_shapes
 
    !> Advance every member from ms%step through step `last` (advance_fused of beamstops_scheme,
-   !> per member, the member index innermost). The end of a step (its update, g.d, the
-   !> bookkeeping and its record) is done in the same sweep as the start of the next
-   !> (lockstep_pass); the first step of a call starts with the product and the forward
-   !> substitution alone, and the last ends with the update alone.
+   !> per member, the member index innermost).
    subroutine advance_members(scenes, model, ops, ms, recorders, last)
       type(scene_type), intent(in) :: scenes(:)
       type(model_type), intent(in) :: model
@@ -527,7 +513,7 @@ contains
       integer(ik), intent(in) :: last
       integer(ik) :: step, next_record, next_snapshot
       integer :: k, c, lo, hi, n, tip, law
-      logical :: energy_wanted
+      logical :: energy_wanted, pending
 
       n = ms%n
       tip = model%tip
@@ -538,58 +524,47 @@ contains
       next_record = minval(ms%next_record)
       next_snapshot = minval(ms%next_snapshot)
       ms%pending = .false.
+      pending = .false.
       ms%u_old_su = 0
       ms%dmd = 0
       call start_loads(ms, ms%step + 1, scenes, model)
       do step = ms%step, last
          ms%sigma_next = ms%sigma
          call next_loads(ms, scenes, model)
-         ms%weight_prev = ms%weight
          ms%weight = model%beta*ms%sigma_next + (1 - 2*model%beta)*ms%sigma_now + model%beta*ms%sigma_prev
+         ! the forward pass, a chunk of members after the other
          ms%coef = model%dt2*ms%weight
          if (law == law_compliance) ms%spring = model%dt2*((1 - 2*model%beta)*ms%p_now + model%beta*ms%p_prev)
-         if (step == ms%step) then
-            ! the first step of the call: S u, the right-hand side and the forward substitution
-            energy_wanted = step == next_record
-            do c = 1, ms%chunks
-               lo = (c - 1)*lockstep_lanes + 1
-               hi = c*lockstep_lanes
-               call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), ms%coef(lo:hi), ms%g(:, :, c), model%dt2, &
-                  & ms%spring(lo:hi), ms%su(:, :, c), ms%rhs(:, :, c))
-               if (energy_wanted) then
-                  call lockstep_forward_energy(ops%solver, ops%mass, ms%u(:, :, c), ms%d(:, :, c), ms%su(:, :, c), &
-                     & ms%rhs(:, :, c), ms%usu(lo:hi), ms%dsu(lo:hi), ms%dmd(lo:hi), ms%partial)
-               else
-                  call lockstep_forward(ops%solver, ms%rhs(:, :, c))
-               end if
-            end do
-         else
-            ! the end of step n-1 and the start of step n in one sweep
-            energy_wanted = next_record == step - 1 .or. next_record == step
-            do c = 1, ms%chunks
-               lo = (c - 1)*lockstep_lanes + 1
-               hi = c*lockstep_lanes
-               call lockstep_pass(ops%stiffness, ops%solver, ops%mass, energy_wanted, tip, ms%c(lo:hi), model%z, &
-                  & ms%g(:, :, c), ms%override(lo:hi), ms%tip_value(lo:hi), ms%u_tip_prev(lo:hi), ms%coef(lo:hi), &
-                  & model%dt2, ms%spring(lo:hi), ms%d(:, :, c), ms%u(:, :, c), ms%rhs(:, :, c), ms%su(:, :, c), &
-                  & ms%gd(lo:hi), ms%usu(lo:hi), ms%dsu(lo:hi), ms%dmd(lo:hi), ms%partial, ms%work_lanes, model%dt2)
-               ms%u_tip(lo:hi) = ms%u(:, tip, c)
-               ms%d_tip(lo:hi) = ms%d(:, tip, c)
-            end do
-            ms%r_prev = ms%reaction
-            call close_steps(law, ms, ms%weight_prev)
-            if (step - 1 == next_record .or. step - 1 == next_snapshot) then
-               call record_members(scenes, model, ms, recorders, step - 1, .true.)
-               next_record = minval(ms%next_record)
-               next_snapshot = minval(ms%next_snapshot)
+         energy_wanted = pending .or. step == next_record
+         do c = 1, ms%chunks
+            lo = (c - 1)*lockstep_lanes + 1
+            hi = c*lockstep_lanes
+            call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), ms%coef(lo:hi), ms%g(:, :, c), model%dt2, &
+               & ms%spring(lo:hi), ms%su(:, :, c), ms%rhs(:, :, c))
+            if (energy_wanted) then
+               call lockstep_forward_energy(ops%solver, ops%mass, ms%u(:, :, c), ms%d(:, :, c), ms%su(:, :, c), &
+                  & ms%rhs(:, :, c), ms%usu(lo:hi), ms%dsu(lo:hi), ms%dmd(lo:hi), ms%partial)
+            else
+               call lockstep_forward(ops%solver, ms%rhs(:, :, c))
             end if
+         end do
+         if (pending) then
+            do k = 1, ms%k
+               if (.not. ms%pending(k)) cycle
+               ms%rows(col_energy, k) = scenes(k)%mass_per_length*energy(model, ms%dmd(k), ms%usu(k), ms%dsu(k), &
+                  & ms%u_old_su(k))
+               if (ms%active(k)) call recorders(k)%record(ms%rows(:, k))
+               ms%pending(k) = .false.
+            end do
+            pending = .false.
          end if
          if (energy_wanted) then
             ms%u_old_su = ms%usu
          else
             ms%u_old_su = 0
          end if
-         ! the back substitution and the contact law at the tip
+         ! the back substitution and the tip step: the contact law, the update and the
+         ! bookkeeping (tip_step, close_step)
          do c = 1, ms%chunks
             lo = (c - 1)*lockstep_lanes + 1
             hi = c*lockstep_lanes
@@ -599,30 +574,42 @@ contains
             ms%trial(lo:hi) = ms%u_tip_prev(lo:hi) + (ms%d_tip_prev(lo:hi) + ms%rhs(:, tip, c))
          end do
          call contact_law(law, scenes, model, ms)
-         ms%override = law == law_signorini .and. ms%contact
-         ms%sigma_prev = ms%sigma_now
-         ms%sigma_now = ms%sigma_next
-      end do
-      ! the end of the last step: update, g.d, bookkeeping, records
-      do c = 1, ms%chunks
-         lo = (c - 1)*lockstep_lanes + 1
-         hi = c*lockstep_lanes
-         call lockstep_update(n, ms%rhs(:, :, c), ms%c(lo:hi), model%z, ms%d(:, :, c), ms%u(:, :, c))
-         call lockstep_dot(n, ms%g(:, :, c), ms%d(:, :, c), ms%partial, ms%gd(lo:hi), model%dt2)
-         ms%u_tip(lo:hi) = ms%u(:, tip, c)
-         ms%d_tip(lo:hi) = ms%d(:, tip, c)
-      end do
-      ms%r_prev = ms%reaction
-      call close_steps(law, ms, ms%weight)
-      if (law == law_signorini) then
          do c = 1, ms%chunks
             lo = (c - 1)*lockstep_lanes + 1
             hi = c*lockstep_lanes
-            ms%u(:, tip, c) = ms%u_tip(lo:hi)
-            ms%d(:, tip, c) = ms%d_tip(lo:hi)
+            call lockstep_update(n, ms%rhs(:, :, c), ms%c(lo:hi), model%z, ms%d(:, :, c), ms%u(:, :, c))
+            call lockstep_dot(n, ms%g(:, :, c), ms%d(:, :, c), ms%partial, ms%gd(lo:hi), model%dt2)
+            ms%u_tip(lo:hi) = ms%u(:, tip, c)
+            ms%d_tip(lo:hi) = ms%d(:, tip, c)
          end do
-      end if
-      if (last == next_record .or. last == next_snapshot) call record_members(scenes, model, ms, recorders, last, .false.)
+         ms%r_prev = ms%reaction
+         call close_steps(law, ms)
+         if (law == law_signorini) then
+            do c = 1, ms%chunks
+               lo = (c - 1)*lockstep_lanes + 1
+               hi = c*lockstep_lanes
+               ms%u(:, tip, c) = ms%u_tip(lo:hi)
+               ms%d(:, tip, c) = ms%d_tip(lo:hi)
+            end do
+         end if
+         ! records and snapshots
+         if (step == next_record .or. step == next_snapshot) then
+            do k = 1, ms%k
+               if (step == ms%next_record(k)) then
+                  ms%next_record(k) = ms%next_record(k) + scenes(k)%record_every
+                  call fill_row(scenes(k), model, ms, k, step, ms%rows(:, k))
+                  ms%pending(k) = .true.
+                  pending = .true.
+               end if
+               if (step == ms%next_snapshot(k)) then
+                  ms%next_snapshot(k) = ms%next_snapshot(k) + scenes(k)%snapshot_every
+                  if (ms%active(k)) call take_snapshot(scenes(k), model, ms, k, step, recorders(k))
+               end if
+            end do
+            next_record = minval(ms%next_record)
+            next_snapshot = minval(ms%next_snapshot)
+         end if
+      end do
       ! S u^{last+1}; it also completes the waiting records, as advance_fused does (one member
       ! at a time, with the one-member products and dot products).
       do c = 1, ms%chunks
@@ -641,36 +628,6 @@ contains
          call recorders(k)%record(ms%rows(:, k))
       end do
    end subroutine advance_members
-
-   !> The snapshots and records of step `step` (done): each member whose snapshot or record is
-   !> due takes it; a record is completed with the energy sums of the sweep just done
-   !> (`complete`) or left waiting (pending) for the end of the call.
-   subroutine record_members(scenes, model, ms, recorders, step, complete)
-      type(scene_type), intent(in) :: scenes(:)
-      type(model_type), intent(in) :: model
-      type(members_type), intent(inout) :: ms
-      class(recorder_type), intent(inout) :: recorders(:)
-      integer(ik), intent(in) :: step
-      logical, intent(in) :: complete
-      integer :: k
-      do k = 1, ms%k
-         if (step == ms%next_snapshot(k)) then
-            ms%next_snapshot(k) = ms%next_snapshot(k) + scenes(k)%snapshot_every
-            if (ms%active(k)) call take_snapshot(scenes(k), model, ms, k, step, recorders(k))
-         end if
-         if (step == ms%next_record(k)) then
-            ms%next_record(k) = ms%next_record(k) + scenes(k)%record_every
-            call fill_row(scenes(k), model, ms, k, step, ms%rows(:, k))
-            if (complete) then
-               ms%rows(col_energy, k) = scenes(k)%mass_per_length*energy(model, ms%dmd(k), ms%usu(k), ms%dsu(k), &
-                  & ms%u_old_su(k))
-               if (ms%active(k)) call recorders(k)%record(ms%rows(:, k))
-            else
-               ms%pending(k) = .true.
-            end if
-         end if
-      end do
-   end subroutine record_members
 
    !> The contact law at the tip of every member (beamstops_scheme's contact_law and the
    !> projection of beamstops_contact_tip_projection, written over the members): from the
@@ -712,21 +669,21 @@ contains
    end subroutine contact_law
 
    !> After the update, for every member (beamstops_scheme's close_step, written over the
-   !> members, on the gathered tip values u_tip, d_tip, with the load weight of the step): the
-   !> exact tip value (Signorini), the violation, impacts, the work of the load and the energy the
-   !> stops take. (The load averages move on at the end of the step, advance_members.)
-   subroutine close_steps(law, ms, weight)
+   !> members, on the gathered tip values u_tip, d_tip): the exact tip value (Signorini), the
+   !> violation, impacts, the work of the load and the energy the stops take, the load averages
+   !> moved on.
+   subroutine close_steps(law, ms)
       integer, intent(in) :: law
       type(members_type), intent(inout) :: ms
-      real(wp), intent(in) :: weight(:)
       integer :: c, lo, hi
       do c = 1, ms%chunks
          lo = (c - 1)*lockstep_lanes + 1
          hi = c*lockstep_lanes
          call close_lanes(law, ms%contact(lo:hi), ms%tip_value(lo:hi), ms%u_tip_prev(lo:hi), ms%d_tip_prev(lo:hi), &
-            & ms%lower(lo:hi), ms%upper(lo:hi), weight(lo:hi), ms%gd(lo:hi), ms%r_step(lo:hi), &
-            & ms%u_tip(lo:hi), ms%d_tip(lo:hi), ms%max_violation(lo:hi), ms%impacts(lo:hi), &
-            & ms%in_contact(lo:hi), ms%work(lo:hi), ms%dissipated(lo:hi), ms%reaction(lo:hi), ms%gd_prev(lo:hi))
+            & ms%lower(lo:hi), ms%upper(lo:hi), ms%weight(lo:hi), ms%gd(lo:hi), ms%r_step(lo:hi), &
+            & ms%sigma_next(lo:hi), ms%u_tip(lo:hi), ms%d_tip(lo:hi), ms%max_violation(lo:hi), ms%impacts(lo:hi), &
+            & ms%in_contact(lo:hi), ms%work(lo:hi), ms%dissipated(lo:hi), ms%reaction(lo:hi), ms%gd_prev(lo:hi), &
+            & ms%sigma_prev(lo:hi), ms%sigma_now(lo:hi))
       end do
    end subroutine close_steps
 
@@ -749,14 +706,16 @@ contains
 
    !> close_steps for a chunk of lanes.
    pure subroutine close_lanes(law, contact, tip_value, u_tip_prev, d_tip_prev, lower, upper, weight, gd, r_step, &
-      & u_tip, d_tip, max_violation, impacts, in_contact, work, dissipated, reaction, gd_prev)
+      & sigma_next, u_tip, d_tip, max_violation, impacts, in_contact, work, dissipated, reaction, gd_prev, &
+      & sigma_prev, sigma_now)
       integer, intent(in) :: law
       logical, intent(in) :: contact(lockstep_lanes)
       real(wp), intent(in) :: tip_value(lockstep_lanes), u_tip_prev(lockstep_lanes), d_tip_prev(lockstep_lanes), &
          & lower(lockstep_lanes), upper(lockstep_lanes), weight(lockstep_lanes), gd(lockstep_lanes), &
-         & r_step(lockstep_lanes)
+         & r_step(lockstep_lanes), sigma_next(lockstep_lanes)
       real(wp), intent(inout) :: u_tip(lockstep_lanes), d_tip(lockstep_lanes), max_violation(lockstep_lanes), &
-         & work(lockstep_lanes), dissipated(lockstep_lanes), reaction(lockstep_lanes), gd_prev(lockstep_lanes)
+         & work(lockstep_lanes), dissipated(lockstep_lanes), reaction(lockstep_lanes), gd_prev(lockstep_lanes), &
+         & sigma_prev(lockstep_lanes), sigma_now(lockstep_lanes)
       integer(ik), intent(inout) :: impacts(lockstep_lanes)
       logical, intent(inout) :: in_contact(lockstep_lanes)
       integer :: k
@@ -786,6 +745,8 @@ contains
          dissipated(k) = dissipated(k) - 0.5_wp*r_step(k)*(d_tip(k) + d_tip_prev(k))
          reaction(k) = r_step(k)
          gd_prev(k) = gd(k)
+         sigma_prev(k) = sigma_now(k)
+         sigma_now(k) = sigma_next(k)
       end do
    end subroutine close_lanes
 

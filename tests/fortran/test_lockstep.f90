@@ -17,7 +17,7 @@ module test_lockstep
    use beamstops_band_solve, only: band_solver, band_diagonals, prepare_solver, prepare_diagonals, diagonal_matvec, &
       & forward_substitution, forward_substitution_energy, back_substitution, dot
    use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_work_columns, lockstep_matvec, &
-      & lockstep_forward, lockstep_forward_energy, lockstep_back, lockstep_dot, lockstep_update, lockstep_pass
+      & lockstep_forward, lockstep_forward_energy, lockstep_back, lockstep_dot, lockstep_update
    implicit none
    private
    public :: collect_lockstep
@@ -35,8 +35,6 @@ contains
       tests = [ &
          & new_unittest('kernels: each lane equals the one-member kernel to the bit, J = 4..13, 19, 20, 100, 101', &
          & test_kernels), &
-         & new_unittest('the sweep that ends a step and starts the next equals the one-member operations, '// &
-         & 'J = 4..13, 19, 20, 100, 101', test_pass), &
          & new_unittest('K = 1, Signorini, beta = 1/2', test_one), &
          & new_unittest('K = 3, no stops, beta = 1/4, different omega and amplitude', test_free_three), &
          & new_unittest('K = 5, Signorini, beta = 1/2, different stops, omega, amplitude, cadences', test_signorini_five), &
@@ -288,94 +286,6 @@ contains
          end do
       end do
    end subroutine test_kernels
-
-   !> lockstep_pass against the one-member operations of a step's end and the next step's start:
-   !> the update, g.d (the tip's increment before it is set on its stop), the tip set, S u, the
-   !> right-hand side, the forward substitution with and without the energy sums.
-   subroutine test_pass(error)
-      type(error_type), allocatable, intent(out) :: error
-      integer, parameter :: meshes(14) = [4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 19, 20, 100, 101]
-      integer, parameter :: lanes = lockstep_lanes
-      type(scene_type) :: scene
-      type(model_type) :: model
-      type(band_solver) :: solver
-      type(band_diagonals) :: s, m
-      real(wp), allocatable :: x(:, :), g(:, :), d(:, :), u(:, :), su(:, :), v(:), w(:), sv(:), r(:)
-      real(wp) :: work(lanes, lockstep_work_columns), part(lanes, lockstep_work_columns)
-      real(wp) :: c(lanes), a(lanes), spring(lanes), tv(lanes), utp(lanes), gd(lanes), usu(lanes), dsu(lanes)
-      real(wp) :: dmd(lanes), e(3), gd_ref, coin(lanes), b
-      logical :: ov(lanes), energy
-      integer :: i, rep, k, n, tip
-      character(len=:), allocatable :: where
-      do i = 1, size(meshes)
-         scene%elements = meshes(i)
-         scene%dt = 1.0e-5_wp
-         call build_model(scene, model, error)
-         if (allocated(error)) return
-         call prepare_solver(model%factor, solver)
-         call prepare_diagonals(model%stiffness, s)
-         call prepare_diagonals(model%mass, m)
-         n = model%n
-         tip = model%tip
-         b = model%dt2
-         if (allocated(x)) deallocate (x, g, d, u, su, v, w, sv, r)
-         allocate (x(lanes, n), g(lanes, n), d(lanes, n), u(lanes, n), su(lanes, n), v(n), w(n), sv(n), r(n))
-         do rep = 1, 20
-            energy = mod(rep, 2) == 0
-            call random_number(x)
-            call random_number(g)
-            call random_number(d)
-            call random_number(u)
-            call random_number(c)
-            call random_number(a)
-            call random_number(spring)
-            call random_number(tv)
-            call random_number(utp)
-            call random_number(coin)
-            x = x - 0.5_wp
-            d = d - 0.5_wp
-            c = c - 0.5_wp
-            ov = coin > 0.5_wp
-            where = 'J = '//int_text(meshes(i))//': '
-            block
-               real(wp) :: x0(lanes, n), d0(lanes, n), u0(lanes, n)
-               x0 = x
-               d0 = d
-               u0 = u
-               call lockstep_pass(s, solver, m, energy, tip, c, model%z, g, ov, tv, utp, a, b, spring, d, u, x, su, &
-                  & gd, usu, dsu, dmd, part, work, 1.0_wp)
-               do k = 1, lanes
-                  v = d0(k, :) + x0(k, :) + c(k)*model%z
-                  w = u0(k, :) + v
-                  gd_ref = dot(g(k, :), v)
-                  if (ov(k)) then
-                     w(tip) = tv(k)
-                     v(tip) = tv(k) - utp(k)
-                  end if
-                  call diagonal_matvec(s, w, sv)
-                  r = a(k)*g(k, :) - b*sv
-                  r(n - 1) = r(n - 1) + spring(k)
-                  if (energy) then
-                     call forward_substitution_energy(solver, m, w, v, sv, r, e(1), e(2), e(3))
-                  else
-                     call forward_substitution(solver, r)
-                  end if
-                  if (.not. (all(same_bits(v, d(k, :))) .and. all(same_bits(w, u(k, :))))) &
-                     & call test_failed(error, where//'update, lane '//int_text(k))
-                  if (.not. same_bits(gd_ref, gd(k))) call test_failed(error, where//'g.d, lane '//int_text(k))
-                  if (.not. all(same_bits(sv, su(k, :)))) call test_failed(error, where//'S u, lane '//int_text(k))
-                  if (.not. all(same_bits(r, x(k, :)))) call test_failed(error, where//'forward substitution, lane '// &
-                     & int_text(k))
-                  if (energy) then
-                     if (.not. (same_bits(e(1), usu(k)) .and. same_bits(e(2), dsu(k)) .and. same_bits(e(3), dmd(k)))) &
-                        & call test_failed(error, where//'energy sums, lane '//int_text(k))
-                  end if
-                  if (allocated(error)) return
-               end do
-            end block
-         end do
-      end do
-   end subroutine test_pass
 
    subroutine test_one(error)
       type(error_type), allocatable, intent(out) :: error
