@@ -1,55 +1,18 @@
 !> Symmetric band storage (LAPACK 'U', kd = 3) of the assembled Hermite matrices,
-!> and the LAPACK calls on it, with info codes turned into messages.
+!> and the LAPACK calls on it (interfaces and info messages: beamstops_lapack).
 module beamstops_band
    use beamstops_kinds, only: wp
    use beamstops_error, only: error_type, fatal_error
+   use beamstops_lapack, only: dpbtrf, dpbtrs, dsbgv, dgbtrf, dgbtrs, dpbtrf_message, dpbtrs_message, &
+      & dsbgv_message, dgbtrf_message, dgbtrs_message
    implicit none
    private
    public :: kd, assemble_band, band_matvec, band_to_dense, cholesky_factor, cholesky_solve
-   public :: largest_eigenvalue_exact, largest_eigenvalue_iterative
+   public :: largest_eigenvalue_exact, largest_eigenvalue_iterative, generalized_eigenvalues
 
    !> Half-bandwidth of Hermite cubic matrices with (u, u') interleaved.
    integer, parameter :: kd = 3
 
-   interface
-      subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
-         import :: wp
-         character, intent(in) :: uplo
-         integer, intent(in) :: n, kd, ldab
-         real(wp), intent(inout) :: ab(ldab, *)
-         integer, intent(out) :: info
-      end subroutine dpbtrf
-      subroutine dpbtrs(uplo, n, kd, nrhs, ab, ldab, b, ldb, info)
-         import :: wp
-         character, intent(in) :: uplo
-         integer, intent(in) :: n, kd, nrhs, ldab, ldb
-         real(wp), intent(in) :: ab(ldab, *)
-         real(wp), intent(inout) :: b(ldb, *)
-         integer, intent(out) :: info
-      end subroutine dpbtrs
-      subroutine dsbgv(jobz, uplo, n, ka, kb, ab, ldab, bb, ldbb, w, z, ldz, work, info)
-         import :: wp
-         character, intent(in) :: jobz, uplo
-         integer, intent(in) :: n, ka, kb, ldab, ldbb, ldz
-         real(wp), intent(inout) :: ab(ldab, *), bb(ldbb, *)
-         real(wp), intent(out) :: w(*), z(ldz, *), work(*)
-         integer, intent(out) :: info
-      end subroutine dsbgv
-      subroutine dgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
-         import :: wp
-         integer, intent(in) :: m, n, kl, ku, ldab
-         real(wp), intent(inout) :: ab(ldab, *)
-         integer, intent(out) :: ipiv(*), info
-      end subroutine dgbtrf
-      subroutine dgbtrs(trans, n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
-         import :: wp
-         character, intent(in) :: trans
-         integer, intent(in) :: n, kl, ku, nrhs, ldab, ipiv(*), ldb
-         real(wp), intent(in) :: ab(ldab, *)
-         real(wp), intent(inout) :: b(ldb, *)
-         integer, intent(out) :: info
-      end subroutine dgbtrs
-   end interface
 
 contains
 
@@ -140,27 +103,21 @@ contains
       !> Set when the matrix is not positive definite.
       type(error_type), allocatable, intent(out) :: error
       integer :: info
-      character(len=16) :: buf
       call dpbtrf('U', size(ab, 2), kd, ab, size(ab, 1), info)
-      if (info /= 0) then
-         write (buf, '(i0)') abs(info)
-         if (info > 0) then
-            call fatal_error(error, 'dpbtrf: the leading minor of order '//trim(buf)//' of '//what// &
-               & ' is not positive definite')
-         else
-            call fatal_error(error, 'dpbtrf: argument '//trim(buf)//' had an illegal value')
-         end if
-      end if
+      if (info /= 0) call fatal_error(error, dpbtrf_message(info, what))
    end subroutine cholesky_factor
 
    !> Solve A x = b with the factor from cholesky_factor (LAPACK dpbtrs).
-   subroutine cholesky_solve(factor, b)
+   subroutine cholesky_solve(factor, b, error)
       !> Factor U in band storage.
       real(wp), intent(in) :: factor(:, :)
       !> Right-hand side, replaced by the solution.
       real(wp), intent(inout) :: b(:)
+      !> Set when dpbtrs refuses its arguments (sizes that do not match); absent: not checked.
+      type(error_type), allocatable, intent(out), optional :: error
       integer :: info
       call dpbtrs('U', size(factor, 2), kd, 1, factor, size(factor, 1), b, size(b), info)
+      if (info /= 0 .and. present(error)) call fatal_error(error, dpbtrs_message(info))
    end subroutine cholesky_solve
 
    !> Largest eigenvalue of S v = kappa M v, exactly (LAPACK dsbgv). Cost O(n^2): small n only.
@@ -176,20 +133,57 @@ contains
       real(wp), allocatable :: sa(:, :), ma(:, :), w(:), work(:)
       real(wp) :: zdum(1, 1)
       integer :: n, info
-      character(len=16) :: buf
       n = size(s, 2)
       allocate (sa, source=s)
       allocate (ma, source=m)
       allocate (w(n), work(3*n))
       call dsbgv('N', 'U', n, kd, kd, sa, kd + 1, ma, kd + 1, w, zdum, 1, work, info)
       if (info /= 0) then
-         write (buf, '(i0)') info
-         call fatal_error(error, 'dsbgv failed with info = '//trim(buf))
+         call fatal_error(error, dsbgv_message(info, n))
          kappa = 0
          return
       end if
       kappa = w(n)
    end subroutine largest_eigenvalue_exact
+
+   !> All finite eigenvalues kappa of S v = kappa M v, ascending (LAPACK dsbgv; O(n^2): small n
+   !> only). M may be singular with `massless` zero rows (mass redistribution): then the pencil
+   !> is taken the other way round, M v = mu S v (S is positive definite), whose `massless`
+   !> smallest eigenvalues are the zeros of M (infinite kappa) and the others give kappa = 1/mu.
+   subroutine generalized_eigenvalues(s, m, massless, kappa, error)
+      !> Stiffness, band storage (positive definite).
+      real(wp), intent(in) :: s(:, :)
+      !> Mass, band storage (positive definite, or semi-definite with `massless` zero rows).
+      real(wp), intent(in) :: m(:, :)
+      !> Number of zero rows of M.
+      integer, intent(in) :: massless
+      !> The n - massless finite eigenvalues, ascending.
+      real(wp), allocatable, intent(out) :: kappa(:)
+      !> Set when LAPACK fails.
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: sa(:, :), ma(:, :), w(:), work(:)
+      real(wp) :: zdum(1, 1)
+      integer :: n, info
+      n = size(s, 2)
+      allocate (sa, source=s)
+      allocate (ma, source=m)
+      allocate (w(n), work(3*n))
+      if (massless == 0) then
+         call dsbgv('N', 'U', n, kd, kd, sa, kd + 1, ma, kd + 1, w, zdum, 1, work, info)
+      else
+         call dsbgv('N', 'U', n, kd, kd, ma, kd + 1, sa, kd + 1, w, zdum, 1, work, info)
+      end if
+      if (info /= 0) then
+         call fatal_error(error, dsbgv_message(info, n))
+         allocate (kappa(0))
+         return
+      end if
+      if (massless == 0) then
+         kappa = w
+      else
+         kappa = 1/w(n:massless + 1:-1)
+      end if
+   end subroutine generalized_eigenvalues
 
    !> Largest eigenvalue of S v = kappa M v by inverse iteration shifted at an upper bound
    !> `shift` (O(n) per iteration; for meshes too large for dsbgv). Converges to the top of
@@ -221,7 +215,7 @@ contains
       end do
       call dgbtrf(n, n, kl, ku, ab, ldab, ipiv, info)
       if (info /= 0) then
-         call fatal_error(error, 'dgbtrf: the shifted matrix S - shift M is singular')
+         call fatal_error(error, dgbtrf_message(info)//' (the shifted matrix S - shift M)')
          kappa = shift
          return
       end if
@@ -230,6 +224,10 @@ contains
       do it = 1, max_iterations
          call band_matvec(m, x, y)
          call dgbtrs('N', n, kl, ku, 1, ab, ldab, ipiv, y, n, info)
+         if (info /= 0) then
+            call fatal_error(error, dgbtrs_message(info))
+            return
+         end if
          x = y/norm2(y)
          call band_matvec(s, x, sx)
          call band_matvec(m, x, mx)

@@ -21,7 +21,7 @@ module beamstops_band_solve
    private
    public :: band_solver, prepare_solver, fused_solve, forward_substitution, back_substitution
    public :: forward_substitution_energy
-   public :: band_diagonals, prepare_diagonals, diagonal_matvec, dot
+   public :: band_diagonals, prepare_diagonals, diagonal_matvec, diagonal_row, dot
 
    !> The factor of A = M + dt^2 beta S in the form the fused substitutions read.
    type :: band_solver
@@ -318,6 +318,23 @@ contains
          y(n) = a(n, 3)*x(n - 3) + a(n, 2)*x(n - 2) + a(n, 1)*x(n - 1) + a(n, 0)*x(n)
       end associate
    end subroutine diagonal_matvec
+
+   !> Row k of A x for a symmetric band matrix stored by diagonals (any row, the edges included).
+   pure function diagonal_row(diagonals, x, k) result(y)
+      !> Matrix by diagonals.
+      type(band_diagonals), intent(in) :: diagonals
+      !> Vector (n).
+      real(wp), intent(in) :: x(:)
+      !> Row.
+      integer, intent(in) :: k
+      real(wp) :: y
+      integer :: j
+      y = diagonals%a(k, 0)*x(k)
+      do j = 1, kd
+         if (k - j >= 1) y = y + diagonals%a(k, j)*x(k - j)
+         if (k + j <= diagonals%n) y = y + diagonals%a(k + j, j)*x(k + j)
+      end do
+   end function diagonal_row
 
    !> x . y with eight partial sums: the products vectorize and the dependency chain is
    !> n/8 additions long instead of n (a fixed order, so the result is reproducible).

@@ -2,7 +2,6 @@
 !> output, and the scene's signature, in a small HDF5 file written atomically (a temporary
 !> file, then rename), so that a killed run resumes exactly where its last checkpoint was.
 module beamstops_checkpoint
-   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
    use hdf5
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
@@ -10,25 +9,13 @@ module beamstops_checkpoint
    use beamstops_attributes, only: attribute_list, kind_real, kind_text
    use beamstops_model, only: model_type
    use beamstops_state, only: state_type
+   use beamstops_files, only: rename_file, remove_file
    use beamstops_recorder_hdf5_vector, only: write_vector, read_vector
    implicit none
    private
-   public :: write_checkpoint, read_checkpoint, checkpoint_path, scene_signature, remove_file
+   public :: write_checkpoint, read_checkpoint, checkpoint_path, scene_signature, is_checkpoint
 
    integer, parameter :: n_scalars = 16
-
-   interface
-      function c_rename(from, to) bind(c, name='rename') result(status)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: from(*), to(*)
-         integer(c_int) :: status
-      end function c_rename
-      function c_remove(path) bind(c, name='remove') result(status)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: path(*)
-         integer(c_int) :: status
-      end function c_remove
-   end interface
 
 contains
 
@@ -65,13 +52,26 @@ contains
       end do
    end function scene_signature
 
-   !> Remove a file if it exists.
-   subroutine remove_file(path)
+   !> Whether `path` is a checkpoint file (HDF5 holding a scene signature), so that it may be
+   !> replaced or removed.
+   function is_checkpoint(path) result(yes)
       !> File.
       character(len=*), intent(in) :: path
-      integer(c_int) :: status
-      status = c_remove(path//c_null_char)
-   end subroutine remove_file
+      logical :: yes
+      integer(hid_t) :: file
+      integer :: hdferr, closing
+      logical :: hdf5_file
+      yes = .false.
+      call h5open_f(hdferr)
+      call h5eset_auto_f(0, hdferr)
+      call h5fis_hdf5_f(path, hdf5_file, hdferr)
+      if (hdferr /= 0 .or. .not. hdf5_file) return
+      call h5fopen_f(path, H5F_ACC_RDONLY_F, file, hdferr)
+      if (hdferr /= 0) return
+      call h5lexists_f(file, 'signature', yes, hdferr)
+      yes = yes .and. hdferr == 0
+      call h5fclose_f(file, closing)
+   end function is_checkpoint
 
    !> Write the checkpoint `path` atomically.
    subroutine write_checkpoint(path, scene, state, records, snapshots, error)
@@ -88,13 +88,13 @@ contains
       character(len=:), allocatable :: temporary
       integer(hid_t) :: file
       integer :: hdferr
-      logical :: ok(6)
+      logical :: ok(6), moved
       temporary = path//'.tmp'
       call h5open_f(hdferr)
       call h5eset_auto_f(0, hdferr)
       call h5fcreate_f(temporary, H5F_ACC_TRUNC_F, file, hdferr)
       if (hdferr /= 0) then
-         call fatal_error(error, path//': cannot write the checkpoint')
+         call fatal_error(error, path//': cannot create the checkpoint')
          return
       end if
       call write_vector(file, 'signature', scene_signature(scene), ok(1))
@@ -104,13 +104,16 @@ contains
       call write_vector(file, 'su', state%su, ok(5))
       ok(6) = .true.
       if (allocated(state%stop_reaction)) call write_vector(file, 'stop_reaction', state%stop_reaction, ok(6))
+      ! The energy the damping took (its other terms are rebuilt from d on resume).
+      if (ok(6) .and. allocated(state%cd)) call write_vector(file, 'damped', [state%damped], ok(6))
       call h5fclose_f(file, hdferr)
       if (.not. all(ok) .or. hdferr /= 0) then
-         call fatal_error(error, path//': cannot write the checkpoint')
+         call remove_file(temporary)
+         call fatal_error(error, path//': cannot write the checkpoint (disk full, or beyond the file-size limit?)')
          return
       end if
-      if (c_rename(temporary//c_null_char, path//c_null_char) /= 0) &
-         & call fatal_error(error, path//': cannot move the new checkpoint in place')
+      call rename_file(temporary, path, moved)
+      if (.not. moved) call fatal_error(error, path//': cannot move the new checkpoint in place')
    end subroutine write_checkpoint
 
    !> Read the checkpoint `path` of a run of `scene`: the state (with its work arrays) and
@@ -129,7 +132,7 @@ contains
       !> Set when the file is unreadable or belongs to another scene.
       type(error_type), allocatable, intent(out) :: error
       real(wp), allocatable :: signature(:)
-      real(wp) :: scalars(n_scalars)
+      real(wp) :: scalars(n_scalars), damped(1)
       integer(hid_t) :: file
       integer :: hdferr, n
       logical :: ok(6)
@@ -153,6 +156,10 @@ contains
       call read_vector(file, 'su', state%su, ok(5))
       ok(6) = .true.
       if (allocated(state%stop_reaction)) call read_vector(file, 'stop_reaction', state%stop_reaction, ok(6))
+      if (ok(6) .and. model%damped) then
+         call read_vector(file, 'damped', damped, ok(6))
+         state%damped = damped(1)
+      end if
       call h5fclose_f(file, hdferr)
       if (.not. all(ok)) then
          call fatal_error(error, path//': the checkpoint is damaged or of another mesh')

@@ -15,9 +15,11 @@
 !> floating-point operations of advance_fused in the same order (the load rotation and its
 !> restarts, the forward pass with its energy sums, the back substitution, the contact law of
 !> the tip, the update, the work and the energy the stops take), with the substitutions of
-!> beamstops_band_solve_lockstep; the runs are cut into the same blocks (block_steps and the
-!> checkpoints), so that the delayed energy record of a block's last step is completed the same
-!> way. tests/fortran/test_lockstep.f90 compares every column and snapshot to the bit.
+!> beamstops_band_solve_lockstep; the runs are cut into the same blocks (block_steps), so that
+!> the delayed energy record of a block's last step is completed the same way. Each member
+!> feeds its own observer (shock log and statistics) every step, as run_scheme does, and gets
+!> run_scheme's summary (ledger, shocks, statistics). tests/fortran/test_lockstep.f90 compares
+!> every column, snapshot and summary value to the bit.
 !>
 !> Laws: Signorini and compliance at the tip, or none. Stops along the span (SPEC 7) are
 !> refused (their QP per member is not in this path yet).
@@ -39,8 +41,9 @@ module beamstops_lockstep
    use beamstops_clock, only: thread_cpu_seconds
    use beamstops_forcing, only: load_average, support_position, lift_shape, lift_slope
       use beamstops_contact_compliance, only: spring_force, solve_spring_tip
+   use beamstops_observe_observer, only: observer_type
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
-      & col_work, col_dissipated
+      & col_work, col_dissipated, col_damped
    use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running
    implicit none
    private
@@ -96,6 +99,8 @@ module beamstops_lockstep
       integer(ik), allocatable :: next_record(:), next_snapshot(:)
       !> Record rows waiting for their energy (n_columns, K).
       real(wp), allocatable :: rows(:, :)
+      !> The shock log and statistics of each member (K; inactive unless its scene asks).
+      type(observer_type), allocatable :: observers(:)
       !> One member's vectors, contiguous (n), and its snapshot buffer (J+1).
       real(wp), allocatable :: vec_u(:), vec_d(:), vec_su(:), vec_s(:), shape(:)
    end type members_type
@@ -104,7 +109,8 @@ contains
 
    !> Whether K scenes can run in lockstep with `model` (built from the first of them): the
    !> same A (mesh, beam, dt, beta), the same law and compliance stiffness, the same number of
-   !> steps and checkpoint cadence, no stops along the span, J >= 4. The message names the
+   !> steps, the paper's scheme (no damping, restitution or mass redistribution), no stops
+   !> along the span, J >= 4. The message names the
    !> first member and key that differ.
    subroutine check_lockstep(scenes, model, error)
       !> The members' validated scenes (K >= 1).
@@ -134,6 +140,13 @@ contains
                & '(&stops nodes or x); the lockstep path runs tip stops only: run it alone')
             return
          end if
+         if (scenes(k)%restitution /= 0 .or. scenes(k)%damping_mass /= 0 .or. scenes(k)%damping_stiffness /= 0 &
+            & .or. scenes(k)%damping_by_ratio .or. scenes(k)%redistributed_mass) then
+            call fatal_error(error, 'lockstep: member '//fmt_int(int(k, ik))//' asks for damping, restitution or '// &
+               & 'mass redistribution (&damping, &stops restitution or mass); the lockstep path runs the '// &
+               & 'paper''s scheme: run it alone')
+            return
+         end if
          if (k == 1) cycle
          call differ(k, 'mesh', 'elements', real(scenes(k)%elements, wp), real(scenes(1)%elements, wp))
          call differ(k, 'beam', 'length', scenes(k)%length, scenes(1)%length)
@@ -142,8 +155,6 @@ contains
          call differ(k, 'time', 'dt', scenes(k)%dt, scenes(1)%dt)
          call differ(k, 'time', 'beta', scenes(k)%beta, scenes(1)%beta)
          call differ(k, 'time', 'steps (t_end/dt)', real(steps_of(scenes(k)), wp), real(steps_of(scenes(1)), wp))
-         call differ(k, 'output', 'checkpoint_every', real(scenes(k)%checkpoint_every, wp), &
-            & real(scenes(1)%checkpoint_every, wp))
          if (allocated(error)) return
          if (scenes(k)%law /= scenes(1)%law) then
             call fatal_error(error, 'lockstep: member '//fmt_int(int(k, ik))//': &stops law = '''// &
@@ -215,8 +226,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(operators_type) :: ops
       type(members_type) :: ms
-      type(state_type) :: state
-      integer(ik) :: steps, last, every
+      integer(ik) :: steps, last
       real(wp) :: t0, kinetic, cap
       integer :: k, nk
 
@@ -234,14 +244,12 @@ contains
       if (allocated(error)) return
 
       steps = steps_of(scenes(1))
-      every = scenes(1)%checkpoint_every
       do k = 1, nk
          summaries(k)%status = status_running
       end do
       t0 = thread_cpu_seconds()
       do while (ms%step <= steps .and. any(ms%active))
          last = min(steps, ms%step + block_steps - 1)
-         if (every > 0) last = min(last, ((ms%step - 1)/every + 1)*every)
          call advance_members(scenes, model, ops, ms, recorders, last)
          ms%step = last + 1
          do k = 1, nk
@@ -249,7 +257,7 @@ contains
             if (recorders(k)%failed) then
                summaries(k)%status = status_failed
                summaries(k)%message = 'the recorder could not write'
-               call finish_member(k, ms, model, summaries(k), t0)
+               call finish_member(k, scenes(k), ms, model, summaries(k), t0)
                cycle
             end if
             ms%vec_d = ms%d(lane(k), :, chunk(k))
@@ -261,36 +269,57 @@ contains
                summaries(k)%status = status_diverged
                summaries(k)%message = 'the solution blew up (kinetic energy beyond 1e8 times the energy supplied) '// &
                   & 'before t = '//trim(real_text(real(ms%step - 1, wp)*model%dt))//' s'
-               call finish_member(k, ms, model, summaries(k), t0)
+               call finish_member(k, scenes(k), ms, model, summaries(k), t0)
                cycle
             end if
-            if (every > 0 .and. ms%step <= steps) then
-               if (mod(ms%step - 1, every) == 0) then
-                  call member_state(k, ms, model, t0, state)
-                  call recorders(k)%checkpoint(state)
-               end if
-            end if
+            if (ms%observers(k)%active) call ms%observers(k)%drain()
             call recorders(k)%progress(ms%step - 1, steps)
          end do
       end do
       do k = 1, nk
-         if (ms%active(k)) call finish_member(k, ms, model, summaries(k), t0)
+         if (ms%active(k)) call finish_member(k, scenes(k), ms, model, summaries(k), t0)
       end do
    end subroutine simulate_lockstep
 
-   !> A member leaves the group: its summary, and its lanes set to rest (zeros stay zeros).
-   subroutine finish_member(k, ms, model, summary, t0)
+   !> A member leaves the group: its summary (run_scheme's: counts, the energy ledger of
+   !> close_ledger, the shock log and statistics of its observer), and its lanes set to rest
+   !> (zeros stay zeros).
+   subroutine finish_member(k, scene, ms, model, summary, t0)
       integer, intent(in) :: k
+      type(scene_type), intent(in) :: scene
       type(members_type), intent(inout) :: ms
       type(model_type), intent(in) :: model
       type(run_summary), intent(inout) :: summary
       real(wp), intent(in) :: t0
+      real(wp) :: dmd, usu, dsu, dsd, e_end, damped
       summary%cpu_seconds = (thread_cpu_seconds() - t0)/ms%k
       summary%steps = ms%step - 1
       summary%t_final = real(summary%steps, wp)*model%dt
       summary%impacts = ms%impacts(k)
       summary%max_violation = ms%max_violation(k)
-      if (summary%status == status_running) summary%status = status_complete
+      summary%contact_phases = ms%impacts(k)
+      ! the ledger (close_ledger): no damping in this path
+      damped = 0
+      ms%vec_u = ms%u(lane(k), :, chunk(k))
+      ms%vec_d = ms%d(lane(k), :, chunk(k))
+      call band_matvec(model%mass, ms%vec_d, ms%vec_s)
+      dmd = dot_product(ms%vec_d, ms%vec_s)
+      call band_matvec(model%stiffness, ms%vec_u, ms%vec_s)
+      usu = dot_product(ms%vec_u, ms%vec_s)
+      dsu = dot_product(ms%vec_d, ms%vec_s)
+      call band_matvec(model%stiffness, ms%vec_d, ms%vec_s)
+      dsd = dot_product(ms%vec_d, ms%vec_s)
+      e_end = energy(model, dmd, usu, dsu, usu - 2*dsu + dsd)
+      summary%work = scene%mass_per_length*ms%work(k)
+      summary%dissipated = scene%mass_per_length*ms%dissipated(k)
+      summary%damped = scene%mass_per_length*damped
+      summary%energy_residual = scene%mass_per_length*((e_end - ms%energy0(k)) &
+         & - (ms%work(k) - ms%dissipated(k) - damped))
+      if (summary%status == status_running .and. ms%step > steps_of(scene)) summary%status = status_complete
+      if (ms%observers(k)%active .and. summary%status /= status_running) then
+         call ms%observers(k)%finish(summary%shocks, summary%statistics)
+         summary%impacts = ms%observers(k)%shocks%shock_count()
+      end if
       ms%active(k) = .false.
       ms%u(lane(k), :, chunk(k)) = 0
       ms%d(lane(k), :, chunk(k)) = 0
@@ -298,36 +327,6 @@ contains
       ms%p_prev(k) = 0
       ms%p_now(k) = 0
    end subroutine finish_member
-
-   !> The state_type of member k after the last block (for its recorder's checkpoint): what
-   !> run_scheme would hold at the same step.
-   subroutine member_state(k, ms, model, t0, state)
-      integer, intent(in) :: k
-      type(members_type), intent(in) :: ms
-      type(model_type), intent(in) :: model
-      real(wp), intent(in) :: t0
-      type(state_type), intent(inout) :: state
-      if (.not. allocated(state%u)) allocate (state%u(ms%n), state%d(ms%n), state%su(ms%n), state%rhs(ms%n), &
-         & state%scratch(ms%n), state%shape(size(model%x)))
-      state%step = ms%step
-      state%u = ms%u(lane(k), :, chunk(k))
-      state%d = ms%d(lane(k), :, chunk(k))
-      state%su = ms%su(lane(k), :, chunk(k))
-      state%rhs = ms%rhs(lane(k), :, chunk(k))
-      state%sigma_prev = ms%sigma_prev(k)
-      state%sigma_now = ms%sigma_now(k)
-      state%gd_prev = ms%gd_prev(k)
-      state%p_prev = ms%p_prev(k)
-      state%p_now = ms%p_now(k)
-      state%work = ms%work(k)
-      state%dissipated = ms%dissipated(k)
-      state%energy0 = ms%energy0(k)
-      state%reaction = ms%reaction(k)
-      state%in_contact = ms%in_contact(k)
-      state%impacts = ms%impacts(k)
-      state%cpu_seconds = (thread_cpu_seconds() - t0)/ms%k
-      state%max_violation = ms%max_violation(k)
-   end subroutine member_state
 
    !> Start every member by the one-scene start (start_state, which hands each recorder its
    !> record of t = 0) with the member's load vector and initial velocity, and gather the
@@ -367,6 +366,7 @@ contains
          & ms%dsu(nk), ms%dmd(nk), ms%u_old_su(nk), ms%gd(nk), ms%contact(nk), ms%pending(nk), &
          & ms%next_record(nk), ms%next_snapshot(nk), ms%rows(n_columns, nk))
       allocate (ms%vec_u(n), ms%vec_d(n), ms%vec_su(n), ms%vec_s(n), ms%shape(size(model%x)))
+      allocate (ms%observers(ms%k))
       allocate (ms%lower(nk), ms%upper(nk), ms%u_tip(nk), ms%d_tip(nk))
       call zero_members(ms)
       ms%lower = -1
@@ -412,6 +412,7 @@ contains
          ms%max_violation(k) = state%max_violation
          ms%in_contact(k) = state%in_contact
          ms%impacts(k) = state%impacts
+         ms%observers(k) = state%observer
          ms%step = state%step
       end do
    end subroutine start_members
@@ -513,7 +514,7 @@ contains
       integer(ik), intent(in) :: last
       integer(ik) :: step, next_record, next_snapshot
       integer :: k, c, lo, hi, n, tip, law
-      logical :: energy_wanted, pending
+      logical :: energy_wanted, pending, observing
 
       n = ms%n
       tip = model%tip
@@ -523,6 +524,7 @@ contains
       end do
       next_record = minval(ms%next_record)
       next_snapshot = minval(ms%next_snapshot)
+      observing = any(ms%observers%active)
       ms%pending = .false.
       pending = .false.
       ms%u_old_su = 0
@@ -590,6 +592,13 @@ contains
                hi = c*lockstep_lanes
                ms%u(:, tip, c) = ms%u_tip(lo:hi)
                ms%d(:, tip, c) = ms%d_tip(lo:hi)
+            end do
+         end if
+         ! the shock log and statistics of each member that keeps them
+         if (observing) then
+            do k = 1, ms%k
+               if (ms%observers(k)%active .and. ms%active(k)) call ms%observers(k)%tip(real(step + 1, wp)*model%dt, &
+                  & ms%u_tip(k), ms%reaction(k), ms%dissipated(k))
             end do
          end if
          ! records and snapshots
@@ -765,6 +774,7 @@ contains
       row(col_energy) = 0
       row(col_work) = scene%mass_per_length*ms%work(k)
       row(col_dissipated) = scene%mass_per_length*ms%dissipated(k)
+      row(col_damped) = scene%mass_per_length*0.0_wp
    end subroutine fill_row
 
    !> Snapshot of member k's u^n (= u^{n+1} - d^n) at t_n (take_snapshot, physical_shape).

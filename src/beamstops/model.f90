@@ -1,5 +1,6 @@
 !> What a scene implies before time runs: assembled M and S, the load vector,
-!> the factor of A = M + dt^2 beta S, the tip column z = A^{-1} e_tip, the stops along
+!> the factor of A = M + dt/2 C + dt^2 beta S (C the Rayleigh damping, M possibly with the
+!> constrained unknowns massless, SPEC 8, 10), the tip column z = A^{-1} e_tip, the stops along
 !> the span (their columns A^{-1} P and C = P^T A^{-1} P), the initial data, kappa_h and
 !> the stability limits. Built once.
 module beamstops_model
@@ -9,7 +10,9 @@ module beamstops_model
    use beamstops_scene, only: scene_type, law_compliance, fmt_real, stop_count
    use beamstops_hermite, only: element_mass, element_stiffness, hermite_basis, gauss_points, gauss_weights
    use beamstops_band, only: kd, assemble_band, cholesky_factor, cholesky_solve, &
-      & largest_eigenvalue_exact, largest_eigenvalue_iterative
+      & largest_eigenvalue_exact, largest_eigenvalue_iterative, generalized_eigenvalues
+   use beamstops_contact_mass_redistribution, only: assemble_redistributed_mass
+   use beamstops_band_solve, only: band_solver, prepare_solver, band_diagonals, prepare_diagonals
    use beamstops_forcing, only: lift_shape, lift_slope
    use beamstops_contact_span_stops, only: span_stops_type, new_span_stops
    use beamstops_contact_box_qp, only: box_qp_type, new_box_qp
@@ -38,8 +41,12 @@ module beamstops_model
       real(wp), allocatable :: mass(:, :)
       !> Stiffness matrix S, band storage (kd+1, n).
       real(wp), allocatable :: stiffness(:, :)
-      !> Cholesky factor U of A = M + dt^2 beta S, band storage (kd+1, n).
+      !> Cholesky factor U of A = M + dt/2 C + dt^2 beta S, band storage (kd+1, n).
       real(wp), allocatable :: factor(:, :)
+      !> The factor of A in the form of the fused substitutions (from factor).
+      type(band_solver) :: solver
+      !> S and M by diagonals (the vectorized products of the time loop).
+      type(band_diagonals) :: stiffness_diagonals, mass_diagonals
       !> Load vector g: G(t) = sin(omega t) g (n).
       real(wp), allocatable :: load(:)
       !> Tip column z = A^{-1} e_tip (n).
@@ -66,6 +73,24 @@ module beamstops_model
       real(wp) :: dt_paper_exact = 0
       !> Paper's condition (3.1) with its bound kappa_tilde (s).
       real(wp) :: dt_paper_bound = 0
+      ! ---- physics of issue 12 (SPEC 8-10) ----
+      !> Rayleigh damping on: C = a M + b S with a or b nonzero (SPEC 8).
+      logical :: damped = .false.
+      !> The coefficients a (1/s) and b (s) used: the scene's, or solved from its ratios.
+      real(wp) :: damping_a = 0, damping_b = 0
+      !> Angular frequencies of the two modes of the ratio form (rad/s; 0 otherwise).
+      real(wp) :: damping_omega(2) = 0
+      !> C = a M + b S, band storage (kd+1, n) (allocated when damped).
+      real(wp), allocatable :: damping(:, :)
+      !> C by diagonals (the loop's product C d^n; filled when damped).
+      type(band_diagonals) :: damping_diagonals
+      !> Mass redistribution (SPEC 10): the constrained unknowns carry no mass.
+      logical :: redistributed = .false.
+      !> The massless unknowns (the tip value, or the value of each stop node); empty otherwise.
+      integer, allocatable :: massless(:)
+      !> The rows of A of the massless unknowns are row_scale times those of S:
+      !> row_scale = dt^2 beta + dt b/2.
+      real(wp) :: row_scale = 0
    end type model_type
 
 contains
@@ -92,8 +117,20 @@ contains
       me = element_mass(model%h)
       se = element_stiffness(model%h, scene%k2)
       allocate (model%mass(kd + 1, n), model%stiffness(kd + 1, n))
-      call assemble_band(scene%elements, me, model%mass)
       call assemble_band(scene%elements, se, model%stiffness)
+      model%redistributed = scene%redistributed_mass
+      if (model%redistributed) then
+         if (stop_count(scene) > 0) then
+            model%massless = 2*scene%stop_nodes - 1
+            call assemble_redistributed_mass(scene%elements, model%h, scene%stop_nodes, model%mass)
+         else
+            model%massless = [model%tip]
+            call assemble_redistributed_mass(scene%elements, model%h, [scene%elements], model%mass)
+         end if
+      else
+         allocate (model%massless(0))
+         call assemble_band(scene%elements, me, model%mass)
+      end if
 
       model%x = [(scene%length*j/scene%elements, j=0, scene%elements)]
       model%lift = lift_shape(model%x, scene%length)
@@ -105,9 +142,19 @@ contains
       model%v0(1::2) = -scene%amplitude*scene%omega*lift_shape(model%x(2:), scene%length)
       model%v0(2::2) = -scene%amplitude*scene%omega*lift_slope(model%x(2:), scene%length)
 
-      model%factor = model%mass + model%dt2*model%beta*model%stiffness
-      call cholesky_factor(model%factor, 'A = M + dt^2 beta S', error)
+      call build_damping(scene, model, error)
       if (allocated(error)) return
+      if (model%damped) then
+         model%factor = model%mass + 0.5_wp*model%dt*model%damping + model%dt2*model%beta*model%stiffness
+      else
+         model%factor = model%mass + model%dt2*model%beta*model%stiffness
+      end if
+      model%row_scale = model%dt2*model%beta + 0.5_wp*model%dt*model%damping_b
+      call cholesky_factor(model%factor, 'A = M + dt/2 C + dt^2 beta S', error)
+      if (allocated(error)) return
+      call prepare_solver(model%factor, model%solver)
+      call prepare_diagonals(model%stiffness, model%stiffness_diagonals)
+      call prepare_diagonals(model%mass, model%mass_diagonals)
       allocate (model%z(n))
       model%z = 0
       model%z(model%tip) = 1
@@ -119,6 +166,60 @@ contains
 
       call spectrum(scene, model, error)
    end subroutine build_model
+
+   !> Rayleigh damping (SPEC 8): a and b, given or solved from the ratios at two modes,
+   !> zeta(omega) = a/(2 omega) + b omega/2 (one ratio given, the second left 0: both equal), the
+   !> frequencies those of the model's own pencil (S, M) (M^rho with mass redistribution);
+   !> then C = a M + b S.
+   subroutine build_damping(scene, model, error)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(inout) :: model
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: kappa(:)
+      real(wp) :: zeta(2), w1, w2, det
+      model%damping_a = scene%damping_mass
+      model%damping_b = scene%damping_stiffness
+      if (scene%damping_by_ratio) then
+         zeta = scene%damping_ratio
+         if (zeta(2) == 0) zeta(2) = zeta(1)
+         if (model%n > exact_eigen_limit) then
+            call fatal_error(error, '&damping damping_ratio: the ratio form needs the frequencies of the mesh, '// &
+               & 'computed for 2 elements <= '//fmt_real(real(exact_eigen_limit, wp))//' only; give '// &
+               & 'damping_mass and damping_stiffness instead')
+            return
+         end if
+         call generalized_eigenvalues(model%stiffness, model%mass, size(model%massless), kappa, error)
+         if (allocated(error)) return
+         if (any(scene%damping_modes > size(kappa))) then
+            call fatal_error(error, '&damping damping_modes: the model has '//fmt_real(real(size(kappa), wp))// &
+               & ' modes only')
+            return
+         end if
+         w1 = sqrt(kappa(scene%damping_modes(1)))
+         w2 = sqrt(kappa(scene%damping_modes(2)))
+         model%damping_omega = [w1, w2]
+         ! [1/(2 w1), w1/2; 1/(2 w2), w2/2] [a; b] = zeta
+         det = (w2**2 - w1**2)/(4*w1*w2)
+         model%damping_a = (zeta(1)*w2/2 - zeta(2)*w1/2)/det
+         model%damping_b = (zeta(2)/(2*w1) - zeta(1)/(2*w2))/det
+         if (model%damping_a < 0 .or. model%damping_b < 0) then
+            call fatal_error(error, '&damping damping_ratio = '//fmt_real(zeta(1))//', '//fmt_real(zeta(2))// &
+               & ' at modes of '//fmt_real(w1, 6)//' and '//fmt_real(w2, 6)//' rad/s gives a = '// &
+               & fmt_real(model%damping_a, 6)//' 1/s, b = '//fmt_real(model%damping_b, 6)// &
+               & ' s; allowed: ratios giving a >= 0 and b >= 0')
+            return
+         end if
+      end if
+      if (model%redistributed .and. model%damping_b /= 0) then
+         call fatal_error(error, '&stops redistributed_mass = .true. with stiffness-proportional damping (b = '// &
+            & fmt_real(model%damping_b, 6)//' s) is not supported; allowed: &damping damping_mass alone')
+         return
+      end if
+      model%damped = model%damping_a /= 0 .or. model%damping_b /= 0
+      if (.not. model%damped) return
+      model%damping = model%damping_a*model%mass + model%damping_b*model%stiffness
+      call prepare_diagonals(model%damping, model%damping_diagonals)
+   end subroutine build_damping
 
    !> The stops along the span: Z = A^{-1} P by m solves, C = P^T Z, and C checked positive
    !> definite (stops on distinct nodes make it so; round-off could not for nodes too close).
@@ -161,7 +262,7 @@ contains
       type(scene_type), intent(in) :: scene
       type(model_type), intent(inout) :: model
       type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: sc(:, :), mfac(:, :), e_tip(:)
+      real(wp), allocatable :: sc(:, :), mfac(:, :), e_tip(:), kappas(:)
       real(wp) :: inf, spring, upper
       inf = ieee_value(1.0_wp, ieee_positive_inf)
       model%kappa_bound = kappa_bound_constant*scene%k2/model%h**4
@@ -169,7 +270,19 @@ contains
       if (scene%law == law_compliance) spring = scene%stiffness_per_mass
       allocate (sc, source=model%stiffness)
       sc(kd + 1, model%tip) = sc(kd + 1, model%tip) + spring
-      if (model%n <= exact_eigen_limit) then
+      if (model%redistributed) then
+         ! M^rho is singular: the finite spectrum from the pencil taken the other way round.
+         if (model%n > exact_eigen_limit) then
+            call fatal_error(error, '&stops redistributed_mass = .true.: the spectrum of M^rho is computed for '// &
+               & '2 elements <= '//fmt_real(real(exact_eigen_limit, wp))//' only')
+            return
+         end if
+         model%kappa_method = 'dsbgv (S, M^rho)'
+         call generalized_eigenvalues(model%stiffness, model%mass, size(model%massless), kappas, error)
+         if (allocated(error)) return
+         model%kappa_h = kappas(size(kappas))
+         model%kappa_contact = model%kappa_h
+      else if (model%n <= exact_eigen_limit) then
          model%kappa_method = 'dsbgv'
          call largest_eigenvalue_exact(model%stiffness, model%mass, model%kappa_h, error)
          if (allocated(error)) return

@@ -5,21 +5,27 @@
 !> source, the group and the key.
 module beamstops_namelist
    use, intrinsic :: iso_fortran_env, only: iostat_end
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
    use beamstops_scene, only: scene_type, validate_scene, tube_beam, law_code, law_compliance, max_stops
    use beamstops_strings, only: fmt_real, itoa, lower, squeeze
+   use beamstops_physics_checks, only: validate_physics
+   use beamstops_observe_statistics, only: validate_statistics, validate_ensemble
    implicit none
    private
    public :: read_scene, scene_from_text, read_text_file, default_output, group_names, group_keys
 
    !> Groups a scene file may hold, each at most once.
-   character(len=*), parameter :: group_names(6) = ['beam   ', 'support', 'stops  ', 'mesh   ', 'time   ', 'output ']
+   character(len=*), parameter :: group_names(9) = [character(len=10) :: 'beam', 'support', 'stops', 'damping', &
+      & 'mesh', 'time', 'output', 'statistics', 'ensemble']
    !> Keys of each group, for messages.
-   character(len=*), parameter :: group_keys(6) = [character(len=140) :: &
+   character(len=*), parameter :: group_keys(9) = [character(len=140) :: &
       & 'length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness', &
-      & 'amplitude, omega', 'lower, upper, nodes, x, law, stiffness, stiffness_per_mass', 'elements', &
-      & 'dt, t_end, beta, load_rule, start, allow_unstable', 'file, record_every, snapshot_every, checkpoint_every, max_output_gb']
+      & 'amplitude, omega', 'lower, upper, nodes, x, law, stiffness, stiffness_per_mass, restitution, mass', &
+      & 'mass_coefficient, stiffness_coefficient, ratio, modes', 'elements', &
+      & 'dt, t_end, beta, load_rule, start, allow_unstable', 'file, record_every, snapshot_every, checkpoint_every, max_output_gb', &
+      & 'enabled, transient, batches, bins, rest_time, histogram_lower, histogram_upper', 'members, perturbation, seed']
    real(wp), parameter :: unset = -huge(1.0_wp)
    integer, parameter :: unset_node = -huge(1)
    integer, parameter :: text_len = 4096
@@ -105,7 +111,15 @@ contains
       ! &stops: lower, upper one value (the tip) or one per stop along the span (nodes or x)
       real(wp) :: lower(max_stops), upper(max_stops), x(max_stops), stiffness, stiffness_per_mass
       integer :: nodes(max_stops)
-      character(len=64) :: law
+      character(len=64) :: law, mass
+      real(wp) :: restitution
+      ! &damping: Rayleigh coefficients, or ratios at two modes
+      real(wp) :: mass_coefficient, stiffness_coefficient, ratio(2)
+      integer :: modes(2)
+      ! &statistics, &ensemble
+      logical :: enabled
+      real(wp) :: transient, rest_time, histogram_lower, histogram_upper, perturbation
+      integer :: batches, bins, members, seed
       ! &mesh
       integer :: elements
       ! &time
@@ -119,7 +133,10 @@ contains
       integer(ik) :: checkpoint_every
       namelist /beam/ length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness
       namelist /support/ amplitude, omega
-      namelist /stops/ lower, upper, nodes, x, law, stiffness, stiffness_per_mass
+      namelist /stops/ lower, upper, nodes, x, law, stiffness, stiffness_per_mass, restitution, mass
+      namelist /damping/ mass_coefficient, stiffness_coefficient, ratio, modes
+      namelist /statistics/ enabled, transient, batches, bins, rest_time, histogram_lower, histogram_upper
+      namelist /ensemble/ members, perturbation, seed
       namelist /mesh/ elements
       namelist /time/ dt, t_end, beta, load_rule, start, allow_unstable
       namelist /output/ file, record_every, snapshot_every, checkpoint_every, max_output_gb
@@ -138,6 +155,11 @@ contains
       amplitude = scene%amplitude; omega = scene%omega
       lower = unset; upper = unset; nodes = unset_node; x = unset
       law = 'signorini'; stiffness = unset; stiffness_per_mass = unset
+      restitution = scene%restitution; mass = 'consistent'
+      mass_coefficient = unset; stiffness_coefficient = unset; ratio = unset; modes = scene%damping_modes
+      enabled = scene%statistics; transient = scene%transient; batches = scene%batches; bins = scene%bins
+      rest_time = scene%rest_time; histogram_lower = unset; histogram_upper = unset
+      members = scene%members; perturbation = scene%perturbation; seed = scene%seed
       elements = scene%elements
       dt = scene%dt; t_end = scene%t_end; beta = scene%beta; load_rule = 'centered'; start = 'taylor'
       allow_unstable = .false.
@@ -167,8 +189,8 @@ contains
       end if
       if (scene%law == law_compliance) then
          if ((stiffness == unset) .eqv. (stiffness_per_mass == unset)) then
-            call fatal_error(error, source//": &stops law = 'compliance' needs exactly one of stiffness (N/m) "// &
-               & 'or stiffness_per_mass (1/s^2), both > 0')
+            call fatal_error(error, source//": &stops law = 'compliance' needs a spring; allowed: exactly one "// &
+               & 'of stiffness (N/m) or stiffness_per_mass (1/s^2), > 0')
             return
          end if
          if (stiffness /= unset) then
@@ -217,9 +239,85 @@ contains
       scene%checkpoint_every = checkpoint_every
       call stops_from_lists(source, lower, upper, nodes, x, scene, error)
       if (allocated(error)) return
+      scene%restitution = restitution
+      select case (trim(mass))
+      case ('consistent'); scene%redistributed_mass = .false.
+      case ('redistributed'); scene%redistributed_mass = .true.
+      case default
+         call fatal_error(error, source//": &stops mass = '"//trim(mass)//"' is out of range; allowed: "// &
+            & "'consistent' or 'redistributed'")
+         return
+      end select
+      call damping_forms(); if (allocated(error)) return
+      call statistics_keys()
       call validate_scene(scene, source, error)
+      if (allocated(error)) return
+      call validate_physics(scene, source, error)
+      if (allocated(error)) return
+      call validate_statistics(scene%transient, scene%t_end, scene%batches, scene%bins, scene%rest_time, &
+         & scene%histogram_lower, scene%histogram_upper, source, error)
+      if (allocated(error)) return
+      call validate_ensemble(scene%members, source, error)
+      if (allocated(error)) return
+      if (.not. (ieee_is_finite(scene%perturbation) .and. scene%perturbation >= 0 .and. &
+         & scene%perturbation <= 1.0e-3_wp*min(-scene%lower, scene%upper))) then
+         call fatal_error(error, source//': &ensemble perturbation = '//fmt_real(scene%perturbation)// &
+            & ' is out of range; allowed: 0 <= perturbation <= 1e-3 times the smallest gap to a stop = '// &
+            & fmt_real(1.0e-3_wp*min(-scene%lower, scene%upper))//' m')
+         return
+      end if
 
    contains
+
+      !> &statistics and &ensemble into the scene; the histogram's range defaults to the stops'.
+      subroutine statistics_keys()
+         scene%statistics = enabled
+         scene%transient = transient
+         scene%batches = batches
+         scene%bins = bins
+         scene%rest_time = rest_time
+         if (allocated(scene%stop_lower)) then
+            scene%histogram_lower = minval(scene%stop_lower)
+            scene%histogram_upper = maxval(scene%stop_upper)
+            if (any(scene%stop_nodes == scene%elements)) then
+               scene%histogram_lower = scene%stop_lower(findloc(scene%stop_nodes, scene%elements, dim=1))
+               scene%histogram_upper = scene%stop_upper(findloc(scene%stop_nodes, scene%elements, dim=1))
+            end if
+         else
+            scene%histogram_lower = scene%lower
+            scene%histogram_upper = scene%upper
+         end if
+         if (histogram_lower /= unset) scene%histogram_lower = histogram_lower
+         if (histogram_upper /= unset) scene%histogram_upper = histogram_upper
+         scene%members = members
+         scene%perturbation = perturbation
+         scene%seed = seed
+      end subroutine statistics_keys
+
+      !> &damping: the coefficients a and b, or the ratios (one value: both) at `modes`; not both.
+      subroutine damping_forms()
+         if (ratio(1) == unset) then
+            if (ratio(2) /= unset) then
+               call fatal_error(error, source//': &damping ratio(2) is given but ratio(1) is not; allowed: '// &
+                  & 'ratio = zeta (both modes) or ratio = zeta1, zeta2')
+               return
+            end if
+            if (mass_coefficient /= unset) scene%damping_mass = mass_coefficient
+            if (stiffness_coefficient /= unset) scene%damping_stiffness = stiffness_coefficient
+            scene%damping_modes = modes
+            return
+         end if
+         if (mass_coefficient /= unset .or. stiffness_coefficient /= unset) then
+            call fatal_error(error, source//': &damping gives ratio together with mass_coefficient or '// &
+               & 'stiffness_coefficient; allowed: either the Rayleigh coefficients (mass_coefficient, '// &
+               & 'stiffness_coefficient) or the ratios (ratio, with modes)')
+            return
+         end if
+         scene%damping_by_ratio = .true.
+         scene%damping_ratio = ratio(1)
+         if (ratio(2) /= unset) scene%damping_ratio(2) = ratio(2)
+         scene%damping_modes = modes
+      end subroutine damping_forms
 
       !> Read group g from `text` into the namelist variables.
       subroutine read_group(g, text, stat, msg)
@@ -232,9 +330,12 @@ contains
          case (1); read (text, nml=beam, iostat=stat, iomsg=msg)
          case (2); read (text, nml=support, iostat=stat, iomsg=msg)
          case (3); read (text, nml=stops, iostat=stat, iomsg=msg)
-         case (4); read (text, nml=mesh, iostat=stat, iomsg=msg)
-         case (5); read (text, nml=time, iostat=stat, iomsg=msg)
-         case (6); read (text, nml=output, iostat=stat, iomsg=msg)
+         case (4); read (text, nml=damping, iostat=stat, iomsg=msg)
+         case (5); read (text, nml=mesh, iostat=stat, iomsg=msg)
+         case (6); read (text, nml=time, iostat=stat, iomsg=msg)
+         case (7); read (text, nml=output, iostat=stat, iomsg=msg)
+         case (8); read (text, nml=statistics, iostat=stat, iomsg=msg)
+         case (9); read (text, nml=ensemble, iostat=stat, iomsg=msg)
          end select
       end subroutine read_group
 
@@ -254,7 +355,8 @@ contains
             last = len(body)
             if (i < size(starts)) last = starts(i + 1) - 1
             call read_group(g, '&'//trim(group_names(g))//' '//body(starts(i):last)//' /', one_stat, one_msg)
-            if (one_stat == 0) cycle
+            ! (gfortran may read alone what it refuses in the group: then a lone assignment is the culprit)
+            if (one_stat == 0 .and. size(starts) > 1) cycle
             key = key_at(body, starts(i))
             if (index(one_msg, 'Cannot match namelist object name') > 0 .and. .not. known_key(g, key)) then
                call fatal_error(error, source//': &'//trim(group_names(g))//': unknown key '//key// &
@@ -280,6 +382,16 @@ contains
          & 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_')))
    end function key_at
 
+   !> The groups as `&beam, &support, ...`.
+   function all_groups() result(text)
+      character(len=:), allocatable :: text
+      integer :: g
+      text = '&'//trim(group_names(1))
+      do g = 2, size(group_names)
+         text = text//', &'//trim(group_names(g))
+      end do
+   end function all_groups
+
    !> Whether a key belongs to group g.
    logical function known_key(g, key)
       integer, intent(in) :: g
@@ -292,15 +404,17 @@ contains
       character(len=*), intent(in) :: key
       character(len=:), allocatable :: kind
       select case (key)
-      case ('elements', 'record_every', 'snapshot_every', 'checkpoint_every')
+      case ('elements', 'record_every', 'snapshot_every', 'checkpoint_every', 'batches', 'bins', 'members', 'seed')
          kind = 'a whole number'
-      case ('nodes')
+      case ('nodes', 'modes')
          kind = 'whole numbers separated by commas'
+      case ('ratio')
+         kind = 'one or two real numbers separated by commas'
       case ('lower', 'upper', 'x')
          kind = 'real numbers separated by commas (one per stop)'
-      case ('law', 'load_rule', 'start', 'file')
+      case ('law', 'load_rule', 'start', 'file', 'mass')
          kind = "a quoted text, e.g. 'name'"
-      case ('allow_unstable')
+      case ('allow_unstable', 'enabled')
          kind = '.true. or .false.'
       case default
          kind = 'a real number, e.g. 1e-5'
@@ -613,7 +727,7 @@ contains
                g = group_index(name)
                if (g == 0) then
                   call fatal_error(error, source//': line '//itoa(line_no)//': unknown group &'//name// &
-                     & '; allowed groups: &beam, &support, &stops, &mesh, &time, &output')
+                     & '; allowed groups: '//all_groups())
                   return
                end if
                if (present(g)) then
@@ -639,8 +753,8 @@ contains
          if (current > 0) call append_text(current, ' ')
       end do
       if (.not. any(present)) then
-         call fatal_error(error, source//': no namelist group; allowed: groups &beam, &support, &stops, '// &
-            & '&mesh, &time, &output (e.g. `&time dt = 1e-5 /`), each at most once, and comments after !')
+         call fatal_error(error, source//': no namelist group; allowed: groups '//all_groups()// &
+            & ' (e.g. `&time dt = 1e-5 /`), each at most once, and comments after !')
       end if
 
    contains

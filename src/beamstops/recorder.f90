@@ -2,23 +2,27 @@
 !> tip and energy values (and those of the stops along the span, just before), and every
 !> `snapshot_every`-th step's shape, to a recorder.
 !> Implementations: the HDF5 file writer (program) and the array recorder (Python).
+!> A recorder never sees the loop's state: checkpoints are taken by the caller of the loop
+!> (beamstops_run), which flushes the recorder first.
 module beamstops_recorder
    use beamstops_kinds, only: wp, ik
-   use beamstops_state, only: state_type
    implicit none
    private
    public :: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, col_work, col_dissipated
+   public :: col_damped
 
-   !> Columns of a record row.
+   !> Columns of a record row; col_damped: the energy the Rayleigh damping took so far (J).
    integer, parameter :: col_t = 1, col_u = 2, col_v = 3, col_reaction = 4, col_energy = 5, &
-      & col_work = 6, col_dissipated = 7, n_columns = 7
+      & col_work = 6, col_dissipated = 7, col_damped = 8, n_columns = 8
 
    !> Receives records from the time loop.
    type, abstract :: recorder_type
       !> Set by an implementation that can no longer write; the loop stops.
       logical :: failed = .false.
+      !> What failed, naming the file (when the implementation says).
+      character(len=:), allocatable :: message
    contains
-      !> Take one row (t, tip u, tip v, reaction, energy, work, dissipated).
+      !> Take one row (t, tip u, tip v, reaction, energy, work, dissipated, damped).
       procedure(record_interface), deferred :: record
       !> Take one snapshot of the physical displacement at the nodes x_0..x_J.
       procedure(snapshot_interface), deferred :: snapshot
@@ -27,8 +31,9 @@ module beamstops_recorder
       procedure :: record_stops
       !> Told between blocks of steps how far the run is (default: nothing).
       procedure :: progress
-      !> Save what is recorded so far and the state, to resume from (default: nothing).
-      procedure :: checkpoint
+      !> Put everything taken so far into storage and say how many records and snapshots that is
+      !> (before a checkpoint; default: nothing is stored).
+      procedure :: flush => flush_nothing
    end type recorder_type
 
    abstract interface
@@ -67,11 +72,15 @@ contains
       real(wp), intent(in) :: reaction(:)
    end subroutine record_stops
 
-   !> Default checkpoint: none.
-   subroutine checkpoint(self, state)
+   !> Default flush: nothing is stored.
+   subroutine flush_nothing(self, records, snapshots)
       !> Recorder.
       class(recorder_type), intent(inout) :: self
-      !> State of the loop after the last step done.
-      type(state_type), intent(in) :: state
-   end subroutine checkpoint
+      !> Records stored.
+      integer(ik), intent(out) :: records
+      !> Snapshots stored.
+      integer(ik), intent(out) :: snapshots
+      records = 0
+      snapshots = 0
+   end subroutine flush_nothing
 end module beamstops_recorder

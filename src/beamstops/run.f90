@@ -1,16 +1,21 @@
 !> A whole run of a validated scene: model, stability check, start, time loop.
 !> Shared by the program (HDF5 recorder) and the Python wrapper (array recorder),
 !> so both give the same numbers by construction.
+!> The time loop runs in blocks that end on checkpoint steps; between two blocks the
+!> recorder is flushed, then the loop's state is saved (beamstops_checkpoint): the recorder
+!> never sees the state, and a checkpoint never refers to records that are not stored.
 module beamstops_run
-   use beamstops_error, only: error_type
-   use beamstops_scene, only: scene_type
+   use beamstops_kinds, only: ik
+   use beamstops_error, only: error_type, fatal_error
+   use beamstops_scene, only: scene_type, steps_of
    use beamstops_model, only: model_type, build_model, check_stability
    use beamstops_scheme, only: state_type, start_state, run_scheme
    use beamstops_recorder, only: recorder_type
-   use beamstops_summary, only: run_summary
+   use beamstops_checkpoint, only: write_checkpoint
+   use beamstops_summary, only: run_summary, status_running, status_failed
    implicit none
    private
-   public :: prepare_run, simulate
+   public :: prepare_run, simulate, continue_run
 
 contains
 
@@ -29,7 +34,8 @@ contains
       call check_stability(scene, model, source, error)
    end subroutine prepare_run
 
-   !> Run a prepared scene from t = 0 to t_end, feeding `recorder`.
+   !> Run a prepared scene from t = 0 to t_end, feeding `recorder` (no checkpoints). A recorder
+   !> that cannot write ends the run with status 'failed' and its message in the summary.
    subroutine simulate(scene, model, recorder, summary, error)
       !> Validated scene.
       type(scene_type), intent(in) :: scene
@@ -42,8 +48,57 @@ contains
       !> Set when the run cannot start.
       type(error_type), allocatable, intent(out) :: error
       type(state_type) :: state
+      type(error_type), allocatable :: write_error
       call start_state(scene, model, state, recorder, error)
       if (allocated(error)) return
-      call run_scheme(scene, model, state, recorder, summary)
+      call continue_run(scene, model, state, recorder, summary, write_error)
    end subroutine simulate
+
+   !> Run from the state's step (start_state's, or a checkpoint's) to t_end. With `checkpoint`
+   !> and scene%checkpoint_every > 0, every checkpoint_every steps: flush the recorder, then
+   !> save the state with the records and snapshots stored so far to `checkpoint` (atomically).
+   subroutine continue_run(scene, model, state, recorder, summary, error, checkpoint)
+      !> Validated scene.
+      type(scene_type), intent(in) :: scene
+      !> Its model (from prepare_run).
+      type(model_type), intent(in) :: model
+      !> State, advanced to the end of the run (or to where it stopped).
+      type(state_type), intent(inout) :: state
+      !> Receives records and snapshots.
+      class(recorder_type), intent(inout) :: recorder
+      !> Outcome: 'complete', 'diverged' or 'failed' (with a message).
+      type(run_summary), intent(inout) :: summary
+      !> Set when the recorder or a checkpoint could not be written (the run stopped there,
+      !> with status 'failed' and the same message in the summary).
+      type(error_type), allocatable, intent(out) :: error
+      !> Checkpoint file (none without it).
+      character(len=*), intent(in), optional :: checkpoint
+      integer(ik) :: steps, every, until, records, snapshots
+      steps = steps_of(scene)
+      every = 0
+      if (present(checkpoint)) every = scene%checkpoint_every
+      do
+         until = steps
+         if (every > 0) until = min(steps, ((state%step - 1)/every + 1)*every)
+         call run_scheme(scene, model, state, recorder, summary, until)
+         if (summary%status /= status_running .or. recorder%failed) exit
+         call recorder%flush(records, snapshots)
+         if (recorder%failed) exit
+         call write_checkpoint(checkpoint, scene, state, records, snapshots, error)
+         if (allocated(error)) then
+            summary%status = status_failed
+            summary%message = error%message
+            return
+         end if
+      end do
+      if (recorder%failed) then
+         if (allocated(recorder%message)) then
+            call fatal_error(error, recorder%message)
+         else
+            call fatal_error(error, 'the recorder could not write')
+         end if
+         summary%status = status_failed
+         summary%message = error%message
+      end if
+   end subroutine continue_run
 end module beamstops_run

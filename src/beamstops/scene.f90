@@ -71,6 +71,43 @@ module beamstops_scene
       integer :: record_every = 1
       !> &output: record the beam's shape every this many steps (0: never).
       integer :: snapshot_every = 0
+      ! ---- physics of issue 12 (SPEC 8-10): damping, restitution, mass redistribution ----
+      ! Checked by beamstops_physics_checks' validate_physics; the model derives what it uses.
+      !> &damping: Rayleigh coefficient a of C = a M + b S (1/s), >= 0.
+      real(wp) :: damping_mass = 0
+      !> &damping: Rayleigh coefficient b of C = a M + b S (s), >= 0.
+      real(wp) :: damping_stiffness = 0
+      !> &damping: damping ratios zeta at the two modes damping_modes, in [0, 1) (ratio form:
+      !> a and b solve zeta(omega) = a/(2 omega) + b omega/2 at those modes; one ratio given
+      !> means both equal).
+      real(wp) :: damping_ratio(2) = 0
+      !> &damping: the two cantilever modes (1-based, distinct, <= 2J) of the ratio form.
+      integer :: damping_modes(2) = [1, 2]
+      !> &damping: .true. when a and b come from damping_ratio (the ratio form).
+      logical :: damping_by_ratio = .false.
+      !> &stops: Paoli-Schatzman restitution coefficient e in [0, 1] (law 'signorini'; 0: the
+      !> paper's scheme).
+      real(wp) :: restitution = 0
+      !> &stops: .true. to give the constrained displacement unknowns no mass (SPEC 10; beta > 0).
+      logical :: redistributed_mass = .false.
+      ! ---- end of issue 12 ----
+      ! ---- shocks and statistics (issue 13, SPEC 12), ensembles ----
+      !> &statistics enabled: keep the shock log and the running statistics.
+      logical :: statistics = .true.
+      !> &statistics: start of the statistics' window (s), 0 <= transient < t_end.
+      real(wp) :: transient = 0
+      !> &statistics: batches of the batch-means intervals (>= 2) and bins of the tip histogram.
+      integer :: batches = 20, bins = 40
+      !> &statistics: contact phases closer than this are one shock (s; code_aster's DUREE_REPOS).
+      real(wp) :: rest_time = 1.0e-2_wp
+      !> &statistics: range of the tip histogram (m); the reader fills in the stops' range.
+      real(wp) :: histogram_lower = -0.1_wp, histogram_upper = 0.1_wp
+      !> &ensemble: members (1: the scene alone), the size of their initial perturbation (m) and the
+      !> seed of its random numbers.
+      integer :: members = 1
+      real(wp) :: perturbation = 0
+      integer :: seed = 1
+      ! ---- end of issue 13 ----
    end type scene_type
 
 contains
@@ -109,13 +146,13 @@ contains
       if (scene%snapshot_every > 0) n = steps_of(scene)/scene%snapshot_every + 1
    end function snapshot_count
 
-   !> Bytes of recorded data of a complete run: 8 series of records, 2 per stop along the span,
+   !> Bytes of recorded data of a complete run: 9 series of records, 2 per stop along the span,
    !> and the snapshots.
    pure function output_bytes(scene) result(bytes)
       !> Scene.
       type(scene_type), intent(in) :: scene
       real(wp) :: bytes
-      bytes = 8*(8 + 2*stop_count(scene))*real(record_count(scene), wp) &
+      bytes = 8*(9 + 2*stop_count(scene))*real(record_count(scene), wp) &
          & + 8*real(snapshot_count(scene), wp)*(scene%elements + 2)
    end function output_bytes
 
@@ -208,6 +245,25 @@ contains
       end if
       call list%add_text('stops', 'law', law_name(scene%law))
       if (scene%law == law_compliance) call list%add_real('stops', 'stiffness_per_mass', scene%stiffness_per_mass)
+      call list%add_real('stops', 'restitution', scene%restitution)
+      call list%add_text('stops', 'mass', trim(merge('redistributed', 'consistent   ', scene%redistributed_mass)))
+      if (scene%damping_by_ratio) then
+         call list%add_real('damping', 'ratio', 0.0_wp, values=scene%damping_ratio, attribute=.false.)
+      else
+         call list%add_real('damping', 'mass_coefficient', scene%damping_mass)
+         call list%add_real('damping', 'stiffness_coefficient', scene%damping_stiffness)
+      end if
+      call list%add_int('damping', 'modes', 0_ik, values=int(scene%damping_modes, ik), attribute=.false.)
+      call list%add_logical('statistics', 'enabled', scene%statistics)
+      call list%add_real('statistics', 'transient', scene%transient)
+      call list%add_int('statistics', 'batches', int(scene%batches, ik))
+      call list%add_int('statistics', 'bins', int(scene%bins, ik))
+      call list%add_real('statistics', 'rest_time', scene%rest_time)
+      call list%add_real('statistics', 'histogram_lower', scene%histogram_lower)
+      call list%add_real('statistics', 'histogram_upper', scene%histogram_upper)
+      call list%add_int('ensemble', 'members', int(scene%members, ik))
+      call list%add_real('ensemble', 'perturbation', scene%perturbation)
+      call list%add_int('ensemble', 'seed', int(scene%seed, ik))
       call list%add_int('mesh', 'elements', int(scene%elements, ik))
       call list%add_real('time', 'dt', scene%dt)
       call list%add_real('time', 't_end', scene%t_end)

@@ -6,22 +6,23 @@
 module beamstops_scheme
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_kinds, only: wp, ik
-   use beamstops_scene, only: scene_type, steps_of, law_none, law_signorini, law_compliance, stop_count
+   use beamstops_scene, only: scene_type, steps_of, law_signorini
    use beamstops_model, only: model_type
-   use beamstops_error, only: error_type, fatal_error
-   use beamstops_band, only: band_matvec, cholesky_factor, cholesky_solve
-   use beamstops_band_solve, only: band_solver, prepare_solver, forward_substitution, back_substitution, &
-      & forward_substitution_energy, &
-      & band_diagonals, prepare_diagonals, diagonal_matvec, dot
+   use beamstops_error, only: error_type
+   use beamstops_band, only: band_matvec, cholesky_solve
+   use beamstops_band_solve, only: band_solver, forward_substitution, back_substitution, &
+      & forward_substitution_energy, band_diagonals, diagonal_matvec, diagonal_row, dot
    use beamstops_state, only: state_type
    use beamstops_clock, only: thread_cpu_seconds
-   use beamstops_forcing, only: load_average, support_position
-   use beamstops_contact_tip_projection, only: project_tip
-   use beamstops_contact_compliance, only: spring_force, solve_spring_tip
-   use beamstops_contact_span_stops, only: new_span_work, span_contact, span_correction, span_settle, span_energy
+   use beamstops_forcing, only: load_average, support_position, load_rotation, start_loads, next_load
+   use beamstops_contact_tip_contact, only: spring_term, tip_step, tip_step_massless, update
+   use beamstops_contact_span_stops, only: new_span_work, span_contact, span_correction, span_settle, span_energy, &
+      & span_energy_massless
    use beamstops_contact_box_qp, only: qp_solved, qp_message
-   use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
-      & col_work, col_dissipated
+   use beamstops_recorder, only: recorder_type, n_columns, col_energy
+   use beamstops_ledger, only: energy, move_on, damping_loss, fill_row, take_snapshot, first_events
+   use beamstops_contact_mass_redistribution, only: equilibrium_rows, massless_reaction
+   use beamstops_start, only: start_state
    use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running
    implicit none
    private
@@ -30,145 +31,12 @@ module beamstops_scheme
    !> Steps between progress reports and divergence checks.
    integer(ik), parameter :: block_steps = 8192_ik
 
-
-   !> The load averages sigma_k = f sin(omega c_k) (forcing's load_average; f = sinc(omega dt/2),
-   !> c_k the centre of step k's interval) step after step by rotating (f sin, f cos)(omega c_k)
-   !> by omega dt: four multiply-adds instead of a sine. Every restart_every steps they restart
-   !> from load_average itself, so they differ from it by a few ulps at most.
-   type :: load_rotation
-      !> Index k of the current value.
-      integer(ik) :: k = 0
-      !> sigma_k = f sin(omega c_k) and f cos(omega c_k).
-      real(wp) :: sigma = 0, cosine = 0
-      !> cos(omega dt), sin(omega dt).
-      real(wp) :: cos_step = 1, sin_step = 0
-   end type load_rotation
-
-   !> Steps between two restarts of load_rotation from exact values.
-   integer(ik), parameter :: restart_every = 64
-
 contains
 
-   !> Start a run: u^0 = u0 and u^1 by the Taylor (or Euler) start, projected into K;
-   !> hands the record (and snapshot) of step 0 to the recorder.
-   subroutine start_state(scene, model, state, recorder, error)
-      !> Scene.
-      type(scene_type), intent(in) :: scene
-      !> Its model.
-      type(model_type), intent(in) :: model
-      !> State at n = 1 on return.
-      type(state_type), intent(out) :: state
-      !> Receives the record of t = 0.
-      class(recorder_type), intent(inout) :: recorder
-      !> Set when M cannot be factored.
-      type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: mfac(:, :), a0(:), su0(:)
-      real(wp) :: c, tip_value, r(n_columns)
-      integer :: n, tip
-
-      n = model%n
-      tip = model%tip
-      allocate (state%u(n), state%d(n), state%su(n), state%rhs(n), state%scratch(n), state%shape(size(model%x)))
-      state%u = model%u0 + model%dt*model%v0
-      if (scene%taylor_start) then
-         ! M a0 = G(0) - S u0 + p(u0) e_tip
-         allocate (a0(n), su0(n))
-         call band_matvec(model%stiffness, model%u0, su0)
-         a0 = support_position(0.0_wp, 1.0_wp, scene%omega)*model%load - su0
-         if (scene%law == law_compliance) a0(tip) = a0(tip) + &
-            & spring_force(model%u0(tip), scene%lower, scene%upper, scene%stiffness_per_mass)
-         mfac = model%mass
-         call cholesky_factor(mfac, 'M', error)
-         if (allocated(error)) return
-         call cholesky_solve(mfac, a0)
-         state%u = state%u + 0.5_wp*model%dt2*a0
-      end if
-      if (model%stops%m > 0) then
-         call start_span(scene, model, state, error)
-         if (allocated(error)) return
-      else if (scene%law == law_signorini) then
-         call project_tip(state%u(tip), scene%lower, scene%upper, model%z(tip), c, tip_value)
-         state%u = state%u + c*model%z
-         state%u(tip) = tip_value
-      end if
-      state%d = state%u - model%u0
-      call band_matvec(model%stiffness, state%u, state%su)
-      state%sigma_prev = load_average(0_ik, model%dt, scene%omega, scene%centered_load)
-      state%sigma_now = load_average(1_ik, model%dt, scene%omega, scene%centered_load)
-      state%gd_prev = dot_product(model%load, state%d)
-      if (scene%law == law_compliance) then
-         state%p_prev = spring_force(model%u0(tip), scene%lower, scene%upper, scene%stiffness_per_mass)
-         state%p_now = spring_force(state%u(tip), scene%lower, scene%upper, scene%stiffness_per_mass)
-      end if
-      if (scene%law /= law_none .and. model%stops%m == 0) state%max_violation = violation(state%u(tip), scene)
-      if (state%solver%n /= model%n) call prepare_operators(model, state)
-      call band_matvec(model%mass, state%d, state%scratch)
-      state%energy0 = energy(model, dot_product(state%d, state%scratch), dot_product(state%u, state%su), &
-         & dot_product(state%d, state%su), dot_product(model%u0, matmul_band(model, model%u0)))
-      r = 0
-      r(col_u) = model%u0(tip)
-      r(col_v) = model%v0(tip)
-      r(col_energy) = scene%mass_per_length*state%energy0
-      if (model%stops%m > 0) then
-         state%span%record_u = model%u0(model%stops%unknown) + model%stops%lift*support_position(0.0_wp, &
-            & scene%amplitude, scene%omega)
-         state%span%record_reaction = 0
-         call recorder%record_stops(state%span%record_u, state%span%record_reaction)
-      end if
-      call recorder%record(r)
-      if (scene%snapshot_every > 0) then
-         call physical_shape(model, model%u0, 0.0_wp, scene, state%shape)
-         call recorder%snapshot(0.0_wp, state%shape)
-      end if
-      state%step = 1
-   end subroutine start_state
-
-   !> The stops along the span at the start: their work, and u^1 projected on the bounds of t_1
-   !> (the QP on the trial values u^1 at the stops; with one stop at the tip, the tip's projection).
-   subroutine start_span(scene, model, state, error)
-      type(scene_type), intent(in) :: scene
-      type(model_type), intent(in) :: model
-      type(state_type), intent(inout) :: state
-      type(error_type), allocatable, intent(out) :: error
-      real(wp) :: c, worst
-      integer :: col
-      allocate (state%stop_reaction(model%stops%m))
-      state%stop_reaction = 0
-      call new_span_work(state%span, model%stops, error)
-      if (allocated(error)) return
-      if (scene%law /= law_signorini) return
-      call prepare_operators(model, state)
-      state%scratch = 0
-      call span_contact(model%stops, state%span, state%u, state%scratch, state%scratch, &
-         & support_position(model%dt, scene%amplitude, scene%omega), .true., state%span%info)
-      if (state%span%info /= qp_solved) then
-         call fatal_error(error, 'the start u^1: '//qp_message(state%span%info))
-         return
-      end if
-      call span_correction(model%stops, state%span, state%solver, state%scratch, c, col)
-      if (col > 0) then
-         state%u = state%u + c*model%stops%z(:, col)
-      else
-         state%u = state%u + state%scratch
-      end if
-      worst = 0
-      state%rhs = 0
-      call span_settle(model%stops, state%span, state%u, state%rhs, worst)
-      state%max_violation = worst
-   end subroutine start_span
-
-   !> S x as a new array (start-up only).
-   function matmul_band(model, x) result(y)
-      type(model_type), intent(in) :: model
-      real(wp), intent(in) :: x(:)
-      real(wp) :: y(size(x))
-      call band_matvec(model%stiffness, x, y)
-   end function matmul_band
-
-   !> Run from the state's step to the scene's last step, in blocks; fills the summary.
-   !> Between blocks: the divergence check, progress, and every scene%checkpoint_every
-   !> steps the recorder's checkpoint (blocks end on checkpoint steps).
-   subroutine run_scheme(scene, model, state, recorder, summary)
+   !> Run from the state's step to the scene's last step (or to step `until`), in blocks; fills
+   !> the summary. Between blocks: the divergence check and progress. A call that ends at `until`
+   !> before the last step leaves the status 'running': the caller continues with another call.
+   subroutine run_scheme(scene, model, state, recorder, summary, until)
       !> Scene.
       type(scene_type), intent(in) :: scene
       !> Its model.
@@ -179,15 +47,17 @@ contains
       class(recorder_type), intent(inout) :: recorder
       !> Outcome of the run.
       type(run_summary), intent(inout) :: summary
-      integer(ik) :: steps, last, every
+      !> Last step of this call (default: the scene's last).
+      integer(ik), intent(in), optional :: until
+      integer(ik) :: steps, last, final
       real(wp) :: t0, kinetic, cap
       steps = steps_of(scene)
-      every = scene%checkpoint_every
+      final = steps
+      if (present(until)) final = min(steps, until)
       summary%status = status_running
       t0 = thread_cpu_seconds() - state%cpu_seconds
-      do while (state%step <= steps)
-         last = min(steps, state%step + block_steps - 1)
-         if (every > 0) last = min(last, ((state%step - 1)/every + 1)*every)
+      do while (state%step <= final)
+         last = min(final, state%step + block_steps - 1)
          call advance(scene, model, state, recorder, last)
          state%cpu_seconds = thread_cpu_seconds() - t0
          if (recorder%failed) then
@@ -211,9 +81,7 @@ contains
                & 'before t = '//trim(real_text(real(state%step - 1, wp)*model%dt))//' s'
             exit
          end if
-         if (every > 0 .and. state%step <= steps) then
-            if (mod(state%step - 1, every) == 0) call recorder%checkpoint(state)
-         end if
+         if (state%observer%active) call state%observer%drain()
          call recorder%progress(state%step - 1, steps)
       end do
       summary%cpu_seconds = state%cpu_seconds
@@ -221,8 +89,38 @@ contains
       summary%t_final = real(summary%steps, wp)*model%dt
       summary%impacts = state%impacts
       summary%max_violation = state%max_violation
-      if (summary%status == status_running) summary%status = status_complete
+      summary%contact_phases = state%impacts
+      call close_ledger(scene, model, state, summary)
+      if (summary%status == status_running .and. state%step > steps) summary%status = status_complete
+      if (state%observer%active .and. summary%status /= status_running) then
+         call state%observer%finish(summary%shocks, summary%statistics)
+         summary%impacts = state%observer%shocks%shock_count()
+      end if
    end subroutine run_scheme
+
+   !> The energy ledger of the summary (J): work, stops' and damping's losses, and the balance
+   !> residual E^{N+1/2} - E^{1/2} - (work - dissipated - damped), E from u^{N+1}, d^N and S u^{N+1}.
+   subroutine close_ledger(scene, model, state, summary)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      type(run_summary), intent(inout) :: summary
+      real(wp) :: dmd, usu, dsu, dsd, e_end
+      if (.not. allocated(state%d)) return
+      call band_matvec(model%mass, state%d, state%scratch)
+      dmd = dot_product(state%d, state%scratch)
+      call band_matvec(model%stiffness, state%u, state%scratch)
+      usu = dot_product(state%u, state%scratch)
+      dsu = dot_product(state%d, state%scratch)
+      call band_matvec(model%stiffness, state%d, state%scratch)
+      dsd = dot_product(state%d, state%scratch)
+      e_end = energy(model, dmd, usu, dsu, usu - 2*dsu + dsd)
+      summary%work = scene%mass_per_length*state%work
+      summary%dissipated = scene%mass_per_length*state%dissipated
+      summary%damped = scene%mass_per_length*state%damped
+      summary%energy_residual = scene%mass_per_length*((e_end - state%energy0) &
+         & - (state%work - state%dissipated - state%damped))
+   end subroutine close_ledger
 
    !> Text of a real for messages.
    function real_text(x) result(s)
@@ -247,12 +145,14 @@ contains
       !> Last step to do.
       integer(ik), intent(in) :: last
       integer(ik) :: done
-      if (state%solver%n /= model%n) call prepare_operators(model, state)
       done = last
+      if (model%damped .and. .not. allocated(state%cd)) call resume_damping(model, state)
       if (model%stops%m > 0) then
          call advance_span(scene, model, state, recorder, last, done)
       else if (state%lapack_solve) then
          call advance_reference(scene, model, state, recorder, last)
+      else if (model%damped .or. model%redistributed) then
+         call advance_fused_general(scene, model, state, recorder, last)
       else
          call advance_fused(scene, model, state, recorder, last)
       end if
@@ -279,9 +179,19 @@ contains
          sigma_next = load_average(step + 1, model%dt, scene%omega, scene%centered_load)
          weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
          state%rhs = model%dt2*(weight*model%load - state%su)
+         if (model%damped) state%rhs = state%rhs - model%dt*state%cd
          state%rhs(tip) = state%rhs(tip) + spring_term(scene, model, state)
+         if (model%redistributed) call equilibrium_rows(model%massless, model%row_scale, sigma_next, model%load, &
+            & state%su, model%stiffness_diagonals, state%d, state%rhs)
          call cholesky_solve(model%factor, state%rhs)
-         call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+         if (model%redistributed) then
+            call tip_step_massless(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+         else
+            call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+         end if
+         if (state%observer%active) call state%observer%tip(real(step + 1, wp)*model%dt, state%u(tip), &
+            & state%reaction, state%dissipated)
+         if (model%damped) call damping_loss(model, state)
          if (step == next_record) u_old_su = dot_product(state%u, state%su) - dot_product(state%d, state%su)
          call band_matvec(model%stiffness, state%u, state%su)
          if (step == next_record) then
@@ -324,12 +234,12 @@ contains
       pending = .false.
       u_old_su = 0
       dmd = 0
-      call start_loads(loads, state%step + 1, scene, model)
+      call start_loads(loads, state%step + 1, model%dt, scene%omega, scene%centered_load)
       do step = state%step, last
          sigma_next = loads%sigma
-         call next_load(loads, scene, model)
+         call next_load(loads)
          weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
-         call forward_pass(state%stiffness, state%mass, state%solver, model%load, state%u, state%d, &
+         call forward_pass(model%stiffness_diagonals, model%mass_diagonals, model%solver, model%load, state%u, state%d, &
             & model%dt2*weight, model%dt2, spring_term(scene, model, state), pending .or. step == next_record, &
             & state%su, state%rhs, usu, dsu, dmd)
          if (pending) then
@@ -340,8 +250,10 @@ contains
             pending = .false.
          end if
          u_old_su = usu
-         call back_substitution(state%solver, state%rhs)
+         call back_substitution(model%solver, state%rhs)
          call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+         if (state%observer%active) call state%observer%tip(real(step + 1, wp)*model%dt, state%u(tip), &
+            & state%reaction, state%dissipated)
          if (step == next_record) then
             next_record = next_record + scene%record_every
             call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_prev, row)
@@ -353,14 +265,82 @@ contains
          end if
       end do
       ! The state carries S u^{last+1}; it also completes a waiting record.
-      call diagonal_matvec(state%stiffness, state%u, state%su)
+      call diagonal_matvec(model%stiffness_diagonals, state%u, state%su)
       if (pending) then
-         call diagonal_matvec(state%mass, state%d, state%scratch)
+         call diagonal_matvec(model%mass_diagonals, state%d, state%scratch)
          row(col_energy) = scene%mass_per_length*energy(model, dot(state%d, state%scratch), dot(state%u, state%su), &
             & dot(state%d, state%su), u_old_su)
          call recorder%record(row)
       end if
    end subroutine advance_fused
+
+   !> advance_fused with Rayleigh damping (SPEC 8) and/or mass redistribution (SPEC 10): with
+   !> damping, rhs gains -dt C d^{n-1} and each step ends with damping_loss (C d^n, the energy
+   !> the damping took); with massless unknowns, their rows of rhs are their equilibria. A loop
+   !> of its own, so that the loop of the paper's scheme is today's, unchanged (advance branches
+   !> once per call).
+   subroutine advance_fused_general(scene, model, state, recorder, last)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      class(recorder_type), intent(inout) :: recorder
+      integer(ik), intent(in) :: last
+      integer(ik) :: step, next_record, next_snapshot
+      integer :: tip
+      real(wp) :: sigma_next, weight, d_tip_prev, u_tip_prev
+      real(wp) :: usu, dsu, u_old_su, dmd, r_prev, row(n_columns)
+      logical :: pending
+      type(load_rotation) :: loads
+
+      tip = model%tip
+      call first_events(scene, state%step, next_record, next_snapshot)
+      pending = .false.
+      u_old_su = 0
+      dmd = 0
+      call start_loads(loads, state%step + 1, model%dt, scene%omega, scene%centered_load)
+      do step = state%step, last
+         sigma_next = loads%sigma
+         call next_load(loads)
+         weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
+         call forward_pass(model%stiffness_diagonals, model%mass_diagonals, model%solver, model%load, state%u, state%d, &
+            & model%dt2*weight, model%dt2, spring_term(scene, model, state), pending .or. step == next_record, &
+            & state%su, state%rhs, usu, dsu, dmd, model%massless, model%row_scale, sigma_next, state%cd, model%dt)
+         if (pending) then
+            ! usu = u^n.S u^n, dsu = d^{n-1}.S u^n and dmd = d^{n-1}.M d^{n-1} complete the energy
+            ! of step n-1.
+            row(col_energy) = scene%mass_per_length*energy(model, dmd, usu, dsu, u_old_su)
+            call recorder%record(row)
+            pending = .false.
+         end if
+         u_old_su = usu
+         call back_substitution(model%solver, state%rhs)
+         if (model%redistributed) then
+            call tip_step_massless(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+         else
+            call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+         end if
+         if (state%observer%active) call state%observer%tip(real(step + 1, wp)*model%dt, state%u(tip), &
+            & state%reaction, state%dissipated)
+         if (model%damped) call damping_loss(model, state)
+         if (step == next_record) then
+            next_record = next_record + scene%record_every
+            call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_prev, row)
+            pending = .true.
+         end if
+         if (step == next_snapshot) then
+            next_snapshot = next_snapshot + scene%snapshot_every
+            call take_snapshot(scene, model, state, step, recorder)
+         end if
+      end do
+      ! The state carries S u^{last+1}; it also completes a waiting record.
+      call diagonal_matvec(model%stiffness_diagonals, state%u, state%su)
+      if (pending) then
+         call diagonal_matvec(model%mass_diagonals, state%d, state%scratch)
+         row(col_energy) = scene%mass_per_length*energy(model, dot(state%d, state%scratch), dot(state%u, state%su), &
+            & dot(state%d, state%su), u_old_su)
+         call recorder%record(row)
+      end if
+   end subroutine advance_fused_general
 
    !> The fused step with stops along the span (SPEC 7; contact/span_stops.f90): the full back
    !> substitution gives x = A^{-1} rhs; the trial values u^n + d^{n-1} + x at the stops against
@@ -377,7 +357,7 @@ contains
       integer(ik), intent(in) :: last
       integer(ik), intent(out) :: done
       integer(ik) :: step, next_record, next_snapshot
-      integer :: tip, col
+      integer :: tip, col, i
       real(wp) :: sigma_next, weight, c, gd, d_tip_prev, u_tip_prev, r_tip
       real(wp) :: usu, dsu, u_old_su, dmd, r_prev, phi_prev, phi_now, phi_next, row(n_columns)
       logical :: contact, pending, enforce
@@ -393,15 +373,15 @@ contains
       done = state%step - 1
       phi_prev = support_position(real(state%step - 1, wp)*model%dt, scene%amplitude, scene%omega)
       phi_now = support_position(real(state%step, wp)*model%dt, scene%amplitude, scene%omega)
-      call start_loads(loads, state%step + 1, scene, model)
+      call start_loads(loads, state%step + 1, model%dt, scene%omega, scene%centered_load)
       do step = state%step, last
          sigma_next = loads%sigma
-         call next_load(loads, scene, model)
+         call next_load(loads)
          phi_next = support_position(real(step + 1, wp)*model%dt, scene%amplitude, scene%omega)
          weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
-         call forward_pass(state%stiffness, state%mass, state%solver, model%load, state%u, state%d, &
+         call forward_pass(model%stiffness_diagonals, model%mass_diagonals, model%solver, model%load, state%u, state%d, &
             & model%dt2*weight, model%dt2, 0.0_wp, pending .or. step == next_record, &
-            & state%su, state%rhs, usu, dsu, dmd)
+            & state%su, state%rhs, usu, dsu, dmd, model%massless, model%row_scale, sigma_next, state%cd, model%dt)
          if (pending) then
             row(col_energy) = scene%mass_per_length*energy(model, dmd, usu, dsu, u_old_su)
             call recorder%record_stops(state%span%record_u, state%span%record_reaction)
@@ -409,12 +389,19 @@ contains
             pending = .false.
          end if
          u_old_su = usu
-         call back_substitution(state%solver, state%rhs)
+         call back_substitution(model%solver, state%rhs)
          d_tip_prev = state%d(tip)
          u_tip_prev = state%u(tip)
-         call span_contact(model%stops, state%span, state%u, state%d, state%rhs, phi_next, enforce, state%span%info)
+         if (model%redistributed) then
+            do i = 1, model%stops%m
+               state%span%s_u(i) = diagonal_row(model%stiffness_diagonals, state%u, model%stops%unknown(i))
+               state%span%s_d_prev(i) = diagonal_row(model%stiffness_diagonals, state%d, model%stops%unknown(i))
+            end do
+         end if
+         call span_contact(model%stops, state%span, state%u, state%d, state%rhs, phi_next, enforce, state%span%info, &
+            & scene%restitution, phi_prev)
          if (state%span%info /= qp_solved) exit
-         call span_correction(model%stops, state%span, state%solver, state%rhs, c, col)
+         call span_correction(model%stops, state%span, model%solver, state%rhs, c, col)
          if (col > 0) then
             call update(state%rhs, c, model%stops%z(:, col), state%d, state%u)
          else
@@ -423,19 +410,29 @@ contains
          gd = dot(model%load, state%d)
          contact = state%span%contact
          ! The stops on their bounds, the energy they take and the work of the support through them.
-         if (enforce) call span_settle(model%stops, state%span, state%u, state%d, state%max_violation)
+         if (enforce) call span_settle(model%stops, state%span, state%u, state%d, state%max_violation, &
+            & .not. model%redistributed)
          r_prev = state%reaction
          r_tip = 0
-         if (model%stops%tip > 0) r_tip = state%span%lambda(model%stops%tip)/model%dt2
-         if (contact .and. .not. state%in_contact) state%impacts = state%impacts + 1
-         state%in_contact = contact
-         state%work = state%work + 0.5_wp*weight*(gd + state%gd_prev)
-         call span_energy(model%stops, state%span, state%d, model%dt2, phi_next - phi_prev, state%dissipated, &
-            & state%work)
-         state%reaction = r_tip
-         state%gd_prev = gd
-         state%sigma_prev = state%sigma_now
-         state%sigma_now = sigma_next
+         if (model%redistributed) then
+            do i = 1, model%stops%m
+               state%span%reaction(i) = massless_reaction(model%beta, weight, model%load(model%stops%unknown(i)), &
+                  & state%span%s_u(i), state%span%s_d_prev(i), &
+                  & diagonal_row(model%stiffness_diagonals, state%d, model%stops%unknown(i)))
+            end do
+            if (model%stops%tip > 0) r_tip = state%span%reaction(model%stops%tip)
+         else
+            if (model%stops%tip > 0) r_tip = state%span%lambda(model%stops%tip)/model%dt2
+         end if
+         call move_on(state, contact, gd, weight, r_tip, sigma_next)
+         if (model%redistributed) then
+            call span_energy_massless(model%stops, state%span, state%d, phi_next - phi_prev, state%dissipated, &
+               & state%work)
+         else
+            call span_energy(model%stops, state%span, state%d, model%dt2, phi_next - phi_prev, state%dissipated, &
+               & state%work)
+         end if
+         if (model%damped) call damping_loss(model, state)
          if (step == next_record) then
             next_record = next_record + scene%record_every
             call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_prev, row)
@@ -443,7 +440,14 @@ contains
             state%span%record_reaction = scene%mass_per_length*state%stop_reaction
             pending = .true.
          end if
-         state%stop_reaction = state%span%lambda/model%dt2
+         if (model%redistributed) then
+            state%stop_reaction = state%span%reaction
+         else
+            state%stop_reaction = state%span%lambda/model%dt2
+         end if
+         if (state%observer%active) call state%observer%span(real(step + 1, wp)*model%dt, &
+            & state%u(model%stops%unknown) + model%stops%lift*phi_next, state%stop_reaction, state%u(tip), &
+            & state%dissipated)
          if (step == next_snapshot) then
             next_snapshot = next_snapshot + scene%snapshot_every
             call take_snapshot(scene, model, state, step, recorder)
@@ -452,15 +456,25 @@ contains
          phi_prev = phi_now
          phi_now = phi_next
       end do
-      call diagonal_matvec(state%stiffness, state%u, state%su)
+      call diagonal_matvec(model%stiffness_diagonals, state%u, state%su)
       if (pending) then
-         call diagonal_matvec(state%mass, state%d, state%scratch)
+         call diagonal_matvec(model%mass_diagonals, state%d, state%scratch)
          row(col_energy) = scene%mass_per_length*energy(model, dot(state%d, state%scratch), dot(state%u, state%su), &
             & dot(state%d, state%su), u_old_su)
          call recorder%record_stops(state%span%record_u, state%span%record_reaction)
          call recorder%record(row)
       end if
    end subroutine advance_span
+
+   !> The damping terms of the state after a checkpoint: C d^{n-1} and d^{n-1}.C d^{n-1}, from d
+   !> by the same product as the loop's (so a resumed run continues with the same bits).
+   subroutine resume_damping(model, state)
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      allocate (state%cd(model%n))
+      call diagonal_matvec(model%damping_diagonals, state%d, state%cd)
+      state%dcd_prev = dot(state%d, state%cd)
+   end subroutine resume_damping
 
    !> The work of the stops along the span after a checkpoint (the state holds no QP).
    subroutine resume_span(model, state)
@@ -474,10 +488,12 @@ contains
       end if
    end subroutine resume_span
 
-   !> Forward pass of a step: su = S u, rhs = a g - b su plus `spring` in the tip row (n-1),
-   !> both vectorized, then the forward substitution (rhs replaced by D^{-2} w); with `energy`,
-   !> usu = u.su, dsu = d.su and dmd = d.M d, accumulated beside the substitution.
-   subroutine forward_pass(stiffness, mass, solver, g, u, d, a, b, spring, energy, su, rhs, usu, dsu, dmd)
+   !> Forward pass of a step: su = S u, rhs = a g - b su (- c_scale cd with damping) plus
+   !> `spring` in the tip row (n-1), the rows of the massless unknowns replaced by their
+   !> equilibrium (mass redistribution), then the forward substitution (rhs replaced by D^{-2} w);
+   !> with `energy`, usu = u.su, dsu = d.su and dmd = d.M d, accumulated beside the substitution.
+   subroutine forward_pass(stiffness, mass, solver, g, u, d, a, b, spring, energy, su, rhs, usu, dsu, dmd, &
+      & massless, row_scale, sigma_next, cd, c_scale)
       !> S and M by diagonals.
       type(band_diagonals), intent(in) :: stiffness, mass
       !> Factor of A.
@@ -494,11 +510,26 @@ contains
       real(wp), intent(out), contiguous :: rhs(:)
       !> u.S u, d.S u and d.M d (when energy).
       real(wp), intent(out) :: usu, dsu, dmd
+      !> The massless unknowns (mass redistribution; absent or empty otherwise).
+      integer, intent(in), optional :: massless(:)
+      !> Their rows of A over those of S, and sigma_{n+1} (equilibrium_rows; with massless).
+      real(wp), intent(in), optional :: row_scale, sigma_next
+      !> C d^{n-1} (n), absent without damping.
+      real(wp), intent(in), contiguous, optional :: cd(:)
+      !> Its coefficient in rhs (dt).
+      real(wp), intent(in), optional :: c_scale
       integer :: n
       n = solver%n
       call diagonal_matvec(stiffness, u, su)
-      rhs = a*g - b*su
+      if (present(cd)) then
+         rhs = a*g - b*su - c_scale*cd
+      else
+         rhs = a*g - b*su
+      end if
       rhs(n - 1) = rhs(n - 1) + spring
+      if (present(massless)) then
+         if (size(massless) > 0) call equilibrium_rows(massless, row_scale, sigma_next, g, su, stiffness, d, rhs)
+      end if
       if (energy) then
          call forward_substitution_energy(solver, mass, u, d, su, rhs, usu, dsu, dmd)
       else
@@ -509,244 +540,4 @@ contains
       end if
    end subroutine forward_pass
 
-   !> load_rotation at step k: from load_average at the last multiple of restart_every, then
-   !> rotated, so that the value of every step is the same however the run is cut into calls.
-   subroutine start_loads(loads, k, scene, model)
-      type(load_rotation), intent(out) :: loads
-      integer(ik), intent(in) :: k
-      type(scene_type), intent(in) :: scene
-      type(model_type), intent(in) :: model
-      call restart_loads(loads, (k/restart_every)*restart_every, scene, model)
-      do while (loads%k < k)
-         call next_load(loads, scene, model)
-      end do
-   end subroutine start_loads
-
-   !> load_rotation at step k, exact: load_average and the same centre and factor for the cosine.
-   subroutine restart_loads(loads, k, scene, model)
-      type(load_rotation), intent(out) :: loads
-      integer(ik), intent(in) :: k
-      type(scene_type), intent(in) :: scene
-      type(model_type), intent(in) :: model
-      real(wp) :: centre, x, factor
-      centre = real(k, wp)*model%dt
-      if (.not. scene%centered_load) centre = (real(k, wp) + 0.5_wp)*model%dt
-      x = 0.5_wp*scene%omega*model%dt
-      if (abs(x) < 1.0e-8_wp) then
-         factor = 1 - x**2/6
-      else
-         factor = sin(x)/x
-      end if
-      loads%k = k
-      loads%sigma = load_average(k, model%dt, scene%omega, scene%centered_load)
-      loads%cosine = factor*cos(scene%omega*centre)
-      loads%cos_step = cos(scene%omega*model%dt)
-      loads%sin_step = sin(scene%omega*model%dt)
-   end subroutine restart_loads
-
-   !> load_rotation moved on to step k + 1.
-   subroutine next_load(loads, scene, model)
-      type(load_rotation), intent(inout) :: loads
-      type(scene_type), intent(in) :: scene
-      type(model_type), intent(in) :: model
-      real(wp) :: sigma
-      if (mod(loads%k + 1, restart_every) == 0) then
-         call restart_loads(loads, loads%k + 1, scene, model)
-         return
-      end if
-      sigma = loads%sigma*loads%cos_step + loads%cosine*loads%sin_step
-      loads%cosine = loads%cosine*loads%cos_step - loads%sigma*loads%sin_step
-      loads%sigma = sigma
-      loads%k = loads%k + 1
-   end subroutine next_load
-
-   !> The update of the step: d^n = d^{n-1} + x + c z, u^{n+1} = u^n + d^n.
-   pure subroutine update(x, c, z, d, u)
-      !> A^{-1} rhs and z = A^{-1} e_tip (n).
-      real(wp), intent(in), contiguous :: x(:), z(:)
-      !> Multiple of z (contact).
-      real(wp), intent(in) :: c
-      !> d^{n-1} and u^n on entry, d^n and u^{n+1} on return (n).
-      real(wp), intent(inout), contiguous :: d(:), u(:)
-      d = d + x + c*z
-      u = u + d
-   end subroutine update
-
-   !> dt^2 times the explicit part of the Newmark-weighted spring force, added to the tip row of
-   !> the right-hand side (normal compliance; zero otherwise).
-   pure function spring_term(scene, model, state) result(f)
-      type(scene_type), intent(in) :: scene
-      type(model_type), intent(in) :: model
-      type(state_type), intent(in) :: state
-      real(wp) :: f
-      f = 0
-      if (scene%law == law_compliance) f = model%dt2*((1 - 2*model%beta)*state%p_now + model%beta*state%p_prev)
-   end function spring_term
-
-   !> The contact law at the tip: from the trial tip value u^n_tip + (A^{-1} rhs + d^{n-1})_tip,
-   !> the multiple c of z to add, the tip value, the reaction per unit mass of the step and
-   !> whether the tip is in contact (SPEC 4, 5).
-   subroutine contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
-      type(scene_type), intent(in) :: scene
-      type(model_type), intent(in) :: model
-      type(state_type), intent(inout) :: state
-      real(wp), intent(in) :: trial
-      real(wp), intent(out) :: c, tip_value, r_step
-      logical, intent(out) :: contact
-      real(wp) :: p_next
-      select case (scene%law)
-      case (law_signorini)
-         call project_tip(trial, scene%lower, scene%upper, model%z(model%tip), c, tip_value)
-         contact = c /= 0
-         r_step = c/model%dt2
-      case (law_compliance)
-         tip_value = solve_spring_tip(trial, scene%lower, scene%upper, scene%stiffness_per_mass, &
-            & model%dt2*model%beta*model%z(model%tip))
-         p_next = spring_force(tip_value, scene%lower, scene%upper, scene%stiffness_per_mass)
-         c = model%dt2*model%beta*p_next
-         r_step = model%beta*p_next + (1 - 2*model%beta)*state%p_now + model%beta*state%p_prev
-         state%p_prev = state%p_now
-         state%p_now = p_next
-         contact = r_step /= 0
-      case default
-         c = 0
-         tip_value = trial
-         r_step = 0
-         contact = .false.
-      end select
-   end subroutine contact_law
-
-   !> The rest of a step once state%rhs holds A^{-1} rhs: the contact law at the tip, the
-   !> update d^n = d^{n-1} + A^{-1} rhs + c z, u^{n+1} = u^n + d^n, and close_step. Returns
-   !> u^n_tip, d^{n-1}_tip and the reaction r_{n-1} recorded with u^n.
-   subroutine tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
-      type(scene_type), intent(in) :: scene
-      type(model_type), intent(in) :: model
-      type(state_type), intent(inout) :: state
-      real(wp), intent(in) :: weight, sigma_next
-      real(wp), intent(out) :: u_tip_prev, d_tip_prev, r_prev
-      real(wp) :: trial, c, tip_value, r_step
-      logical :: contact
-      d_tip_prev = state%d(model%tip)
-      u_tip_prev = state%u(model%tip)
-      trial = u_tip_prev + (d_tip_prev + state%rhs(model%tip))
-      call contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
-      call update(state%rhs, c, model%z, state%d, state%u)
-      r_prev = state%reaction
-      call close_step(scene, model, state, contact, tip_value, dot(model%load, state%d), weight, r_step, &
-         & d_tip_prev, u_tip_prev, sigma_next)
-   end subroutine tip_step
-
-   !> After the update: the exact tip value (Signorini), the violation of the stops, impacts,
-   !> the work of the load and the energy taken by the stops, the load averages moved on.
-   subroutine close_step(scene, model, state, contact, tip_value, gd, weight, r_step, d_tip_prev, u_tip_prev, &
-      & sigma_next)
-      type(scene_type), intent(in) :: scene
-      type(model_type), intent(in) :: model
-      type(state_type), intent(inout) :: state
-      logical, intent(in) :: contact
-      real(wp), intent(in) :: tip_value, gd, weight, r_step, d_tip_prev, u_tip_prev, sigma_next
-      integer :: tip
-      tip = model%tip
-      if (scene%law == law_signorini .and. contact) then
-         ! The tip exactly on the stop, and d^n its exact increment (a tip resting on a stop
-         ! then has exactly zero velocity).
-         state%u(tip) = tip_value
-         state%d(tip) = tip_value - u_tip_prev
-      end if
-      if (scene%law /= law_none) state%max_violation = max(state%max_violation, violation(state%u(tip), scene))
-      if (contact .and. .not. state%in_contact) state%impacts = state%impacts + 1
-      state%in_contact = contact
-      state%work = state%work + 0.5_wp*weight*(gd + state%gd_prev)
-      state%dissipated = state%dissipated - 0.5_wp*r_step*(state%d(tip) + d_tip_prev)
-      state%reaction = r_step
-      state%gd_prev = gd
-      state%sigma_prev = state%sigma_now
-      state%sigma_now = sigma_next
-   end subroutine close_step
-
-   !> A record row of step n, the energy column left for the caller.
-   subroutine fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_step, row)
-      type(scene_type), intent(in) :: scene
-      type(model_type), intent(in) :: model
-      type(state_type), intent(in) :: state
-      integer(ik), intent(in) :: step
-      real(wp), intent(in) :: u_tip_prev, d_tip_prev, r_step
-      real(wp), intent(out) :: row(n_columns)
-      row(col_t) = real(step, wp)*model%dt
-      row(col_u) = u_tip_prev
-      row(col_v) = (state%d(model%tip) + d_tip_prev)/(2*model%dt)
-      row(col_reaction) = scene%mass_per_length*r_step
-      row(col_energy) = 0
-      row(col_work) = scene%mass_per_length*state%work
-      row(col_dissipated) = scene%mass_per_length*state%dissipated
-   end subroutine fill_row
-
-   !> Snapshot of u^n (= u^{n+1} - d^n) at t_n.
-   subroutine take_snapshot(scene, model, state, step, recorder)
-      type(scene_type), intent(in) :: scene
-      type(model_type), intent(in) :: model
-      type(state_type), intent(inout) :: state
-      integer(ik), intent(in) :: step
-      class(recorder_type), intent(inout) :: recorder
-      state%scratch = state%u - state%d
-      call physical_shape(model, state%scratch, real(step, wp)*model%dt, scene, state%shape)
-      call recorder%snapshot(real(step, wp)*model%dt, state%shape)
-   end subroutine take_snapshot
-
-   !> The first recorded step and the first snapshot step at or after `step`.
-   pure subroutine first_events(scene, step, next_record, next_snapshot)
-      type(scene_type), intent(in) :: scene
-      integer(ik), intent(in) :: step
-      integer(ik), intent(out) :: next_record, next_snapshot
-      next_record = next_multiple(step, int(scene%record_every, ik))
-      next_snapshot = huge(step)
-      if (scene%snapshot_every > 0) next_snapshot = next_multiple(step, int(scene%snapshot_every, ik))
-   end subroutine first_events
-
-   !> The first multiple of `every` at or after `step`.
-   pure function next_multiple(step, every) result(m)
-      integer(ik), intent(in) :: step, every
-      integer(ik) :: m
-      m = ((step + every - 1)/every)*every
-   end function next_multiple
-
-   !> The factor of A, S and M in the layouts of the fused loop.
-   subroutine prepare_operators(model, state)
-      type(model_type), intent(in) :: model
-      type(state_type), intent(inout) :: state
-      call prepare_solver(model%factor, state%solver)
-      call prepare_diagonals(model%stiffness, state%stiffness)
-      call prepare_diagonals(model%mass, state%mass)
-   end subroutine prepare_operators
-
-   !> Discrete energy E^{n+1/2} per unit mass (SPEC 6) from d.M d, u.S u and d.S u (u = u^{n+1},
-   !> d = d^n = u^{n+1} - u^n) and u^n.S u^n.
-   pure function energy(model, dmd, usu, dsu, u_old_s_u_old) result(e)
-      type(model_type), intent(in) :: model
-      real(wp), intent(in) :: dmd, usu, dsu, u_old_s_u_old
-      real(wp) :: e
-      e = 0.5_wp*dmd/model%dt2 + 0.5_wp*(model%beta*usu + model%beta*u_old_s_u_old &
-         & + (1 - 2*model%beta)*(usu - dsu))
-   end function energy
-
-   !> Violation of the stops by a tip value (m).
-   pure function violation(u_tip, scene) result(v)
-      real(wp), intent(in) :: u_tip
-      type(scene_type), intent(in) :: scene
-      real(wp) :: v
-      v = max(u_tip - scene%upper, scene%lower - u_tip, 0.0_wp)
-   end function violation
-
-   !> Physical displacement u + h(x) phi(t) at the nodes x_0..x_J from the homogeneous unknown u.
-   subroutine physical_shape(model, u, t, scene, shape)
-      type(model_type), intent(in) :: model
-      real(wp), intent(in) :: u(:), t
-      type(scene_type), intent(in) :: scene
-      real(wp), intent(out) :: shape(:)
-      real(wp) :: phi
-      phi = support_position(t, scene%amplitude, scene%omega)
-      shape = model%lift*phi
-      shape(2:) = shape(2:) + u(1::2)
-   end subroutine physical_shape
 end module beamstops_scheme

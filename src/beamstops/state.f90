@@ -2,8 +2,8 @@
 !> A run resumes from it (checkpoints), and a recorder may save it.
 module beamstops_state
    use beamstops_kinds, only: wp, ik
-   use beamstops_band_solve, only: band_solver, band_diagonals
    use beamstops_contact_span_stops, only: span_work_type
+   use beamstops_observe_observer, only: observer_type
    implicit none
    private
    public :: state_type
@@ -28,6 +28,12 @@ module beamstops_state
       real(wp) :: p_prev = 0, p_now = 0
       !> Work of the load W_{n-1} and energy taken by the stops D_{n-1}, per unit mass.
       real(wp) :: work = 0, dissipated = 0
+      !> Energy taken by the Rayleigh damping so far, per unit mass (SPEC 8).
+      real(wp) :: damped = 0
+      !> With damping: C d^{n-1} (n; unallocated without damping).
+      real(wp), allocatable :: cd(:)
+      !> With damping: d^{n-1}.C d^{n-1}.
+      real(wp) :: dcd_prev = 0
       !> Discrete energy E^{1/2} per unit mass (reference for the divergence check).
       real(wp) :: energy0 = 0
       !> Reaction per unit mass of the step that gave u^n (r_{n-1}; recorded with u^n).
@@ -45,10 +51,8 @@ module beamstops_state
       real(wp) :: cpu_seconds = 0
       !> Largest violation of the stops so far (m).
       real(wp) :: max_violation = 0
-      !> The factor of A in the form of the fused substitutions (from model%factor).
-      type(band_solver) :: solver
-      !> S and M by diagonals (for the vectorized products of the loop).
-      type(band_diagonals) :: stiffness, mass
+      !> The shock log and the running statistics, fed every step (when &statistics enabled).
+      type(observer_type) :: observer
       !> Solve with LAPACK's dpbtrs and separate updates: the reference path of the tests.
       logical :: lapack_solve = .false.
    end type state_type

@@ -55,6 +55,11 @@ contains
          call fatal_error(error, 'scene: the three-level form runs without stops only; allowed: &stops law = ''none''')
          return
       end if
+      if (model%damped .or. model%redistributed) then
+         call fatal_error(error, 'scene: the three-level form runs the paper''s scheme only; allowed: no &damping '// &
+            & 'and &stops redistributed_mass = .false.')
+         return
+      end if
       ! The engine's start (u^1, Taylor or Euler), without records beyond t = 0.
       quiet = scene
       quiet%snapshot_every = 0

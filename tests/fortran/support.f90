@@ -4,30 +4,13 @@ module test_support
    use testing, only: int_text   ! public here too, for the suites that take it from this module
    use beamstops, only: wp, ik, error_type, fatal_error, scene_type, validate_scene, model_type, &
       & prepare_run, simulate, record_count, array_recorder, run_summary, status_complete, stop_count
+   use beamstops_lapack, only: dsbgv, dsygv, dsbgv_message, dsygv_message
    implicit none
    private
    public :: band_eigenvalues, dense_eigenvalues, run_recorded, int_text
    public :: basis_coefficients, product_integral, poly, exact_element, dense_assembly, lift, lift_prime
    public :: simpson_load, solve_spd
 
-   interface
-      subroutine dsbgv(jobz, uplo, n, ka, kb, ab, ldab, bb, ldbb, w, z, ldz, work, info)
-         import :: wp
-         character, intent(in) :: jobz, uplo
-         integer, intent(in) :: n, ka, kb, ldab, ldbb, ldz
-         real(wp), intent(inout) :: ab(ldab, *), bb(ldbb, *)
-         real(wp), intent(out) :: w(*), z(ldz, *), work(*)
-         integer, intent(out) :: info
-      end subroutine dsbgv
-      subroutine dsygv(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
-         import :: wp
-         integer, intent(in) :: itype, n, lda, ldb, lwork
-         character, intent(in) :: jobz, uplo
-         real(wp), intent(inout) :: a(lda, *), b(ldb, *)
-         real(wp), intent(out) :: w(*), work(*)
-         integer, intent(out) :: info
-      end subroutine dsygv
-   end interface
 
 contains
 
@@ -220,7 +203,7 @@ contains
       allocate (ma, source=m)
       allocate (w(n), work(3*n))
       call dsbgv('N', 'U', n, kd, kd, sa, kd + 1, ma, kd + 1, w, zdum, 1, work, info)
-      if (info /= 0) call fatal_error(error, 'dsbgv failed, info = '//int_text(int(info, ik)))
+      if (info /= 0) call fatal_error(error, dsbgv_message(info, n))
    end subroutine band_eigenvalues
 
    !> All eigenvalues (ascending) of the dense symmetric pencil (a, b), b positive definite.
@@ -240,7 +223,7 @@ contains
       allocate (bb, source=b)
       allocate (w(n), work(max(1, 3*n - 1)))
       call dsygv(1, 'N', 'U', n, aa, n, bb, n, w, work, size(work), info)
-      if (info /= 0) call fatal_error(error, 'dsygv failed, info = '//int_text(int(info, ik)))
+      if (info /= 0) call fatal_error(error, dsygv_message(info, n))
    end subroutine dense_eigenvalues
 
    !> Validate, prepare and run a scene, every record kept in `rec`; the run must complete

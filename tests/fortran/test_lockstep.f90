@@ -3,9 +3,9 @@
 !> column of every record, every snapshot, the summary. Groups of K = 1, 3, 5, 8, 13 (not
 !> multiples of the vector width) whose members differ in omega, amplitude, tip stops, load
 !> rule, start and record cadences; without contact, with Signorini stops and with
-!> compliance; runs long enough to cross blocks (block_steps), load restarts and contacts,
-!> and cut by checkpoints. Groups that cannot share A are refused with a message naming the
-!> member and the key.
+!> compliance; runs long enough to cross blocks (block_steps), load restarts and contacts.
+!> The summaries too: counts, the energy ledger, the shock log and the statistics tables.
+!> Groups that cannot share A are refused with a message naming the member and the key.
 module test_lockstep
    use, intrinsic :: iso_fortran_env, only: int64
    use testing
@@ -24,7 +24,7 @@ module test_lockstep
 
    !> Columns of a record, for messages.
    character(len=10), parameter :: column_names(n_columns) = [character(len=10) :: 't', 'u', 'v', 'reaction', &
-      & 'energy', 'work', 'dissipated']
+      & 'energy', 'work', 'dissipated', 'damped']
 
 contains
 
@@ -39,7 +39,7 @@ contains
          & new_unittest('K = 3, no stops, beta = 1/4, different omega and amplitude', test_free_three), &
          & new_unittest('K = 5, Signorini, beta = 1/2, different stops, omega, amplitude, cadences', test_signorini_five), &
          & new_unittest('K = 8, compliance 1e8, beta = 1/4', test_compliance_eight), &
-         & new_unittest('K = 13, Signorini, beta = 1/4, paper''s load for some, checkpoints cut the blocks', &
+         & new_unittest('K = 13, Signorini, beta = 1/4, paper''s load and Euler start for some, checkpoint_every set', &
          & test_signorini_thirteen), &
          & new_unittest('K = 8, J = 100, Signorini, beta = 1/2', test_fine_eight), &
          & new_unittest('a member whose recorder fails stops; the others go on, still bit for bit', test_failing_member), &
@@ -163,7 +163,45 @@ contains
          & real_text(a%max_violation)//' and '//real_text(b%max_violation))
       if (allocated(error)) return
       call check(error, same_bits(a%t_final, b%t_final), who//': t_final')
+      if (allocated(error)) return
+      call check(error, a%contact_phases == b%contact_phases .and. same_bits(a%work, b%work) .and. &
+         & same_bits(a%dissipated, b%dissipated) .and. same_bits(a%damped, b%damped) .and. &
+         & same_bits(a%energy_residual, b%energy_residual), who//': the ledger (work '//real_text(a%work)//' and '// &
+         & real_text(b%work)//', residual '//real_text(a%energy_residual)//' and '//real_text(b%energy_residual)//')')
+      if (allocated(error)) return
+      call same_observations(a, b, who, error)
    end subroutine same_summary
+
+   !> The shock logs and the statistics tables of two summaries, bit for bit.
+   subroutine same_observations(a, b, who, error)
+      type(run_summary), intent(in) :: a, b
+      character(len=*), intent(in) :: who
+      type(error_type), allocatable, intent(out) :: error
+      integer :: q
+      call check(error, allocated(a%shocks) .eqv. allocated(b%shocks), who//': shock logs kept alike')
+      if (allocated(error)) return
+      if (allocated(a%shocks)) then
+         call check(error, all(shape(a%shocks) == shape(b%shocks)), who//': '//int_text(size(a%shocks, 2))//' and '// &
+            & int_text(size(b%shocks, 2))//' shocks')
+         if (allocated(error)) return
+         call check(error, all(same_bits(a%shocks, b%shocks)), who//': the shock log')
+         if (allocated(error)) return
+      end if
+      call check(error, allocated(a%statistics%quantity) .eqv. allocated(b%statistics%quantity), &
+         & who//': statistics kept alike')
+      if (allocated(error) .or. .not. allocated(a%statistics%quantity)) return
+      call check(error, size(a%statistics%quantity) == size(b%statistics%quantity), who//': statistics tables')
+      if (allocated(error)) return
+      do q = 1, size(a%statistics%quantity)
+         associate (x => a%statistics%quantity(q), y => b%statistics%quantity(q))
+            call check(error, x%name == y%name .and. size(x%value) == size(y%value), who//': statistic '//x%name)
+            if (allocated(error)) return
+            call check(error, all(same_bits(x%value, y%value)) .and. all(same_bits(x%half_width, y%half_width)), &
+               & who//': statistic '//x%name//' (value and half-width)')
+            if (allocated(error)) return
+         end associate
+      end do
+   end subroutine same_observations
 
    !> Every record and snapshot, bit for bit.
    subroutine same_records(a, b, who, error)
@@ -395,6 +433,14 @@ contains
       scenes(2)%stop_lower = [-0.05_wp, -0.1_wp]
       scenes(2)%stop_upper = [0.05_wp, 0.1_wp]
       call expect_refusal(scenes, 'member 2 has stops along the span', error)
+      if (allocated(error)) return
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      scenes(3)%restitution = 0.5_wp
+      call expect_refusal(scenes, 'member 3 asks for damping, restitution or mass redistribution', error)
+      if (allocated(error)) return
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      scenes(1)%damping_mass = 1.0_wp
+      call expect_refusal(scenes, 'member 1 asks for damping', error)
       if (allocated(error)) return
       scenes = members_of(base_scene(3, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
       call expect_refusal(scenes, '&mesh elements = 3', error)

@@ -142,7 +142,7 @@ contains
       integer(ik) :: j
       integer :: c
       character(len=*), parameter :: names(n_columns) = [character(len=10) :: 't', 'u', 'v', 'reaction', 'energy', &
-         & 'work', 'dissipated']
+         & 'work', 'dissipated', 'damped']
       call check(error, a%filled == b%filled, what//': as many records'); if (allocated(error)) return
       do j = 1, a%filled
          do c = 1, n_columns

@@ -136,3 +136,291 @@ def test_unwritable_output_exits_4(tmp_path: Path) -> None:
     done = beamstops("run", scene, "-o", tmp_path / "no" / "such" / "dir.h5", cwd=tmp_path)
     assert done.returncode == 4
     assert "dir.h5" in done.stderr
+
+
+# ---------------------------------------------------------------- no input can destroy data (issue 11)
+
+
+def one_error_line(done: subprocess.CompletedProcess[str]) -> str:
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1, done.stderr
+    assert lines[0].startswith("beamstops: error: "), lines[0]
+    assert "Traceback" not in done.stderr and "Backtrace" not in done.stderr
+    return lines[0]
+
+
+def complete_output(tmp_path: Path, name: str = "kept.h5") -> tuple[Path, bytes]:
+    """A complete output of a short run, and its bytes."""
+    scene = write(tmp_path, SHORT, name="previous.nml")
+    done = beamstops("run", scene, "-o", name, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    return tmp_path / name, (tmp_path / name).read_bytes()
+
+
+@pytest.mark.parametrize("spelling", ["same name", "./ spelling", "hard link", "symbolic link"])
+def test_output_that_is_the_input_is_refused(spelling: str, tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT)
+    text = scene.read_bytes()
+    out = {"same name": "scene.nml", "./ spelling": "./scene.nml", "hard link": "link.h5",
+           "symbolic link": "symlink.h5"}[spelling]
+    if spelling == "hard link":
+        os.link(scene, tmp_path / out)
+    elif spelling == "symbolic link":
+        os.symlink(scene, tmp_path / out)
+    done = beamstops("run", "scene.nml", "-o", out, cwd=tmp_path)
+    assert done.returncode == 4
+    line = one_error_line(done)
+    assert line.startswith(f"beamstops: error: {out}: ") and "input" in line
+    assert scene.read_bytes() == text
+    assert not list(tmp_path.glob("*.partial"))
+
+
+def test_namelist_output_key_naming_the_input_is_refused(tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT + "&output file='scene.nml' /\n")
+    text = scene.read_bytes()
+    done = beamstops("run", scene, cwd=tmp_path)
+    assert done.returncode == 4
+    assert "input" in one_error_line(done)
+    assert scene.read_bytes() == text
+
+
+def foreign_files(tmp_path: Path) -> dict[str, tuple[Path, str]]:
+    text = tmp_path / "notes.h5"
+    text.write_text("my notes, not HDF5\n")
+    plain = tmp_path / "plain.h5"
+    with h5py.File(plain, "w") as f:
+        f["data"] = np.arange(3.0)
+        f.attrs["version"] = "mine"  # a version but no status: still not a beamstops output
+    folder = tmp_path / "folder.h5"
+    folder.mkdir()
+    return {"text": (text, "not an HDF5 file"), "hdf5": (plain, "without the root attributes"),
+            "folder": (folder, "folder")}
+
+
+@pytest.mark.parametrize("kind", ["text", "hdf5", "folder"])
+def test_existing_file_that_is_not_an_output_is_refused(kind: str, tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT)
+    target, why = foreign_files(tmp_path)[kind]
+    before = target.read_bytes() if target.is_file() else None
+    done = beamstops("run", scene, "-o", target.name, cwd=tmp_path)
+    assert done.returncode == 4
+    line = one_error_line(done)
+    assert line.startswith(f"beamstops: error: {target.name}: ") and why in line
+    if before is not None:
+        assert target.read_bytes() == before
+    assert not list(tmp_path.glob("*.partial")) and not list(tmp_path.glob("*.checkpoint"))
+
+
+@pytest.mark.parametrize("suffix", [".partial", ".checkpoint"])
+def test_foreign_file_at_the_partial_or_checkpoint_name_is_refused(suffix: str, tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT)
+    mine = tmp_path / f"out.h5{suffix}"
+    mine.write_text("not HDF5\n")
+    done = beamstops("run", scene, "-o", "out.h5", cwd=tmp_path)
+    assert done.returncode == 4
+    assert one_error_line(done).startswith(f"beamstops: error: out.h5{suffix}: ")
+    assert mine.read_text() == "not HDF5\n" and not (tmp_path / "out.h5").exists()
+
+
+def test_an_earlier_output_is_replaced_only_when_the_run_is_complete(tmp_path: Path) -> None:
+    output, _ = complete_output(tmp_path)
+    scene = write(tmp_path, "&time dt=5e-5, t_end=0.5 /\n")
+    done = beamstops("run", scene, "-o", output.name, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    with h5py.File(output) as f:
+        assert f.attrs["status"] == b"complete" and f.attrs["steps"] == 10000
+    assert not list(tmp_path.glob("*.partial"))
+
+
+def limit_file_size(size: int):  # type: ignore[no-untyped-def]
+    import resource
+
+    def apply() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (size, size))
+
+    return apply
+
+
+def test_write_beyond_the_file_size_limit_fails_cleanly(tmp_path: Path) -> None:
+    output, before = complete_output(tmp_path)
+    # about 13 MB of records against a 1 MB limit: the write fails with EFBIG, not SIGXFSZ
+    scene = write(tmp_path, "&time dt=1e-5, t_end=2 /\n")
+    done = subprocess.run([PROGRAM, "run", "scene.nml", "-o", output.name], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=120, preexec_fn=limit_file_size(1 << 20))
+    assert done.returncode == 4, (done.returncode, done.stderr)
+    line = one_error_line(done)
+    assert line.startswith(f"beamstops: error: {output.name}: ") and "file-size limit" in line
+    assert "kept.h5.partial" in line
+    assert output.read_bytes() == before  # the complete output of the earlier run is untouched
+    partial = tmp_path / "kept.h5.partial"
+    assert partial.exists() and partial.stat().st_size <= 1 << 20
+    try:  # the partial file is never presented as complete (a failed write may leave it unreadable)
+        with h5py.File(partial) as f:
+            assert f.attrs["status"] != b"complete"
+    except OSError:
+        pass
+    # once the limit is lifted, the same command runs (the broken partial file is its own)
+    done = beamstops("run", scene, "-o", output.name, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    with h5py.File(output) as f:
+        assert f.attrs["status"] == b"complete" and f.attrs["steps"] == 200000
+
+
+def test_unwritable_folder_exits_4_and_writes_nothing(tmp_path: Path) -> None:
+    """A folder the program may not write into; root writes anywhere, so as root the program
+    runs as the user nobody."""
+    import tempfile
+
+    base = Path(tempfile.mkdtemp(prefix="beamstops-ro-"))
+    try:
+        base.chmod(0o755)
+        scene = base / "scene.nml"
+        scene.write_text(SHORT)
+        scene.chmod(0o644)
+        locked = base / "locked"
+        locked.mkdir()
+        locked.chmod(0o555)
+        preexec = None
+        if os.geteuid() == 0:
+            def preexec() -> None:
+                os.setgid(65534)
+                os.setuid(65534)
+        done = subprocess.run([PROGRAM, "run", "scene.nml", "-o", "locked/out.h5"], cwd=base, capture_output=True,
+                              text=True, timeout=120, preexec_fn=preexec)
+        assert done.returncode == 4, done.stderr
+        line = one_error_line(done)
+        assert line.startswith("beamstops: error: locked/out.h5: ") and "locked/out.h5.partial" in line
+        assert list(locked.iterdir()) == []
+    finally:
+        shutil.rmtree(base, ignore_errors=True)
+
+
+def test_diverged_run_replaces_the_output_and_says_so(tmp_path: Path) -> None:
+    output, _ = complete_output(tmp_path, "bad.h5")
+    scene = write(tmp_path, "&time dt=2e-5, beta=0, t_end=0.5, allow_unstable=.true. /\n"
+                            "&output record_every=100 /\n")
+    done = beamstops("run", scene, "-o", output.name, cwd=tmp_path)
+    assert done.returncode == 3
+    assert "diverged" in one_error_line(done)
+    with h5py.File(output) as f:
+        assert f.attrs["status"] == b"diverged" and f.attrs["beta"] == 0
+    assert not list(tmp_path.glob("*.partial")) and not list(tmp_path.glob("*.checkpoint"))
+
+
+# ---------------------------------------------------------------- one entry point: the Python subcommands
+
+
+def listed_commands(help_text: str) -> dict[str, str]:
+    """Command names of `beamstops --help` (two-space indented lines) and their descriptions."""
+    out = {}
+    for line in help_text.split("exit statuses")[0].splitlines():
+        if line.startswith("  ") and not line.startswith("   "):
+            name, _, description = line.strip().partition(" ")
+            out[name] = description.strip()
+    return out
+
+
+def test_help_lists_every_command_with_a_description(tmp_path: Path) -> None:
+    from beamstops.cli import commands
+
+    done = beamstops("--help", cwd=tmp_path)
+    assert done.returncode == 0 and done.stderr == ""
+    listed = listed_commands(done.stdout)
+    python = commands()
+    assert {"plot", "sweep", "converge", "work-precision", "stability-map", "compliance"} <= set(python)
+    for name in ["run", "info", *python]:
+        assert name in listed, (name, done.stdout)
+    for name in python:
+        assert listed[name], name
+    # the program hands on exactly the Python subcommands: none missing, none extra
+    assert set(listed) - {"run", "info", "--version"} == set(python)
+
+
+def test_python_subcommands_run_from_the_program(tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT)
+    assert beamstops("run", scene, "-o", "short.h5", cwd=tmp_path).returncode == 0
+    done = beamstops("plot", "short.h5", "--kind", "energy", "-o", "energy.png", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "energy.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # the exit status is Python's: 1 for a user error, 2 for argparse's usage error
+    done = beamstops("plot", "missing.h5", cwd=tmp_path)
+    assert done.returncode == 1 and done.stderr.startswith("beamstops: error: missing.h5")
+    done = beamstops("plot", cwd=tmp_path)
+    assert done.returncode == 2 and "usage: beamstops plot" in done.stderr
+    for name in ["sweep", "converge", "work-precision", "stability-map", "compliance"]:
+        done = beamstops(name, "--help", cwd=tmp_path)
+        assert done.returncode == 0 and f"usage: beamstops {name}" in done.stdout, (name, done.stderr)
+
+
+def test_a_python_subcommand_replaces_the_program(tmp_path: Path) -> None:
+    """execv, not a child process: the process becomes Python, so signals reach it directly."""
+    import signal
+    import time
+
+    process = subprocess.Popen([PROGRAM, "converge", "-o", str(tmp_path / "c"), "--quiet"], cwd=tmp_path,
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    cmdline = Path(f"/proc/{process.pid}/cmdline")
+    deadline = time.time() + 30
+    seen = b""
+    while time.time() < deadline and process.poll() is None:
+        seen = cmdline.read_bytes() if cmdline.exists() else b""
+        if b"beamstops.cli" in seen:
+            break
+        time.sleep(0.01)
+    try:
+        assert b"beamstops.cli" in seen and b"converge" in seen, seen
+        assert not [p for p in Path("/proc").glob("[0-9]*") if _parent(p) == process.pid]
+    finally:
+        process.send_signal(signal.SIGTERM)
+        returncode = process.wait(timeout=30)
+    assert returncode == -signal.SIGTERM
+
+
+def _parent(proc: Path) -> int:
+    try:
+        return int((proc / "stat").read_text().rsplit(")", 1)[1].split()[1])
+    except (OSError, IndexError, ValueError):
+        return -1
+
+
+def test_without_python_a_python_subcommand_says_so(tmp_path: Path) -> None:
+    lone = tmp_path / "bin" / "beamstops"
+    lone.parent.mkdir()
+    shutil.copy2(PROGRAM, lone)  # no python beside it, and none on PATH
+    done = subprocess.run([str(lone), "plot", "x.h5"], cwd=tmp_path, capture_output=True, text=True, timeout=60,
+                          env={"PATH": str(tmp_path / "bin")})
+    assert done.returncode == 2
+    line = one_error_line(done)
+    assert "'plot'" in line and "Python" in line
+    # the engine's own commands need no Python
+    scene = write(tmp_path, SHORT)
+    assert subprocess.run([str(lone), "info", str(scene)], capture_output=True, env={"PATH": ""}).returncode == 0
+
+
+def test_without_the_package_a_python_subcommand_says_so(tmp_path: Path) -> None:
+    import sys
+
+    base = getattr(sys, "_base_executable", sys.executable)
+    probe = subprocess.run([base, "-c", "import beamstops"], capture_output=True)
+    if probe.returncode == 0:
+        pytest.skip(f"{base} imports beamstops: no Python without the package here")
+    lone = tmp_path / "bin" / "beamstops"
+    lone.parent.mkdir()
+    shutil.copy2(PROGRAM, lone)
+    (tmp_path / "bin" / "python").symlink_to(base)  # a Python beside the program, without the package
+    done = subprocess.run([str(lone), "sweep", "spec.toml"], cwd=tmp_path, capture_output=True, text=True,
+                          timeout=60)
+    assert done.returncode == 2
+    line = one_error_line(done)
+    assert "'sweep'" in line and "beamstops Python package" in line and "pip install" in line
+
+
+def test_an_empty_partial_file_left_by_a_kill_is_replaced(tmp_path: Path) -> None:
+    """A run killed right after creating OUT.h5.partial leaves it empty: the next run takes it."""
+    scene = write(tmp_path, SHORT)
+    (tmp_path / "out.h5.partial").write_bytes(b"")
+    done = beamstops("run", scene, "-o", "out.h5", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert not (tmp_path / "out.h5.partial").exists()
+    with h5py.File(tmp_path / "out.h5") as f:
+        assert f.attrs["status"] == b"complete"

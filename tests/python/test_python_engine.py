@@ -88,7 +88,7 @@ BAD = [
     ("no elements", dict(elements=0), "scene: &mesh elements = 0"),
     ("huge elements", dict(elements=2**40), "scene: &mesh elements = 1099511627776 is malformed; allowed:"),
     ("huger elements", dict(elements=2**80), "scene: &mesh elements = 1208925819614629174706176 is malformed"),
-    ("compliance without stiffness", dict(law="compliance"), "scene: &stops stiffness_per_mass = 0"),
+    ("compliance without stiffness", dict(law="compliance"), "scene: &stops law = 'compliance' needs a spring"),
     ("record_every", dict(record_every=0), "scene: &output record_every = 0"),
     ("snapshot_every", dict(snapshot_every=-1), "scene: &output snapshot_every = -1"),
     ("output too large", dict(dt=1e-9, t_end=100.0), "max_output_gb"),

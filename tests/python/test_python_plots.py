@@ -1,4 +1,8 @@
-"""beamstops.plots and `python -m beamstops plot`: files written without any display."""
+"""beamstops.plots and `python -m beamstops plot`: files written without any display.
+
+Every kind is drawn from a real run (in memory and by the program, with snapshots); the kinds
+of the shock log and the statistics also from the program's file with /impacts and
+/statistics groups added in the engine's layout (tests/python/synthetic.py)."""
 
 from __future__ import annotations
 
@@ -7,26 +11,44 @@ import subprocess
 import sys
 from pathlib import Path
 
+import h5py
+import numpy as np
 import pytest
 
+import synthetic
 import beamstops
 from beamstops import Scene, plots
+from beamstops.transforms import frame_indices, stroboscopic, welch
 
 PNG = b"\x89PNG\r\n\x1a\n"
 
 
 @pytest.fixture(scope="module")
 def result() -> beamstops.Result:
-    return beamstops.run(Scene(t_end=0.2, snapshot_every=50))
+    return beamstops.run(Scene(t_end=1.3, snapshot_every=100))
 
 
 @pytest.fixture(scope="module")
 def output(program: str, tmp_path_factory: pytest.TempPathFactory) -> Path:
     where = tmp_path_factory.mktemp("plot")
-    Scene(t_end=0.2, snapshot_every=50, file="out.h5").to_namelist(where / "scene.nml")
+    Scene(t_end=1.3, snapshot_every=100, file="out.h5").to_namelist(where / "scene.nml")
     done = subprocess.run([program, "run", "scene.nml"], cwd=where, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     return where / "out.h5"
+
+
+@pytest.fixture(scope="module")
+def logged(output: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The program's output with a shock log and statistics added in the engine's layout."""
+    path = tmp_path_factory.mktemp("logged") / "logged.h5"
+    path.write_bytes(output.read_bytes())
+    return synthetic.write(path, synthetic.impacts(60, stops=1), synthetic.statistics(stops=1, bins=24),
+                           {"transient": 0.05, "batches": 8, "bins": 24, "rest_time": 1e-3})
+
+
+@pytest.fixture(scope="module")
+def logged_result(logged: Path) -> beamstops.Result:
+    return beamstops.load(logged)
 
 
 def headless() -> dict[str, str]:
@@ -34,10 +56,204 @@ def headless() -> dict[str, str]:
     return env
 
 
-@pytest.mark.parametrize("kind", plots.KINDS)
+#: Still kinds a run has data for without a shock log, stops along the span or statistics.
+RUN_KINDS = [k for k in plots.FIGURE_KINDS if k not in ("stops", "impacts")]
+
+
+@pytest.mark.parametrize("kind", RUN_KINDS)
 def test_each_kind_is_written_from_python(kind: str, result: beamstops.Result, tmp_path: Path) -> None:
     path = plots.save(result, tmp_path / f"{kind}.png", kind=kind)
     assert path.read_bytes()[:8] == PNG and path.stat().st_size > 5000
+
+
+@pytest.mark.parametrize("kind", plots.FIGURE_KINDS)
+def test_each_kind_is_drawn_from_a_file_with_shocks_and_statistics(kind: str, logged_result: beamstops.Result,
+                                                                   tmp_path: Path) -> None:
+    if kind == "stops":
+        pytest.skip("no stops along the span in this scene (tests/python/test_python_stops.py)")
+    path = plots.save(logged_result, tmp_path / f"{kind}.png", kind=kind)
+    assert path.read_bytes()[:8] == PNG and path.stat().st_size > 5000
+
+
+def test_every_kind_is_known_to_the_command_line() -> None:
+    from beamstops.cli import build_parser
+
+    plot = build_parser()._subparsers._group_actions[0].choices["plot"]  # type: ignore[union-attr]
+    kind = next(a for a in plot._actions if a.dest == "kind")
+    assert tuple(kind.choices) == plots.KINDS
+    assert {"impacts", "pdf", "psd", "poincare", "spacetime", "shape", "animation", "all"} <= set(plots.KINDS)
+
+
+def test_spacetime_is_the_shape(result: beamstops.Result) -> None:
+    assert plots.plot_spacetime is plots.plot_shape
+    a, b = plots.figure(result, "shape"), plots.figure(result, "spacetime")
+    assert [ax.get_title() for ax in a.axes] == [ax.get_title() for ax in b.axes]
+
+
+def test_impacts_histograms_count_the_logged_shocks(logged_result: beamstops.Result) -> None:
+    fig = plots.figure(logged_result, "impacts")
+    impulses, velocities = fig.axes[:2]
+    side = logged_result.impacts["side"]
+    kept = logged_result.impacts["truncated"] == 0
+    # one step histogram per side, labelled with its count
+    labels = [t.get_text() for t in impulses.get_legend().get_texts()]
+    assert labels == [f"lower stop ({np.sum(kept & (side == 1))})", f"upper stop ({np.sum(kept & (side == -1))})"]
+    labels = [t.get_text() for t in velocities.get_legend().get_texts()]
+    assert labels == [f"lower stop ({np.sum(side == 1)})", f"upper stop ({np.sum(side == -1)})"]
+    assert "60 shocks, 1 truncated left out" in impulses.get_title()
+    assert len(impulses.patches) == 2 and len(velocities.patches) == 2
+
+
+def test_impacts_per_stop_along_the_span(logged: Path, tmp_path: Path) -> None:
+    path = tmp_path / "span.h5"
+    with h5py.File(path, "w") as f:
+        f.attrs["status"] = "complete"
+        f.create_dataset("stops/x", data=[0.5, 1.0, 1.5])
+        f.create_dataset("stops/node", data=[5.0, 10.0, 15.0])
+    synthetic.write(path, synthetic.impacts(90, stops=3, seed=2))
+    result = beamstops.load(path)
+    fig = plots.figure(result, "impacts")
+    labels = [t.get_text() for t in fig.axes[1].get_legend().get_texts()]
+    stop = result.impacts["stop"]
+    assert labels == [f"stop {k} (x = {x:g} m) ({np.sum(stop == k)})" for k, x in ((1, 0.5), (2, 1), (3, 1.5))]
+
+
+def test_pdf_from_the_engine_histogram_with_its_intervals(logged_result: beamstops.Result) -> None:
+    ax = plots.figure(logged_result, "pdf").axes[0]
+    histogram = logged_result.statistics["tip_histogram"]
+    edges = logged_result.statistics["tip_histogram_edges"].value
+    stairs = next(p for p in ax.patches)
+    np.testing.assert_allclose(stairs.get_data().values, histogram.value / np.diff(edges))
+    bars = ax.collections[0].get_segments()
+    np.testing.assert_allclose([s[1, 1] - s[0, 1] for s in bars], 2 * histogram.half_width / np.diff(edges))
+    assert "engine, t ≥ 0.05 s, 8 batches" in ax.get_title()
+    # integrates to one, as a PDF does
+    assert np.sum(stairs.get_data().values * np.diff(edges)) == pytest.approx(1.0)
+    # another transient than the engine's: a histogram of the records after it
+    other = plots.figure(logged_result, "pdf", transient=0.1).axes[0]
+    assert "records /tip/u, t ≥ 0.1 s" in other.get_title()
+    count = int(np.sum(logged_result.t >= 0.1))
+    assert f"{count} samples" in other.get_title()
+
+
+def test_pdf_without_statistics_is_a_histogram_of_the_records(result: beamstops.Result) -> None:
+    ax = plots.figure(result, "pdf").axes[0]
+    values, edges, _ = next(p for p in ax.patches).get_data()
+    assert np.sum(values * np.diff(edges)) == pytest.approx(1.0)
+    assert edges[0] == pytest.approx(result.tip_u.min()) and edges[-1] == pytest.approx(result.tip_u.max())
+
+
+def test_psd_is_welch_on_log_axes(result: beamstops.Result) -> None:
+    fig = plots.figure(result, "psd")
+    top, bottom = fig.axes[:2]
+    assert top.get_xscale() == "log" and top.get_yscale() == "log" and bottom.get_yscale() == "log"
+    f, p = welch(result.tip_u, 1.0 / (result.t[1] - result.t[0]))
+    line = top.get_lines()[0]
+    np.testing.assert_allclose(line.get_xdata(), f[1:][p[1:] > 0])
+    np.testing.assert_allclose(line.get_ydata(), p[1:][p[1:] > 0])
+    assert "reaction" in bottom.get_title()
+
+
+def test_welch_matches_scipy_and_parseval() -> None:
+    signal = pytest.importorskip("scipy.signal")
+    rng = np.random.default_rng(3)
+    x = np.sin(0.3 * np.arange(5000)) + rng.normal(size=5000)
+    for segment in (None, 256, 301):
+        f, p = welch(x, 200.0, segment)
+        f2, p2 = signal.welch(x, 200.0, nperseg=2 * (f.size - 1) if segment is None else segment)
+        np.testing.assert_allclose(f, f2)
+        np.testing.assert_allclose(p, p2, rtol=1e-10, atol=1e-14 * p2.max())
+    f, p = welch(rng.normal(size=1 << 14), 100.0, 1024)
+    assert np.sum(p) * (f[1] - f[0]) == pytest.approx(1.0, rel=0.05)  # variance 1
+    sine = np.sin(2 * np.pi * 12.5 * np.arange(4096) / 100.0)
+    f, p = welch(sine, 100.0, 512)
+    assert f[np.argmax(p)] == pytest.approx(12.5)
+
+
+def test_poincare_samples_the_records_nearest_kT(result: beamstops.Result) -> None:
+    period = 2 * np.pi / result.attrs["omega"]
+    long = beamstops.run(Scene(t_end=4 * period + 1e-3, omega=10.0))
+    ax = plots.figure(long, "poincare", transient=1.5 * period).axes[0]
+    k, index, offset = stroboscopic(long.t, period, 1.5 * period)
+    assert list(k) == [2, 3, 4]
+    assert offset <= 0.5 * (long.t[1] - long.t[0]) * (1 + 1e-9)
+    expected = np.array([[long.tip_u[np.argmin(np.abs(long.t - j * period))],
+                          long.tip_v[np.argmin(np.abs(long.t - j * period))]] for j in k])
+    np.testing.assert_allclose(ax.collections[0].get_offsets(), expected)
+    with pytest.raises(ValueError, match="no stroboscopic sample"):
+        plots.figure(long, "poincare", transient=10 * period)
+    still = beamstops.run(Scene(t_end=0.01, omega=0.0))
+    with pytest.raises(ValueError, match="no forcing period: omega = 0"):
+        plots.figure(still, "poincare")
+
+
+def test_animation_writes_a_gif_of_at_most_200_frames(tmp_path: Path) -> None:
+    from PIL import Image
+
+    many = beamstops.run(Scene(t_end=0.3, snapshot_every=10))  # 601 snapshots
+    assert many.snapshot_t.size > 200
+    path = plots.save(many, tmp_path / "beam.gif", kind="animation", dpi=40)
+    with Image.open(path) as gif:
+        assert gif.format == "GIF" and gif.n_frames == 200
+    few = beamstops.run(Scene(t_end=0.02, snapshot_every=50))
+    path = plots.save(few, tmp_path / "few.gif", kind="animation", dpi=40, frames=10)
+    with Image.open(path) as gif:
+        assert gif.n_frames == few.snapshot_t.size == 9
+    assert list(frame_indices(601, 200)[[0, -1]]) == [0, 600] and frame_indices(601, 200).size == 200
+
+
+def test_animation_with_stops_along_the_span_marks_the_contacts(tmp_path: Path) -> None:
+    from PIL import Image
+
+    from beamstops.animation import _contacts
+
+    span = beamstops.run(Scene(length=1.5, elements=30, amplitude=0.002, omega=40.0, beta=0.25, dt=2e-5, t_end=0.3,
+                               nodes=(10, 20, 30), lower=(-0.002, -0.002, -0.004), upper=(0.002, 0.002, 0.004),
+                               snapshot_every=100))
+    acting = np.array([_contacts(span, i) for i in range(span.snapshot_t.size)])
+    assert acting.shape == (span.snapshot_t.size, 3) and acting.any()
+    rows = np.searchsorted(span.t, span.snapshot_t)
+    np.testing.assert_array_equal(acting, span.stops_reaction[rows] != 0)
+    path = plots.save(span, tmp_path / "span.gif", kind="animation", dpi=40, frames=20)
+    with Image.open(path) as gif:
+        assert gif.n_frames == 20
+
+
+@pytest.mark.skipif(not __import__("shutil").which("ffmpeg"), reason="ffmpeg is not installed")
+def test_animation_writes_mp4_with_ffmpeg(result: beamstops.Result, tmp_path: Path) -> None:
+    path = plots.save(result, tmp_path / "beam.mp4", kind="animation", dpi=40, frames=10)
+    assert path.stat().st_size > 1000 and path.read_bytes()[4:8] == b"ftyp"
+
+
+def test_animation_format_errors(result: beamstops.Result, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from matplotlib import animation
+
+    with pytest.raises(ValueError, match=r"written as \.gif or \.mp4, not \.png"):
+        plots.save(result, tmp_path / "beam.png", kind="animation")
+    monkeypatch.setattr(animation.FFMpegWriter, "isAvailable", classmethod(lambda cls: False))
+    with pytest.raises(ValueError, match="MP4 needs ffmpeg, which is not on PATH; write a .gif instead"):
+        plots.save(result, tmp_path / "beam.mp4", kind="animation")
+    with pytest.raises(ValueError, match="not a still figure"):
+        plots.figure(result, "animation")
+
+
+@pytest.mark.parametrize("kind", ["shape", "spacetime", "animation"])
+def test_kinds_without_snapshots_say_how_to_get_them(kind: str, tmp_path: Path) -> None:
+    bare = beamstops.run(Scene(t_end=0.01))
+    with pytest.raises(ValueError, match=r"^no snapshots: run with &output snapshot_every > 0$"):
+        plots.save(bare, tmp_path / ("out.gif" if kind == "animation" else "out.png"), kind=kind)
+
+
+def test_other_missing_data_messages(result: beamstops.Result, tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match=r"^no shock log: the run has no /impacts"):
+        plots.figure(result, "impacts")
+    path = synthetic.write(tmp_path / "quiet.h5", synthetic.impacts(0))
+    with pytest.raises(ValueError, match=r"^no shocks: the shock log /impacts is empty"):
+        plots.figure(beamstops.load(path), "impacts")
+    with pytest.raises(ValueError, match=r"^no stops along the span"):
+        plots.figure(result, "stops")
+    with pytest.raises(ValueError, match="too few records for a spectrum"):
+        plots.figure(result, "psd", transient=float(result.t[-1]))
 
 
 def test_plot_functions_draw_on_given_axes(result: beamstops.Result, tmp_path: Path) -> None:
@@ -54,9 +270,20 @@ def test_plot_functions_draw_on_given_axes(result: beamstops.Result, tmp_path: P
     assert any(line.get_ydata()[0] == 0.1 for line in axes[0].get_lines()[1:])
 
 
-def test_shape_without_snapshots_says_so(tmp_path: Path) -> None:
+def test_all_draws_what_the_run_has(result: beamstops.Result, logged_result: beamstops.Result,
+                                    tmp_path: Path) -> None:
     bare = beamstops.run(Scene(t_end=0.01))
-    assert plots.save(bare, tmp_path / "shape.png", kind="shape").stat().st_size > 0
+    fig = plots.figure(bare, "all")  # no snapshots: the shape's panel says so
+    texts = [t.get_text() for ax in fig.axes for t in ax.texts]
+    assert any(t.startswith("no snapshots") for t in texts)
+    assert plots.save(bare, tmp_path / "bare.png", kind="all").stat().st_size > 0
+    titles = [ax.get_title() for ax in plots.figure(logged_result, "all").axes]
+    for expected in ("tip displacement PDF (engine", "tip displacement u(L, t)", "contact reaction at the tip",
+                     "Poincaré section", "impulse: 60 shocks", "impact velocity: 60 shocks"):
+        assert any(t.startswith(expected) for t in titles), (expected, titles)
+    assert not any(t.startswith("impulse") for t in (ax.get_title() for ax in plots.figure(result, "all").axes))
+    info = "\n".join(t.get_text() for ax in plots.figure(logged_result, "all").axes for t in ax.texts)
+    assert "shocks logged: 60" in info and "power to the stops: 0.560 ± 0.031 W" in info
     with pytest.raises(ValueError, match="unknown plot kind"):
         plots.figure(bare, "bode")
 
@@ -73,6 +300,34 @@ def test_command_line_plot_needs_no_display(kind: str, output: Path, tmp_path: P
                           capture_output=True, text=True, timeout=120, env=headless())
     assert done.returncode == 0, done.stderr
     assert (output.parent / "out_energy.png").is_file()
+
+
+@pytest.mark.parametrize("kind", ["impacts", "pdf", "psd", "poincare", "spacetime"])
+def test_command_line_new_kinds(kind: str, logged: Path, tmp_path: Path) -> None:
+    png = tmp_path / f"cli-{kind}.png"
+    done = subprocess.run([sys.executable, "-m", "beamstops", "plot", str(logged), "-o", str(png), "--kind", kind,
+                           "--transient", "0.05"], capture_output=True, text=True, timeout=120, env=headless())
+    assert done.returncode == 0, done.stderr
+    assert png.read_bytes()[:8] == PNG
+
+
+def test_command_line_animation(output: Path, tmp_path: Path) -> None:
+    done = subprocess.run([sys.executable, "-m", "beamstops", "plot", str(output), "--kind", "animation",
+                           "--frames", "7", "--dpi", "40"], capture_output=True, text=True, timeout=120, env=headless())
+    assert done.returncode == 0, done.stderr
+    gif = output.parent / "out_animation.gif"
+    assert done.stdout.strip() == str(gif)
+    from PIL import Image
+
+    with Image.open(gif) as image:
+        assert image.n_frames == 7
+
+
+def test_command_line_missing_data_is_one_line(output: Path, tmp_path: Path) -> None:
+    done = subprocess.run([sys.executable, "-m", "beamstops", "plot", str(output), "--kind", "impacts",
+                           "-o", str(tmp_path / "x.png")], capture_output=True, text=True, timeout=120, env=headless())
+    assert done.returncode == 1
+    assert done.stderr.startswith("beamstops: error: no shock log") and "Traceback" not in done.stderr
 
 
 def test_command_line_errors_are_one_line(tmp_path: Path) -> None:

@@ -1,5 +1,6 @@
 """Checkpoints: a run killed with SIGKILL at random moments and resumed with --restart
-gives the uninterrupted run's output bit for bit; an interrupted file says so."""
+gives the uninterrupted run's output bit for bit; an interrupted run leaves its records in
+OUT.h5.partial (which says so) and never touches OUT.h5."""
 
 from __future__ import annotations
 
@@ -75,6 +76,7 @@ def test_killed_runs_resume_bit_for_bit(tmp_path: Path) -> None:
     assert done.returncode == 0, f"seed {seed}: {done.stderr}"
     assert kills > 0, "the run was never killed: make it longer"
     assert not (tmp_path / "killed.h5.checkpoint").exists()
+    assert not (tmp_path / "killed.h5.partial").exists()
     assert_identical(tmp_path / "killed.h5", tmp_path / "reference.h5")
 
 
@@ -90,9 +92,10 @@ def test_interrupted_file_says_so_and_keeps_its_records(tmp_path: Path) -> None:
     process.send_signal(signal.SIGKILL)
     process.wait()
     assert checkpoint.exists()
+    assert not (tmp_path / "cut.h5").exists()
     with pytest.raises(beamstops.IncompleteRunError):
-        beamstops.load(tmp_path / "cut.h5")
-    partial = beamstops.load(tmp_path / "cut.h5", allow_incomplete=True)
+        beamstops.load(tmp_path / "cut.h5.partial")
+    partial = beamstops.load(tmp_path / "cut.h5.partial", allow_incomplete=True)
     assert partial.status == "running"
     # every record up to the checkpoint is there, on the time grid
     assert partial.t.size >= 40000
@@ -120,3 +123,46 @@ def test_restart_without_checkpoint_starts_over(tmp_path: Path) -> None:
     assert done.returncode == 0
     assert "starting from t = 0" in done.stderr
     assert beamstops.load(tmp_path / "fresh.h5").attrs["steps"] == 50000
+
+
+def test_killed_rerun_leaves_the_complete_output_untouched(tmp_path: Path) -> None:
+    """A complete output survives a re-run killed in the middle, bit for bit and file for file;
+    --restart then finishes the re-run and replaces it."""
+    scene = write_scene(tmp_path, "kept", t_end=0.3)
+    assert run("run", scene, cwd=tmp_path).returncode == 0
+    output = tmp_path / "kept.h5"
+    before = output.read_bytes()
+    inode = output.stat().st_ino
+    scene.write_text(SCENE.format(t_end=1.0, file="kept.h5"))
+    process = subprocess.Popen([PROGRAM, "run", str(scene)], cwd=tmp_path, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+    checkpoint = tmp_path / "kept.h5.checkpoint"
+    deadline = time.time() + 60
+    while not checkpoint.exists() and time.time() < deadline:
+        time.sleep(0.01)
+    process.send_signal(signal.SIGKILL)
+    assert process.wait() == -signal.SIGKILL, "the re-run ended before it was killed"
+    assert checkpoint.exists() and (tmp_path / "kept.h5.partial").exists()
+    assert output.read_bytes() == before and output.stat().st_ino == inode
+    assert beamstops.load(output).attrs["steps"] == 300000
+    done = run("run", scene, "--restart", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert beamstops.load(output).attrs["steps"] == 1000000
+    assert not (tmp_path / "kept.h5.partial").exists() and not checkpoint.exists()
+
+
+def test_restart_without_partial_output_starts_over(tmp_path: Path) -> None:
+    scene = write_scene(tmp_path, "lost", t_end=4.0)
+    process = subprocess.Popen([PROGRAM, "run", str(scene)], cwd=tmp_path, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+    deadline = time.time() + 60
+    while not (tmp_path / "lost.h5.checkpoint").exists() and time.time() < deadline:
+        time.sleep(0.01)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    (tmp_path / "lost.h5.partial").unlink()
+    scene.write_text(SCENE.format(t_end=0.05, file="lost.h5"))
+    done = run("run", scene, "--restart", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert "lost.h5.partial" in done.stderr and "starting from t = 0" in done.stderr
+    assert beamstops.load(tmp_path / "lost.h5").attrs["steps"] == 50000

@@ -176,6 +176,7 @@ amplitude = { start = 0.10, stop = 0.15, step = 0.01 }
     deadline = time.monotonic() + 60
     while not list((out / "points").glob("*.json")) and time.monotonic() < deadline:
         time.sleep(0.02)
+    time.sleep(0.5)  # the sweep takes the point's result after its worker wrote the file (slow when loaded)
     os.killpg(process.pid, signal.SIGTERM)  # a batch system's time limit: the whole job
     _, err = process.communicate(timeout=60)
     assert process.returncode == 130, err
@@ -186,7 +187,7 @@ amplitude = { start = 0.10, stop = 0.15, step = 0.01 }
     assert done.returncode == 0, done.stderr
     assert "done before" in done.stderr
     resumed = read_summary(out)
-    assert all(r["status"] == "complete" for r in resumed)
+    assert all(r["status"] == "complete" for r in resumed), resumed
     clean = run_sweep(load_spec(spec_path), tmp_path / "clean", jobs=2, stream=None)
     assert clean.complete == len(resumed)
     assert without_timing(read_summary(tmp_path / "clean")) == without_timing(resumed)
@@ -256,3 +257,120 @@ def test_resuming_with_another_build_of_the_engine_says_so(tmp_path: Path, progr
     outcome = run_sweep(spec, tmp_path / "out", jobs=1, stream=log, program=str(rebuilt))
     assert outcome.ran == 1 and outcome.complete == 4
     assert "another build of the engine" in log.getvalue()
+
+
+def test_progress_bar_on_a_terminal_is_tqdm(tmp_path: Path, write_spec: Callable[..., Path]) -> None:
+    import io
+
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    terminal = Terminal()
+    run_sweep(load_spec(write_spec(SMALL)), tmp_path / "out", jobs=2, stream=terminal)
+    text = terminal.getvalue()
+    assert "\r" in text and "100%|" in text and "4/4 points done, 0 failed" in text
+    assert text.splitlines()[-1].startswith("sweep: 4 points: 4 complete")
+
+
+# ---------------------------------------------------------------- one sweep per folder (issue 15)
+
+
+LONG = """
+[scene]
+elements = 10
+dt = 2e-5
+t_end = 20.0
+record_every = 100
+[axes]
+amplitude = { start = 0.10, stop = 0.15, step = 0.01 }
+"""
+
+
+def test_a_second_sweep_into_a_running_sweeps_folder_is_refused(tmp_path: Path, write_spec: Callable[..., Path],
+                                                                 without_timing: Callable[..., Any]) -> None:
+    import socket
+
+    spec_path = write_spec(LONG)
+    out = tmp_path / "out"
+    command = [sys.executable, "-m", "beamstops", "sweep", str(spec_path), "-o", str(out), "-j", "1", "-q"]
+    first = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    lock = out / ".lock"
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and first.poll() is None:
+        if lock.is_file() and lock.read_text().startswith("pid"):
+            break
+        time.sleep(0.01)
+    assert lock.read_text().split() == ["pid", str(first.pid), "host", socket.gethostname()]
+    others = [subprocess.Popen(c, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+              for c in (command, command[:-1])]  # a second sweep, and a resume (not quiet)
+    second, resume = (subprocess.CompletedProcess(p.args, p.wait(timeout=60), *p.communicate()) for p in others)
+    assert first.poll() is None, "the first sweep ended before the others tried: make it longer"
+    _, err = first.communicate(timeout=300)
+    assert first.returncode == 0, err
+    for refused in (second, resume):
+        assert refused.returncode == 1, refused.stderr
+        line = refused.stderr.strip().splitlines()[-1]
+        assert line.startswith(f"beamstops: error: {out}: another sweep is running into this folder")
+        assert f"pid {first.pid} host {socket.gethostname()}" in line
+    # the refused sweeps changed nothing: the results are a lone sweep's
+    assert lock.read_text() == ""
+    rows = read_summary(out)
+    assert all(r["status"] == "complete" for r in rows)
+    clean = run_sweep(load_spec(spec_path), tmp_path / "clean", jobs=2, stream=None)
+    assert clean.complete == len(rows)
+    assert without_timing(read_summary(tmp_path / "clean")) == without_timing(rows)
+
+
+def test_a_sweep_refuses_a_folder_locked_in_this_process(tmp_path: Path, write_spec: Callable[..., Path]) -> None:
+    from beamstops.sweep.runner import FolderLock
+
+    spec = load_spec(write_spec(SMALL))
+    out = tmp_path / "out"
+    with FolderLock(out):
+        with pytest.raises(ValueError, match=f"pid {os.getpid()} host "):
+            run_sweep(spec, out, jobs=1, stream=None)
+        assert not (out / "points").exists()
+    assert run_sweep(spec, out, jobs=2, stream=None).complete == 4
+
+
+def test_the_lock_of_a_dead_sweep_is_taken_over(tmp_path: Path, write_spec: Callable[..., Path]) -> None:
+    import io
+
+    spec = load_spec(write_spec(SMALL))
+    out = tmp_path / "out"
+    run_sweep(spec, out, jobs=2, stream=None)
+    (out / "points" / "00001.h5").unlink()
+    # a sweep killed with SIGKILL: its lock file still names it, but the kernel dropped its lock
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    (out / ".lock").write_text(f"pid {dead.pid} host elsewhere\n")
+    log = io.StringIO()
+    outcome = run_sweep(spec, out, jobs=1, stream=log)
+    assert (outcome.ran, outcome.complete) == (1, 4)
+    assert f"took over the lock of a sweep that is no longer running (pid {dead.pid} host elsewhere)" in log.getvalue()
+
+
+def test_without_flock_the_pid_in_the_lock_file_decides(tmp_path: Path, write_spec: Callable[..., Path],
+                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    import errno
+    import fcntl
+    import socket
+
+    from beamstops.sweep.runner import FolderLock
+
+    def no_locks(fd: int, operation: int) -> None:
+        raise OSError(errno.ENOLCK, "No locks available")
+
+    monkeypatch.setattr(fcntl, "flock", no_locks)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / ".lock").write_text(f"pid {os.getpid()} host {socket.gethostname()}\n")  # alive: this process
+    with pytest.raises(ValueError, match=f"pid {os.getpid()} host"):
+        FolderLock(out).acquire()
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    (out / ".lock").write_text(f"pid {dead.pid} host {socket.gethostname()}\n")
+    with FolderLock(out) as lock:
+        assert lock.unlocked and lock.stale == f"pid {dead.pid} host {socket.gethostname()}"
+        assert (out / ".lock").read_text().split()[1] == str(os.getpid())

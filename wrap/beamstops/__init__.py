@@ -12,10 +12,10 @@ Plots live in :mod:`beamstops.plots`; ``python -m beamstops plot OUT.h5`` draws 
 """
 
 from .engine import Stability, run, stability, version
-from .result import IncompleteRunError, Result, load
+from .result import IncompleteRunError, Result, Statistic, load
 from .scene import Scene
 
 __version__ = version()
 
-__all__ = ["Scene", "Result", "Stability", "IncompleteRunError", "run", "load", "stability", "version",
+__all__ = ["Scene", "Result", "Statistic", "Stability", "IncompleteRunError", "run", "load", "stability", "version",
            "__version__"]

@@ -2,7 +2,11 @@
 
 Each subcommand is a function ``register(subparsers)`` that adds its parser and sets
 ``handler`` (a function of the parsed arguments returning an exit status). To add one,
-write such a function (here or in a module of its own) and list it in :data:`COMMANDS`.
+write such a function (here or in a module of its own) and list it in :data:`COMMANDS`, and
+add its name and one-line help to the table of the program (``python_commands`` in
+src/main.f90), which hands these subcommands to this module: ``beamstops plot ...`` runs
+``main(["plot", ...], prog="beamstops")`` in the Python beside the program
+(tests/python/test_cli.py checks that the two tables agree).
 Errors a user can fix end in one line ``beamstops: error: ...`` and exit status 1.
 """
 
@@ -19,10 +23,29 @@ def _plot(args: argparse.Namespace) -> int:
     from .result import load
 
     result = load(args.file, allow_incomplete=args.allow_incomplete)
-    out = args.output or Path(args.file).with_name(f"{Path(args.file).stem}_{args.kind}.png")
-    plots.save(result, out, kind=args.kind, dpi=args.dpi)
+    suffix = ".gif" if args.kind == "animation" else ".png"
+    out = args.output or Path(args.file).with_name(f"{Path(args.file).stem}_{args.kind}{suffix}")
+    if args.kind == "animation":
+        options = {"frames": args.frames, "fps": args.fps}
+    else:
+        options = {"transient": args.transient} if args.transient is not None else {}
+    plots.save(result, out, kind=args.kind, dpi=args.dpi, **options)
     print(out)
     return 0
+
+
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text}: at least 1")
+    return value
+
+
+def _nonnegative(text: str) -> float:
+    value = float(text)
+    if not value >= 0:
+        raise argparse.ArgumentTypeError(f"{text}: a time ≥ 0 (s)")
+    return value
 
 
 def register_plot(subparsers: argparse._SubParsersAction) -> None:
@@ -32,10 +55,22 @@ def register_plot(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser("plot", help="plot the HDF5 output of `beamstops run`",
                                    description="Plot the HDF5 output of `beamstops run` (no display needed).")
     parser.add_argument("file", type=Path, help="HDF5 file written by `beamstops run`")
-    parser.add_argument("-o", "--output", type=Path, help="image to write (default: FILE_KIND.png next to FILE)")
+    parser.add_argument("-o", "--output", type=Path,
+                        help="image to write (default: FILE_KIND.png next to FILE; FILE_animation.gif for animation)")
     parser.add_argument("--kind", choices=KINDS, default="tip",
-                        help="tip displacement, space-time shape, energy, phase portrait, reaction, the stops along "
-                             "the span (one panel each), or all (default: tip)")
+                        help="tip: tip displacement; shape or spacetime: the beam's ũ(x, t) from snapshots; energy; "
+                             "phase: tip phase portrait; reaction; stops: the stops along the span (one panel each); "
+                             "impacts: histograms of impulse and impact velocity per stop (the shock log); "
+                             "pdf: tip-displacement PDF (the engine's histogram, 95 %% intervals); psd: Welch spectra "
+                             "of the tip displacement and the reaction; poincare: (u, v) of the tip at t = kT, "
+                             "T = 2π/ω; animation: the beam between its stops (.gif, or .mp4 with ffmpeg); all: "
+                             "every still kind the run has data for (default: tip)")
+    parser.add_argument("--transient", type=_nonnegative, metavar="SECONDS",
+                        help="pdf, psd, poincare: draw only t ≥ SECONDS (pdf: the engine's histogram covers its own "
+                             "transient; another one draws a histogram of the records)")
+    parser.add_argument("--frames", type=_positive_int, default=200,
+                        help="animation: at most this many frames, spread over the snapshots (default: 200)")
+    parser.add_argument("--fps", type=_positive_int, default=20, help="animation: frames per second (default: 20)")
     parser.add_argument("--dpi", type=int, default=120, help="resolution of raster images (default: 120)")
     parser.add_argument("--allow-incomplete", action="store_true",
                         help="plot a run that diverged or was interrupted")
@@ -55,10 +90,10 @@ from .studies.cli import STUDIES  # noqa: E402  (issue 6: converge, work-precisi
 COMMANDS += STUDIES
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(prog: str = "python -m beamstops") -> argparse.ArgumentParser:
     from . import version
 
-    parser = argparse.ArgumentParser(prog="python -m beamstops",
+    parser = argparse.ArgumentParser(prog=prog,
                                      description="beamstops: a beam on a vibrating support between rigid stops.")
     parser.add_argument("-V", "--version", action="version", version=f"beamstops {version()}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
@@ -67,8 +102,17 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: Optional[Sequence[str]] = None) -> int:
-    args = build_parser().parse_args(argv)
+def commands() -> dict[str, str]:
+    """The subcommands and their one-line help, in the order ``--help`` lists them."""
+    parser = build_parser()
+    action = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return {choice.dest: choice.help or "" for choice in action._choices_actions}
+
+
+def main(argv: Optional[Sequence[str]] = None, prog: str = "python -m beamstops") -> int:
+    """Run a subcommand; ``prog`` names the command in messages (``beamstops`` when the
+    program hands a subcommand on)."""
+    args = build_parser(prog).parse_args(argv)
     try:
         return int(args.handler(args))
     except (OSError, ValueError) as exc:

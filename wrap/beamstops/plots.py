@@ -3,20 +3,29 @@
 Each ``plot_*`` function draws on a given Axes (or a new figure's) and returns the Axes:
 
 - :func:`plot_tip`: tip displacement against time in the paper's style, stops drawn;
-- :func:`plot_shape`: the beam's shape in space-time, a colour map of ũ(x, t);
+- :func:`plot_shape` (= :func:`plot_spacetime`): the beam's shape in space-time, a colour map of ũ(x, t);
 - :func:`plot_energy`: discrete energy with the work of the load and the energy the stops took;
 - :func:`plot_phase`: phase portrait (u, v) of the tip;
 - :func:`plot_reaction`: contact reaction at the tip;
 - :func:`plot_stop`: displacement of one stop along the span between its stops, contacts marked
-  (kind ``'stops'``: one panel per stop).
+  (kind ``'stops'``: one panel per stop);
+- :func:`plot_impulses`, :func:`plot_impact_velocities` (kind ``'impacts'``): histograms over the
+  engine's shock log, per stop;
+- :func:`plot_pdf`: tip-displacement PDF (the engine's histogram and its 95 % intervals);
+- :func:`plot_psd` (kind ``'psd'``: tip displacement and reaction): Welch spectra, log axes;
+- :func:`plot_poincare`: the stroboscopic section (u(L, kT), v(L, kT)), T = 2π/ω.
 
-:func:`figure` builds a whole figure of one kind (or ``'all'``), :func:`save` writes it.
-Figures are :class:`matplotlib.figure.Figure` objects not attached to any GUI backend,
-so nothing here needs a display; to show one interactively, use pyplot yourself.
+:func:`figure` builds a whole figure of one kind (or ``'all'``: every kind whose data the run
+has), :func:`save` writes it; ``save(result, 'OUT.gif', kind='animation')`` (or
+:func:`beamstops.animation.animate`) writes the beam moving between its stops. A kind whose
+data is absent raises ValueError saying how to get it (``no snapshots: run with &output
+snapshot_every > 0``). Figures are :class:`matplotlib.figure.Figure` objects not attached to any
+GUI backend, so nothing here needs a display; to show one interactively, use pyplot yourself.
 """
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 from typing import Any, Callable, Optional
@@ -26,63 +35,29 @@ from matplotlib import rc_context
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
+from .plotbase import LINE as _LINE
+from .plotbase import STOP as _STOP
+from .plotbase import envelope as _envelope
+from .plotbase import need_impacts, need_records, need_snapshots, placeholder
+from .plotbase import new_axes as _axes
+from .plotbase import tip_stops as _stops
+from .plotbase import title as _title
+from .plots_dynamics import (MIN_SPECTRUM_RECORDS, engine_pdf, plot_impact_velocities, plot_impulses, plot_pdf,
+                             plot_poincare, plot_psd, poincare_period)
 from .result import Result
+from .transforms import after, stroboscopic
 
-__all__ = ["KINDS", "plot_tip", "plot_shape", "plot_energy", "plot_phase", "plot_reaction", "plot_stop", "figure",
-           "save"]
+__all__ = ["KINDS", "FIGURE_KINDS", "plot_tip", "plot_shape", "plot_spacetime", "plot_energy", "plot_phase",
+           "plot_reaction", "plot_stop", "plot_impulses", "plot_impact_velocities", "plot_pdf", "plot_psd",
+           "plot_poincare", "missing", "figure", "save"]
 
-#: Plot kinds understood by :func:`figure`, :func:`save` and ``python -m beamstops plot --kind``.
-KINDS = ("tip", "shape", "energy", "phase", "reaction", "stops", "all")
-
-_LINE = {"color": "k", "linewidth": 0.6}
-_STOP = {"color": "tab:red", "linewidth": 0.8, "linestyle": "--"}
-# Above this many points a series is drawn through its per-bin minima and maxima:
-# the picture is the same at screen resolution, and drawing stays fast.
-_DRAW_POINTS = 20000
-
-
-def _envelope(x: np.ndarray, *ys: np.ndarray, bins: int = 4000) -> tuple[np.ndarray, ...]:
-    """Min/max decimation for drawing: per bin of consecutive samples, the samples where y is extreme."""
-    n = x.size
-    if n <= _DRAW_POINTS:
-        return (x, *ys)
-    width = -(-n // bins)
-    cut = (n // width) * width
-    index = np.arange(cut).reshape(-1, width)
-    keep = [np.arange(cut, n)]
-    for y in ys:
-        block = y[:cut].reshape(-1, width)
-        keep.append(index[np.arange(index.shape[0]), block.argmin(axis=1)])
-        keep.append(index[np.arange(index.shape[0]), block.argmax(axis=1)])
-    order = np.unique(np.concatenate(keep + [np.array([0, n - 1])]))
-    return (x[order], *(y[order] for y in ys))
-
-
-def _axes(ax: Optional[Axes]) -> Axes:
-    if ax is not None:
-        return ax
-    return Figure(figsize=(8, 4.5), layout="constrained").add_subplot()
-
-
-def _title(result: Result) -> str:
-    a = result.attrs
-    law = {"signorini": "Signorini scheme", "compliance": "normal compliance", "none": "no stops"}.get(
-        a.get("law", ""), str(a.get("law", "")))
-    if a.get("law") == "compliance" and "stiffness_per_mass" in a:
-        law += f" (1/ε = {a['stiffness_per_mass']:.3g} 1/s²)"
-    return f"{law}, β = {a.get('beta', float('nan')):g}, Δt = {a.get('dt', float('nan')):g} s"
-
-
-def _stops(result: Result) -> tuple[Optional[float], Optional[float]]:
-    """The tip's stops: the tip-only form's, or those of a stop along the span at the tip."""
-    if result.attrs.get("law") == "none":
-        return None, None
-    if result.stops_node.size:
-        at_tip = np.flatnonzero(result.stops_node == result.attrs.get("elements"))
-        if at_tip.size == 0:
-            return None, None
-        return float(result.stops_lower[at_tip[0]]), float(result.stops_upper[at_tip[0]])
-    return result.attrs.get("lower"), result.attrs.get("upper")
+#: Plot kinds understood by :func:`save` and ``python -m beamstops plot --kind``.
+KINDS = ("tip", "shape", "spacetime", "energy", "phase", "reaction", "stops", "impacts", "pdf", "psd", "poincare",
+         "animation", "all")
+#: The kinds that are still figures (:func:`figure`); 'animation' is written by :func:`save` only.
+FIGURE_KINDS = tuple(kind for kind in KINDS if kind != "animation")
+#: Kinds that take ``transient`` (s): only what comes after it is drawn.
+TRANSIENT_KINDS = ("pdf", "psd", "poincare")
 
 
 def plot_tip(result: Result, ax: Optional[Axes] = None, *, stops: bool = True,
@@ -108,14 +83,11 @@ def plot_tip(result: Result, ax: Optional[Axes] = None, *, stops: bool = True,
 
 
 def plot_shape(result: Result, ax: Optional[Axes] = None, *, cmap: str = "RdBu_r") -> Axes:
-    """The beam's shape in space-time: a colour map of the physical displacement ũ(x, t)."""
+    """The beam's shape in space-time: a colour map of the physical displacement ũ(x, t) (kinds
+    'shape' and 'spacetime'); ValueError without snapshots."""
+    need_snapshots(result)
     ax = _axes(ax)
     t, x, u = result.snapshot_t, result.snapshot_x, result.snapshot_u
-    if t.size == 0:
-        ax.text(0.5, 0.5, "no snapshots\n(set &output snapshot_every > 0)", ha="center", va="center",
-                transform=ax.transAxes)
-        ax.set_axis_off()
-        return ax
     limit = float(np.max(np.abs(u))) or 1.0
     mesh = ax.pcolormesh(t, x, u.T, shading="nearest", cmap=cmap, vmin=-limit, vmax=limit, rasterized=True)
     ax.figure.colorbar(mesh, ax=ax, label="ũ(x, t) (m)")
@@ -123,6 +95,9 @@ def plot_shape(result: Result, ax: Optional[Axes] = None, *, cmap: str = "RdBu_r
     ax.set_ylabel("x (m)")
     ax.set_title("shape ũ(x, t)", fontsize="medium")
     return ax
+
+
+plot_spacetime = plot_shape
 
 
 def plot_energy(result: Result, ax: Optional[Axes] = None) -> Axes:
@@ -175,12 +150,8 @@ def plot_reaction(result: Result, ax: Optional[Axes] = None) -> Axes:
 def plot_stop(result: Result, index: int = 0, ax: Optional[Axes] = None) -> Axes:
     """Physical displacement ũ at stop ``index`` (0-based) along the span against time, between
     its stops; the records where the stop acts (a nonzero reaction) are marked."""
+    _need_span_stops(result)
     ax = _axes(ax)
-    if result.stops_node.size == 0:
-        ax.text(0.5, 0.5, "no stops along the span\n(&stops nodes or x)", ha="center", va="center",
-                transform=ax.transAxes)
-        ax.set_axis_off()
-        return ax
     u = result.stops_u[:, index]
     r = result.stops_reaction[:, index]
     t, ud = _envelope(result.t, u)
@@ -199,12 +170,18 @@ def plot_stop(result: Result, index: int = 0, ax: Optional[Axes] = None) -> Axes
     return ax
 
 
+def _need_span_stops(result: Result) -> None:
+    if result.stops_node.size == 0:
+        raise ValueError("no stops along the span: the scene has none (&stops nodes or x)")
+
+
 def _stops_figure(result: Result) -> Figure:
     """One panel per stop along the span, time shared, the tip at the bottom."""
-    m = max(1, result.stops_node.size)
+    _need_span_stops(result)
+    m = result.stops_node.size
     fig = Figure(figsize=(9, 1.2 + 2.2 * m), layout="constrained")
     axes = np.atleast_1d(fig.subplots(m, 1, sharex=True))
-    order = np.argsort(result.stops_x) if result.stops_node.size else [0]
+    order = np.argsort(result.stops_x)
     for ax, index in zip(axes, order):
         plot_stop(result, int(index), ax)
     axes[-1].set_xlabel("t (s)")
@@ -213,41 +190,147 @@ def _stops_figure(result: Result) -> Figure:
 
 
 _PLOTS: dict[str, Callable[..., Axes]] = {
-    "tip": plot_tip, "shape": plot_shape, "energy": plot_energy, "phase": plot_phase, "reaction": plot_reaction,
+    "tip": plot_tip, "shape": plot_shape, "spacetime": plot_shape, "energy": plot_energy, "phase": plot_phase,
+    "reaction": plot_reaction, "pdf": plot_pdf, "poincare": plot_poincare,
 }
 
 
-def figure(result: Result, kind: str = "tip", **options: Any) -> Figure:
-    """A figure of one kind (see :data:`KINDS`); ``'all'`` puts every kind on one page."""
-    if kind not in KINDS:
-        raise ValueError(f"unknown plot kind {kind!r}; allowed: {', '.join(KINDS)}")
-    if kind == "stops":
-        return _stops_figure(result)
-    if kind != "all":
-        fig = Figure(figsize=(8, 4.5), layout="constrained")
-        _PLOTS[kind](result, fig.add_subplot(), **options)
-        return fig
-    fig = Figure(figsize=(14, 9), layout="constrained")
-    grid = fig.subplots(2, 3)
-    plot_tip(result, grid[0, 0], **options)
-    plot_shape(result, grid[0, 1])
-    plot_energy(result, grid[0, 2])
-    plot_phase(result, grid[1, 0])
-    plot_reaction(result, grid[1, 1])
-    grid[1, 2].set_axis_off()
+def missing(result: Result, kind: str, transient: Optional[float] = None) -> Optional[str]:
+    """Why ``kind`` cannot be drawn from ``result`` (the message of the ValueError), or None if it can."""
+    try:
+        if kind in ("tip", "energy", "phase", "reaction"):
+            need_records(result)
+        elif kind in ("shape", "spacetime", "animation"):
+            need_snapshots(result)
+        elif kind == "stops":
+            _need_span_stops(result)
+        elif kind == "impacts":
+            need_impacts(result)
+        elif kind == "pdf":
+            if not engine_pdf(result, transient):
+                need_records(result)
+                if not after(result.t, transient).any():
+                    return f"no records after the transient: t ≥ {transient} s"
+        elif kind == "psd":
+            need_records(result)
+            count = int(after(result.t, transient).sum())
+            if count < MIN_SPECTRUM_RECORDS:
+                return (f"too few records for a spectrum: {count} after t = {transient or 0.0:g} s "
+                        f"(at least {MIN_SPECTRUM_RECORDS})")
+        elif kind == "poincare":
+            need_records(result)
+            if stroboscopic(result.t, poincare_period(result), transient)[0].size == 0:
+                return f"no stroboscopic sample: no kT after t = {transient or 0.0:g} s within the records"
+    except ValueError as exc:
+        return str(exc)
+    return None
+
+
+def _info(result: Result, ax: Axes) -> None:
+    """The run in text: source, law, scheme, counts, the engine's headline statistics."""
+    ax.set_axis_off()
     a = result.attrs
-    grid[1, 2].text(0.0, 1.0, "\n".join([
+    lines = [
         f"source: {Path(result.source).name}", f"status: {result.status}", f"law: {a.get('law')}",
         f"dt = {a.get('dt')} s, β = {a.get('beta')}, J = {a.get('elements')}",
         f"steps: {a.get('steps')}, impacts: {a.get('impacts')}",
         f"largest stop violation: {a.get('max_violation', float('nan')):.3g} m",
         f"κ_h = {a.get('kappa_h', float('nan')):.5g} 1/s²", f"engine CPU: {a.get('cpu_seconds', float('nan')):.3g} s",
-    ]), va="top", family="monospace", fontsize="small", transform=grid[1, 2].transAxes)
+    ]
+    if result.impacts:
+        lines.append(f"shocks logged: {result.shocks}")
+    for name, label in (("shocks_per_second", "shocks per second"), ("power", "power to the stops"),
+                        ("contact_fraction", "contact fraction")):
+        if name in result.statistics:
+            lines.append(f"{label}: {result.statistics[name]}")
+    if result.statistics_attrs:
+        lines.append(f"statistics: t ≥ {result.statistics_attrs.get('transient', 0.0):g} s, "
+                     f"{result.statistics_attrs.get('batches', '?')} batches")
+    ax.text(0.0, 1.0, "\n".join(lines), va="top", family="monospace", fontsize="small", transform=ax.transAxes)
+
+
+def _all_figure(result: Result, transient: Optional[float], options: dict[str, Any]) -> Figure:
+    """Every still kind whose data the run has on one page (the shape's place kept, empty, without snapshots)."""
+    panels: list[Callable[[Axes], Any]] = [
+        lambda ax: plot_tip(result, ax, **options),
+        lambda ax: plot_shape(result, ax) if missing(result, "shape") is None else placeholder(
+            ax, missing(result, "shape") or ""),
+        lambda ax: plot_energy(result, ax),
+        lambda ax: plot_phase(result, ax),
+        lambda ax: plot_reaction(result, ax),
+    ]
+    if missing(result, "pdf", transient) is None:
+        panels.append(lambda ax: plot_pdf(result, ax, transient=transient))
+    if missing(result, "psd", transient) is None:
+        panels.append(lambda ax: plot_psd(result, ax, quantity="tip_u", transient=transient))
+        if np.any(result.reaction[after(result.t, transient)] != 0):
+            panels.append(lambda ax: plot_psd(result, ax, quantity="reaction", transient=transient))
+    if missing(result, "poincare", transient) is None:
+        panels.append(lambda ax: plot_poincare(result, ax, transient=transient))
+    if missing(result, "impacts") is None:
+        panels += [lambda ax: plot_impulses(result, ax), lambda ax: plot_impact_velocities(result, ax)]
+    panels.append(lambda ax: _info(result, ax))
+    rows = math.ceil(len(panels) / 3)
+    fig = Figure(figsize=(14, 4.5 * rows), layout="constrained")
+    grid = np.atleast_1d(fig.subplots(rows, 3)).ravel()
+    for ax, draw in zip(grid, panels):
+        draw(ax)
+    for ax in grid[len(panels):]:
+        ax.set_axis_off()
+    return fig
+
+
+def figure(result: Result, kind: str = "tip", *, transient: Optional[float] = None, **options: Any) -> Figure:
+    """A figure of one kind (see :data:`FIGURE_KINDS`); ``'all'`` puts every kind the run has data for on one page.
+
+    ``transient`` (s) applies to 'pdf', 'psd' and 'poincare' (and to them in 'all'): only what
+    comes after it is drawn ('pdf' draws the engine's histogram when the transient is the
+    engine's or not given, otherwise a histogram of the records). Other ``options`` go to the
+    kind's ``plot_*`` function (to :func:`plot_tip` for 'all').
+    """
+    if kind not in KINDS:
+        raise ValueError(f"unknown plot kind {kind!r}; allowed: {', '.join(KINDS)}")
+    if kind == "animation":
+        raise ValueError("'animation' is not a still figure: save(result, 'OUT.gif', kind='animation') writes it")
+    if kind == "all":
+        return _all_figure(result, transient, options)
+    reason = missing(result, kind, transient)
+    if reason is not None:
+        raise ValueError(reason)
+    if kind == "stops":
+        return _stops_figure(result)
+    if kind == "impacts":
+        fig = Figure(figsize=(12, 4.5), layout="constrained")
+        left, right = fig.subplots(1, 2)
+        plot_impulses(result, left)
+        plot_impact_velocities(result, right)
+        fig.suptitle(_title(result), fontsize="medium")
+        return fig
+    if kind == "psd":
+        fig = Figure(figsize=(8, 8), layout="constrained")
+        top, bottom = fig.subplots(2, 1, sharex=True)
+        plot_psd(result, top, quantity="tip_u", transient=transient, **options)
+        plot_psd(result, bottom, quantity="reaction", transient=transient, **options)
+        top.set_xlabel("")
+        fig.suptitle(_title(result), fontsize="medium")
+        return fig
+    fig = Figure(figsize=(7, 6) if kind in ("pdf", "poincare") else (8, 4.5), layout="constrained")
+    if kind in TRANSIENT_KINDS:
+        options = {**options, "transient": transient}
+    _PLOTS[kind](result, fig.add_subplot(), **options)
     return fig
 
 
 def save(result: Result, path: str | os.PathLike[str], kind: str = "tip", dpi: int = 120, **options: Any) -> Path:
-    """Draw a figure of one kind and write it (the format follows the file's extension)."""
+    """Draw a figure of one kind and write it (the format follows the file's extension).
+
+    ``kind='animation'`` writes the beam moving between its stops to a .gif (or .mp4 with
+    ffmpeg); its options are ``frames`` (at most this many, default 200) and ``fps``.
+    """
+    if kind == "animation":
+        from .animation import animate
+
+        return animate(result, path, dpi=dpi, **options)
     fig = figure(result, kind, **options)
     path = Path(path)
     with rc_context({"agg.path.chunksize": 20000}):

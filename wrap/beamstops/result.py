@@ -10,6 +10,7 @@ reaction           /tip/reaction          contact reaction (N)
 energy             /energy/E              discrete energy E^{n+1/2} (J)
 work               /energy/work           work of the load (J)
 dissipated         /energy/dissipated     energy taken by the stops (J)
+damped             /energy/damped         energy taken by the Rayleigh damping (J)
 snapshot_t         /snapshots/t           snapshot times (s)
 snapshot_x         /snapshots/x           node abscissae x_0..x_J (m)
 snapshot_u         /snapshots/u           physical displacement ũ(x, t), (snapshots, J+1) (m)
@@ -19,11 +20,18 @@ stops_lower        /stops/lower           their lower stops (m) (m)
 stops_upper        /stops/upper           their upper stops (m) (m)
 stops_u            /stops/u               physical displacement ũ at each stop, (records, m) (m)
 stops_reaction     /stops/reaction        reaction of each stop, (records, m) (N)
+impacts            /impacts/NAME          the engine's shock log: {NAME: one value per shock}
+statistics         /statistics/NAME       the engine's statistics: {NAME: Statistic}
+statistics_attrs   /statistics attributes transient (s), batches, bins, rest_time (s)
 attrs              root attributes        scene, κ_h, limits, status, steps, cpu_seconds, …
 =================  =====================  =========================================
 
 Without stops along the span (the tip-only form) the ``stops_*`` arrays are empty
-(``stops_u`` and ``stops_reaction`` of shape (records, 0)).
+(``stops_u`` and ``stops_reaction`` of shape (records, 0)). Without a shock log or
+statistics (a file written before the engine kept them) ``impacts``, ``statistics`` and
+``statistics_attrs`` are empty dicts. Their columns, names and units are in
+:mod:`beamstops.observations` (definitions: docs/statistics.md); :meth:`Result.impacts_frame`
+and :meth:`Result.statistics_frame` give them as pandas DataFrames when pandas is installed.
 
 :func:`load` reads a file written by ``beamstops run``; :func:`beamstops.run` gives the
 same object from memory.
@@ -37,7 +45,9 @@ from typing import Any, Optional
 
 import numpy as np
 
-__all__ = ["Result", "IncompleteRunError", "load", "ARRAYS"]
+from .observations import Statistic, impacts_frame, read_impacts, read_statistics, statistics_frame
+
+__all__ = ["Result", "Statistic", "IncompleteRunError", "load", "ARRAYS"]
 
 #: Result arrays and the HDF5 datasets they come from.
 ARRAYS: dict[str, str] = {
@@ -48,6 +58,7 @@ ARRAYS: dict[str, str] = {
     "energy": "energy/E",
     "work": "energy/work",
     "dissipated": "energy/dissipated",
+    "damped": "energy/damped",
     "snapshot_t": "snapshots/t",
     "snapshot_x": "snapshots/x",
     "snapshot_u": "snapshots/u",
@@ -82,12 +93,19 @@ class Result:
     snapshot_t: np.ndarray
     snapshot_x: np.ndarray
     snapshot_u: np.ndarray
+    damped: np.ndarray = field(default_factory=lambda: np.empty(0))
     stops_x: np.ndarray = field(default_factory=lambda: np.empty(0))
     stops_node: np.ndarray = field(default_factory=lambda: np.empty(0))
     stops_lower: np.ndarray = field(default_factory=lambda: np.empty(0))
     stops_upper: np.ndarray = field(default_factory=lambda: np.empty(0))
     stops_u: np.ndarray = field(default_factory=lambda: np.empty((0, 0)))
     stops_reaction: np.ndarray = field(default_factory=lambda: np.empty((0, 0)))
+    impacts: dict[str, np.ndarray] = field(default_factory=dict)
+    """The shock log, one 1-d array per column of /impacts ({} when none was recorded)."""
+    statistics: dict[str, Statistic] = field(default_factory=dict)
+    """The engine's statistics by name ({} when none were computed)."""
+    statistics_attrs: dict[str, Any] = field(default_factory=dict)
+    """Attributes of the statistics: transient (s), batches, bins, rest_time (s)."""
     attrs: dict[str, Any] = field(default_factory=dict)
     source: str = "memory"
     """'memory' for :func:`beamstops.run`, the file name for :func:`load`."""
@@ -102,6 +120,19 @@ class Result:
         """(snapshot_t, snapshot_x, snapshot_u)."""
         return self.snapshot_t, self.snapshot_x, self.snapshot_u
 
+    @property
+    def shocks(self) -> int:
+        """Number of rows of the shock log (0 when none was recorded)."""
+        return int(next(iter(self.impacts.values())).size) if self.impacts else 0
+
+    def impacts_frame(self) -> Any:
+        """The shock log as a pandas DataFrame, one row per shock (ImportError without pandas)."""
+        return impacts_frame(self.impacts)
+
+    def statistics_frame(self) -> Any:
+        """The statistics as a pandas DataFrame indexed by (name, index) (ImportError without pandas)."""
+        return statistics_frame(self.statistics)
+
     def scene(self) -> Any:
         """The :class:`beamstops.Scene` of the run, from its ``scene`` attribute (the engine's canonical text)."""
         from .scene import Scene
@@ -113,7 +144,8 @@ class Result:
     def __repr__(self) -> str:
         a = self.attrs
         return (f"Result({self.source!r}, status={self.status!r}, law={a.get('law')!r}, dt={a.get('dt')!r}, "
-                f"records={self.t.size}, snapshots={self.snapshot_t.size}, steps={a.get('steps')!r}, "
+                f"records={self.t.size}, snapshots={self.snapshot_t.size}, shocks={self.shocks}, "
+                f"steps={a.get('steps')!r}, "
                 f"cpu_seconds={a.get('cpu_seconds')!r})")
 
 
@@ -154,6 +186,8 @@ def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result
         for name, dataset in ARRAYS.items():
             if dataset in f:
                 arrays[name] = np.asarray(f[dataset][()], dtype=np.float64)
+        impacts = read_impacts(f, path)
+        statistics, statistics_attrs = read_statistics(f, path)
     nodes = arrays["snapshot_x"].size if "snapshot_x" in arrays else 0
     arrays.setdefault("snapshot_t", np.empty(0))
     arrays.setdefault("snapshot_x", np.empty(0))
@@ -163,7 +197,8 @@ def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result
     arrays.setdefault("stops_reaction", np.empty((records, 0)))
     for name in ARRAYS:
         arrays.setdefault(name, np.empty(0))
-    result = Result(**arrays, attrs=attrs, source=path)
+    result = Result(**arrays, impacts=impacts, statistics=statistics, statistics_attrs=statistics_attrs,
+                    attrs=attrs, source=path)
     if result.status != "complete" and not allow_incomplete:
         raise IncompleteRunError(f"{path}: run {result.status}: {attrs.get('message', 'not complete')}; "
                                  "pass allow_incomplete=True to read what it holds", result)

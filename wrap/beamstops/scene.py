@@ -54,6 +54,8 @@ ROUTES: dict[str, tuple[str, ...]] = {
     "youngs_modulus": ("k2", "mass_per_length"), "density": ("k2", "mass_per_length"),
     "outer_diameter": ("k2", "mass_per_length"), "wall_thickness": ("k2", "mass_per_length"),
     "stiffness": ("stiffness_per_mass",), "x": ("nodes",),
+    "ratio": ("mass_coefficient", "stiffness_coefficient"), "mass_coefficient": ("ratio",),
+    "stiffness_coefficient": ("ratio",),
 }
 
 
@@ -84,6 +86,19 @@ class Scene:
     """Contact law: 'signorini' (the paper's scheme), 'compliance' (a spring) or 'none'."""
     stiffness_per_mass: float = 0.0
     """Normal-compliance stiffness per unit mass 1/ε (1/s²); used with law='compliance' only."""
+    restitution: float = 0.0
+    """Restitution coefficient e in [0, 1] (Paoli–Schatzman, law 'signorini'); 0 is the paper's scheme."""
+    mass: Literal["consistent", "redistributed"] = "consistent"
+    """'redistributed': the constrained displacement unknowns carry no mass (needs beta > 0)."""
+    # &damping
+    mass_coefficient: float = 0.0
+    """Rayleigh damping C = a M + b S: a (1/s)."""
+    stiffness_coefficient: float = 0.0
+    """Rayleigh damping: b (s)."""
+    ratio: tuple[float, ...] = ()
+    """Damping ratios ζ at the two ``modes`` (one value: both); () for the coefficients' form."""
+    modes: tuple[int, ...] = (1, 2)
+    """The two cantilever modes (1-based) of the ratio form."""
     # &mesh
     elements: int = 19
     """Number of elements J."""
@@ -111,6 +126,28 @@ class Scene:
     """Save a checkpoint every this many steps, for ``beamstops run --restart`` (0: never)."""
     max_output_gb: float = 4.0
     """Refuse a run whose recorded data would exceed this many gigabytes (1e9 bytes)."""
+    # &statistics
+    enabled: bool = True
+    """Keep the shock log (/impacts) and the statistics (/statistics)."""
+    transient: float = 0.0
+    """Start of the statistics' window (s)."""
+    batches: int = 20
+    """Batches of the batch-means 95 % intervals (>= 2)."""
+    bins: int = 40
+    """Bins of the tip-displacement histogram."""
+    rest_time: float = 0.01
+    """Contact phases closer than this are one shock (s)."""
+    histogram_lower: float = -0.1
+    """Lower end of the tip histogram (m; default: the lower stop)."""
+    histogram_upper: float = 0.1
+    """Upper end of the tip histogram (m; default: the upper stop)."""
+    # &ensemble
+    members: int = 1
+    """Members of the ensemble (1: the scene alone)."""
+    perturbation: float = 0.0
+    """Size of the members' random initial perturbation (m)."""
+    seed: int = 1
+    """Seed of the perturbation's random numbers."""
 
     def __post_init__(self) -> None:
         values = {field.name: getattr(self, field.name) for field in dataclasses.fields(self)}
@@ -149,7 +186,8 @@ class Scene:
 
         A route replaces the fields it gives (the material replaces ``k2`` and
         ``mass_per_length``, ``stiffness`` replaces ``stiffness_per_mass``, ``x`` replaces
-        ``nodes``); the engine resolves it with the scene's (new) other keys.
+        ``nodes``, the damping ``ratio`` replaces the Rayleigh coefficients and they replace it);
+        the engine resolves it with the scene's (new) other keys.
         """
         unknown = sorted(set(changes) - set(_GROUP_OF))
         if unknown:
@@ -221,10 +259,14 @@ def namelist_value(value: Any, key: str = "value") -> str:
 
 
 def _namelist(values: Mapping[str, Any]) -> str:
-    """Namelist text of flat keys, each in its group; None and empty lists are left out (defaults)."""
+    """Namelist text of flat keys, each in its group; None, empty lists and the fields' defaults
+    are left out (the engine's reader fills in every default)."""
+    defaults = {field.name: field.default for field in dataclasses.fields(Scene)}
     groups: dict[str, list[str]] = {}
     for key, value in values.items():
         if value is None or (isinstance(value, (tuple, list)) and len(value) == 0):
+            continue
+        if key in defaults and type(value) is type(defaults[key]) and value == defaults[key]:
             continue
         groups.setdefault(_GROUP_OF[key], []).append(f"  {key} = {namelist_value(value, key)}")
     return "".join(f"&{group}\n" + "\n".join(lines) + "\n/\n" for group, lines in groups.items()) or "&time /\n"
@@ -268,6 +310,9 @@ def parse_value(text: str) -> Any:
 def _fields_of(text: str) -> dict[str, Any]:
     """Field values of canonical text; with stops along the span lower and upper are tuples."""
     values = {key: parse_value(value) for _, key, value in _items(text)}
+    for key in ("ratio", "modes"):
+        if key in values and not isinstance(values[key], tuple):
+            values[key] = (values[key],)
     if "nodes" in values:
         for key in ("nodes", "lower", "upper"):
             if not isinstance(values[key], tuple):
@@ -279,7 +324,7 @@ def _adopt(scene: Scene, canonical: str) -> None:
     """Set a scene's fields to the values of the engine's canonical text."""
     values = _fields_of(canonical)
     for field in dataclasses.fields(scene):
-        default = field.default if field.name != "nodes" else ()
+        default = field.default if field.name not in ("nodes", "ratio") else ()
         object.__setattr__(scene, field.name, values.get(field.name, default))
     object.__setattr__(scene, "_canonical", canonical)
 

@@ -32,7 +32,7 @@ module beamstops_contact_span_stops
    implicit none
    private
    public :: span_stops_type, span_work_type, new_span_stops, new_span_work, span_contact, span_correction
-   public :: span_settle, span_energy, max_columns
+   public :: span_settle, span_energy, span_energy_massless, max_columns
 
    !> Active stops up to which the correction uses the columns Z (beyond: one banded solve).
    integer, parameter :: max_columns = 8
@@ -66,6 +66,12 @@ module beamstops_contact_span_stops
       type(box_qp_type) :: qp
       !> Trial values, bounds of the step in u, multipliers and constrained values (m).
       real(wp), allocatable :: trial(:), lo(:), hi(:), lambda(:), y(:)
+      !> Bounds of u^{n+1} itself at the stops (= lo, hi but with restitution, where lo, hi bound
+      !> u^{n+1} + e u^{n-1} shifted; the violation is measured on these) (m).
+      real(wp), allocatable :: vlo(:), vhi(:)
+      !> Mass redistribution: (S u^n)_k and (S d^{n-1})_k at the stops before the step, and the
+      !> reaction of each stop during the step, per unit mass (m).
+      real(wp), allocatable :: s_u(:), s_d_prev(:), reaction(:)
       !> u^n and d^{n-1} at the stops, before the step (m).
       real(wp), allocatable :: u_prev(:), d_prev(:)
       !> A record of the stops waiting for the recorder: u~ at each stop and reactions (N) (m).
@@ -147,7 +153,11 @@ contains
          return
       end if
       allocate (work%trial(m), work%lo(m), work%hi(m), work%lambda(m), work%y(m), work%u_prev(m), work%d_prev(m), &
-         & work%record_u(m), work%record_reaction(m))
+         & work%record_u(m), work%record_reaction(m), work%vlo(m), work%vhi(m), work%s_u(m), work%s_d_prev(m), &
+         & work%reaction(m))
+      work%s_u = 0
+      work%s_d_prev = 0
+      work%reaction = 0
       work%record_u = 0
       work%record_reaction = 0
       work%info = qp_solved
@@ -161,7 +171,10 @@ contains
    !> the bounds at phi = phi(t_{n+1}), and the multipliers (zero when no trial value is out).
    !> Also keeps u^n and d^{n-1} at the stops for the record and the energy. Without `enforce`
    !> (law 'none') only that. info: qp_solved or the failure of the program (contact/box_qp.f90).
-   subroutine span_contact(stops, work, u, d, x, phi, enforce, info)
+   !> With a restitution coefficient e > 0 (Paoli-Schatzman, SPEC 9) the program bounds the
+   !> combination (u~^{n+1} + e u~^{n-1})/(1+e) of the physical displacements, that is u^{n+1} at
+   !> each stop between (1+e) lower - e u^{n-1} - h (phi_{n+1} + e phi_{n-1}) and the same with upper.
+   subroutine span_contact(stops, work, u, d, x, phi, enforce, info, e, phi_prev)
       !> The stops.
       type(span_stops_type), intent(in) :: stops
       !> Work; lambda, y, contact set.
@@ -174,6 +187,10 @@ contains
       logical, intent(in) :: enforce
       !> qp_solved, or why the program failed.
       integer, intent(out) :: info
+      !> Restitution coefficient e in [0, 1].
+      real(wp), intent(in) :: e
+      !> Support position at t_{n-1} (m; used when e > 0).
+      real(wp), intent(in) :: phi_prev
       integer :: i, k
       logical :: out
       info = qp_solved
@@ -185,6 +202,12 @@ contains
          work%trial(i) = u(k) + (d(k) + x(k))
          work%lo(i) = stops%lower(i) - stops%lift(i)*phi
          work%hi(i) = stops%upper(i) - stops%lift(i)*phi
+         work%vlo(i) = work%lo(i)
+         work%vhi(i) = work%hi(i)
+         if (e > 0) then
+            work%lo(i) = (1 + e)*stops%lower(i) - e*(u(k) - d(k)) - stops%lift(i)*(phi + e*phi_prev)
+            work%hi(i) = (1 + e)*stops%upper(i) - e*(u(k) - d(k)) - stops%lift(i)*(phi + e*phi_prev)
+         end if
          out = out .or. work%trial(i) < work%lo(i) .or. work%trial(i) > work%hi(i)
       end do
       if (.not. (out .and. enforce)) then
@@ -251,7 +274,9 @@ contains
    !> tip's: a stop resting on a bound has exactly zero velocity), and the largest violation of
    !> a bound by the values of u at the stops (u's frame, the bounds of the step; 0 but for
    !> round-off).
-   subroutine span_settle(stops, work, u, d, worst)
+   !> Without `exact` (mass redistribution: d stays the primary variable) the values are left as
+   !> the update made them. The violation is that of u^{n+1} itself (with restitution too).
+   subroutine span_settle(stops, work, u, d, worst, exact)
       !> The stops.
       type(span_stops_type), intent(in) :: stops
       !> Work from span_contact.
@@ -260,8 +285,10 @@ contains
       real(wp), intent(inout) :: u(:), d(:)
       !> Largest violation (m).
       real(wp), intent(inout) :: worst
+      !> Whether the active stops are set exactly on their bounds.
+      logical, intent(in) :: exact
       integer :: j, a, k
-      if (work%contact) then
+      if (work%contact .and. exact) then
          do j = 1, work%qp%n_active
             a = work%qp%active(j)
             k = stops%unknown(a)
@@ -271,7 +298,7 @@ contains
       end if
       do j = 1, stops%m
          k = stops%unknown(j)
-         worst = max(worst, u(k) - work%hi(j), work%lo(j) - u(k))
+         worst = max(worst, u(k) - work%vhi(j), work%vlo(j) - u(k))
       end do
    end subroutine span_settle
 
@@ -309,4 +336,31 @@ contains
          end if
       end do
    end subroutine span_energy
+
+   !> span_energy for massless stop unknowns (mass redistribution, SPEC 10): the reaction of
+   !> every stop is given (work%reaction, the residual of its row, nonzero a few steps after a
+   !> contact), so the sums run over all stops.
+   pure subroutine span_energy_massless(stops, work, d, dphi, dissipated, support_work)
+      !> The stops.
+      type(span_stops_type), intent(in) :: stops
+      !> Work after span_contact, with the reactions of the step.
+      type(span_work_type), intent(in) :: work
+      !> d^n (n).
+      real(wp), intent(in) :: d(:)
+      !> phi(t_{n+1}) - phi(t_{n-1}).
+      real(wp), intent(in) :: dphi
+      !> Energy taken by the stops so far.
+      real(wp), intent(inout) :: dissipated
+      !> Work of the load and the support so far.
+      real(wp), intent(inout) :: support_work
+      integer :: a, k
+      real(wp) :: r
+      do a = 1, stops%m
+         k = stops%unknown(a)
+         r = work%reaction(a)
+         if (r == 0) cycle
+         dissipated = dissipated - 0.5_wp*r*((d(k) + work%d_prev(a)) + stops%lift(a)*dphi)
+         support_work = support_work - 0.5_wp*r*stops%lift(a)*dphi
+      end do
+   end subroutine span_energy_massless
 end module beamstops_contact_span_stops

@@ -8,7 +8,7 @@ module beamstops_recorder_array
 
    !> Recorder keeping rows and snapshots in memory.
    type, extends(recorder_type) :: array_recorder
-      !> Rows (n_columns, capacity): t, u, v, reaction, energy, work, dissipated.
+      !> Rows (n_columns, capacity): t, u, v, reaction, energy, work, dissipated, damped.
       real(wp), allocatable :: rows(:, :)
       !> Snapshot times (capacity) and shapes (J+1, capacity).
       real(wp), allocatable :: snap_t(:), snap_u(:, :)

@@ -1,9 +1,13 @@
 !> The HDF5 writer: chunked, extendable datasets written as the run goes,
 !> the scene and the results as root attributes, and a `status` attribute that
 !> says 'complete' only once the run has finished and every record is on disk.
+!> The run writes OUT.partial beside the output OUT and renames it onto OUT when it has gone
+!> to its end ('complete' or 'diverged') and the file is closed: a killed or failed run never
+!> touches OUT. `check_output_path` refuses, before anything is written, an OUT that is the
+!> input itself or an existing file that is not a beamstops output.
 !>
 !>   /tip/t, /tip/u, /tip/v, /tip/reaction
-!>   /energy/t, /energy/E, /energy/work, /energy/dissipated
+!>   /energy/t, /energy/E, /energy/work, /energy/dissipated, /energy/damped
 !>   /snapshots/t, /snapshots/x, /snapshots/u   (u: snapshots x (J+1))
 !>   /stops/x, /stops/node, /stops/lower, /stops/upper, /stops/u, /stops/reaction
 !>                                              (stops along the span; u, reaction: records x m)
@@ -14,35 +18,35 @@ module beamstops_recorder_hdf5
    use beamstops_error, only: error_type, fatal_error
    use beamstops_scene, only: scene_type, law_name, law_compliance, stop_count
    use beamstops_model, only: model_type
-   use beamstops_summary, only: run_summary, status_running, status_complete
-   use beamstops_state, only: state_type
-   use beamstops_checkpoint, only: write_checkpoint, checkpoint_path, remove_file
+   use beamstops_summary, only: run_summary, status_running, status_complete, status_diverged, status_failed
+   use beamstops_files, only: file_exists, is_directory, same_file, rename_file
    use beamstops_recorder_hdf5_vector, only: write_vector
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
-      & col_work, col_dissipated
+      & col_work, col_dissipated, col_damped
    use beamstops_attributes, only: attribute_list, kind_real, kind_int, kind_logical, kind_text
    use beamstops_output_attributes, only: run_attributes, summary_attributes
+   use beamstops_recorder_hdf5_observations, only: write_observations
    implicit none
    private
-   public :: hdf5_recorder
+   public :: hdf5_recorder, partial_path, check_output_path
 
    !> Rows buffered before a write (and rows of a chunk).
    integer, parameter :: buffer_rows = 16384
-   integer, parameter :: n_series = 8
+   integer, parameter :: n_series = 9
    character(len=*), parameter :: group_names(3) = [character(len=9) :: 'tip', 'energy', 'snapshots']
    character(len=*), parameter :: series_path(n_series) = [character(len=18) :: '/tip/t', '/tip/u', '/tip/v', &
-      & '/tip/reaction', '/energy/t', '/energy/E', '/energy/work', '/energy/dissipated']
+      & '/tip/reaction', '/energy/t', '/energy/E', '/energy/work', '/energy/dissipated', '/energy/damped']
    character(len=*), parameter :: series_units(n_series) = [character(len=4) :: 's', 'm', 'm/s', 'N', 's', &
-      & 'J', 'J', 'J']
+      & 'J', 'J', 'J', 'J']
    integer, parameter :: series_column(n_series) = [col_t, col_u, col_v, col_reaction, col_t, col_energy, &
-      & col_work, col_dissipated]
+      & col_work, col_dissipated, col_damped]
 
    !> Recorder writing an HDF5 file.
    type, extends(recorder_type) :: hdf5_recorder
-      !> File name.
+      !> The output file, replaced only when the run has gone to its end.
       character(len=:), allocatable :: path
-      !> Message of the first failure.
-      character(len=:), allocatable :: message
+      !> The file written as the run goes (partial_path(path)).
+      character(len=:), allocatable :: partial
       integer(hid_t) :: file = -1
       integer(hid_t) :: series(n_series) = -1
       integer(hid_t) :: snap_t = -1, snap_u = -1
@@ -51,7 +55,7 @@ module beamstops_recorder_hdf5
       integer :: nodes = 0
       !> Buffered rows (buffer_rows, n_columns): each series a contiguous column.
       real(wp), allocatable :: buffer(:, :)
-      !> Scene of the run (for checkpoints).
+      !> Scene of the run.
       type(scene_type) :: scene
       !> Buffered snapshots: times and shapes (nodes, snapshot_rows).
       real(wp), allocatable :: snap_t_buffer(:), snap_u_buffer(:, :)
@@ -69,7 +73,7 @@ module beamstops_recorder_hdf5
       procedure :: reopen
       procedure :: record
       procedure :: record_stops
-      procedure :: checkpoint
+      procedure :: flush => flush_file
       procedure :: snapshot
       procedure :: progress
       procedure :: finish
@@ -77,11 +81,12 @@ module beamstops_recorder_hdf5
 
 contains
 
-   !> Create the file, its datasets and the scene's attributes; status 'running'.
+   !> Create the partial file beside `path`, its datasets and the scene's attributes; status
+   !> 'running'. `path` itself is not touched before `finish`.
    subroutine open_file(self, path, scene, model, error)
       !> Recorder.
       class(hdf5_recorder), intent(inout) :: self
-      !> File to create (replaced if it exists).
+      !> Output file (replaced by finish when the run has gone to its end).
       character(len=*), intent(in) :: path
       !> Scene of the run.
       type(scene_type), intent(in) :: scene
@@ -93,11 +98,10 @@ contains
       integer(hid_t) :: group
       logical :: ok
       call prepare(self, path, scene, model)
-      call remove_file(checkpoint_path(path))
-      call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%file, hdferr)
+      call h5fcreate_f(self%partial, H5F_ACC_TRUNC_F, self%file, hdferr)
       if (hdferr /= 0) then
-         call fatal_error(error, path//': cannot create the HDF5 file')
-         self%failed = .true.
+         call fail(self, 'cannot create '//self%partial//' (no such folder, or not writable?)')
+         call fatal_error(error, self%message)
          return
       end if
       do i = 1, 3
@@ -117,11 +121,11 @@ contains
       if (stop_count(scene) > 0) call create_stops(self, scene, model)
       call attribute_text(self, 'status', status_running)
       call write_attributes(self, run_attributes(scene, model))
-      if (self%failed) then
-         call fatal_error(error, self%message)
-         return
+      if (.not. self%failed) then
+         call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, hdferr)
+         if (hdferr /= 0) call fail(self, write_failure(self))
       end if
-      call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, hdferr)
+      if (self%failed) call fatal_error(error, self%message)
    end subroutine open_file
 
    !> Buffer one row; write the buffer when full.
@@ -197,36 +201,82 @@ contains
       flush (0)
    end subroutine progress
 
-   !> Write what is buffered, the results as attributes and the final status; close the file.
+   !> Write what is buffered, the results as attributes and the final status; close the file
+   !> and, when the run went to its end ('complete' or 'diverged'), rename it onto the output.
+   !> When a write failed, the partial file is marked 'failed' if it still takes it, and stays.
    subroutine finish(self, summary, error)
       !> Recorder.
       class(hdf5_recorder), intent(inout) :: self
       !> Outcome of the run.
       type(run_summary), intent(in) :: summary
-      !> Set when the file could not be completed.
+      !> Set when the file could not be completed (or moved into place).
       type(error_type), allocatable, intent(out) :: error
       integer :: hdferr
+      logical :: ok
       if (self%file < 0) return
       call write_buffer(self)
+      if (allocated(summary%shocks) .and. .not. self%failed) then
+         call write_observations(self%file, summary%shocks, summary%statistics, self%scene%transient, &
+            & self%scene%batches, self%scene%bins, self%scene%rest_time, ok)
+         if (.not. ok) call fail(self, 'cannot write /impacts or /statistics')
+      end if
       call write_attributes(self, summary_attributes(summary))
-      call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, hdferr)
-      if (.not. self%failed) call attribute_text(self, 'status', summary%status)
-      call h5fclose_f(self%file, hdferr)
-      self%file = -1
-      if (summary%status == status_complete .and. .not. self%failed .and. hdferr == 0) &
-         & call remove_file(checkpoint_path(self%path))
-      if (self%failed .or. hdferr /= 0) then
-         if (.not. allocated(self%message)) self%message = self%path//': cannot close the HDF5 file'
+      if (.not. self%failed) then
+         call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, hdferr)
+         if (hdferr /= 0) call fail(self, write_failure(self))
+      end if
+      if (self%failed) then
+         ! best effort: a full disk may take nothing more, and the file then says 'running'
+         call text_attribute_on(self%file, 'status', status_failed, ok)
+         call text_attribute_on(self%file, 'message', self%message, ok)
+      else
+         call attribute_text(self, 'status', summary%status)
+      end if
+      call close_file(self)
+      if (self%failed) then
          call fatal_error(error, self%message)
+         return
+      end if
+      if (summary%status == status_complete .or. summary%status == status_diverged) then
+         call rename_file(self%partial, self%path, ok)
+         if (.not. ok) call fatal_error(error, self%path//': cannot move '//self%partial//' onto it')
       end if
    end subroutine finish
 
-   !> Open the output of an interrupted run to continue it: its series are cut back to the
-   !> `records` and `snapshots` of the checkpoint, its status is 'incomplete' again.
+   !> Close the datasets and the file (so that closing writes everything and says so).
+   subroutine close_file(self)
+      class(hdf5_recorder), intent(inout) :: self
+      integer :: hdferr, i
+      logical :: ok
+      ok = .true.
+      do i = 1, n_series
+         call close_dataset(self%series(i))
+      end do
+      call close_dataset(self%snap_t)
+      call close_dataset(self%snap_u)
+      call close_dataset(self%stops_u)
+      call close_dataset(self%stops_reaction)
+      call h5fclose_f(self%file, hdferr)
+      self%file = -1
+      if (hdferr /= 0 .or. .not. ok) call fail(self, write_failure(self))
+
+   contains
+
+      subroutine close_dataset(dset)
+         integer(hid_t), intent(inout) :: dset
+         if (dset < 0) return
+         call h5dclose_f(dset, hdferr)
+         ok = ok .and. hdferr == 0
+         dset = -1
+      end subroutine close_dataset
+   end subroutine close_file
+
+   !> Open the partial file of an interrupted run to continue it: its series are cut back to
+   !> the `records` and `snapshots` of the checkpoint, its status is 'running' again.
    subroutine reopen(self, path, scene, model, records, snapshots, error)
       !> Recorder.
       class(hdf5_recorder), intent(inout) :: self
-      !> Output file of the interrupted run.
+      !> Output file of the interrupted run (its partial file is reopened).
       character(len=*), intent(in) :: path
       !> Scene of the run.
       type(scene_type), intent(in) :: scene
@@ -238,10 +288,10 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: hdferr, i
       call prepare(self, path, scene, model)
-      call h5fopen_f(path, H5F_ACC_RDWR_F, self%file, hdferr)
+      call h5fopen_f(self%partial, H5F_ACC_RDWR_F, self%file, hdferr)
       if (hdferr /= 0) then
-         self%failed = .true.
-         call fatal_error(error, path//': cannot reopen the output of the interrupted run')
+         call fail(self, 'cannot reopen '//self%partial//', the output of the interrupted run')
+         call fatal_error(error, self%message)
          return
       end if
       do i = 1, n_series
@@ -270,25 +320,108 @@ contains
          integer(ik), intent(in) :: dims(:)
          call h5dopen_f(self%file, name, dset, hdferr)
          if (hdferr == 0) call h5dset_extent_f(dset, int(dims, hsize_t), hdferr)
-         if (hdferr /= 0) call fail(self, 'the output of the interrupted run has no series '//name)
+         if (hdferr /= 0) call fail(self, self%partial//', the output of the interrupted run, has no series '//name)
       end subroutine reopen_series
    end subroutine reopen
 
-   !> Write what is buffered, flush the file, then the checkpoint (atomically).
-   subroutine checkpoint(self, state)
+   !> Write what is buffered and flush the file; the records and snapshots now in it.
+   subroutine flush_file(self, records, snapshots)
+      !> Recorder.
       class(hdf5_recorder), intent(inout) :: self
-      type(state_type), intent(in) :: state
-      type(error_type), allocatable :: error
+      !> Records in the file.
+      integer(ik), intent(out) :: records
+      !> Snapshots in the file.
+      integer(ik), intent(out) :: snapshots
       integer :: hdferr
-      if (self%failed) return
       call write_buffer(self)
-      call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, hdferr)
-      if (hdferr /= 0) call fail(self, 'cannot flush the HDF5 file')
-      if (self%failed) return
-      call write_checkpoint(checkpoint_path(self%path), self%scene, state, int(self%written, ik), &
-         & int(self%snaps_written, ik), error)
-      if (allocated(error)) call fail(self, error%message)
-   end subroutine checkpoint
+      if (.not. self%failed) then
+         call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, hdferr)
+         if (hdferr /= 0) call fail(self, write_failure(self))
+      end if
+      records = int(self%written, ik)
+      snapshots = int(self%snaps_written, ik)
+   end subroutine flush_file
+
+   !> The file a run writes as it goes, renamed onto `output` when the run has gone to its end.
+   pure function partial_path(output) result(path)
+      !> Output file.
+      character(len=*), intent(in) :: output
+      character(len=:), allocatable :: path
+      path = output//'.partial'
+   end function partial_path
+
+   !> Refuse, before anything is written, an output that would destroy data: the input file
+   !> itself (under any name: same device and inode), an existing file at the output path that
+   !> is not a beamstops output (an HDF5 file with the root attributes `version` and `status`),
+   !> or a file at the partial path that is neither empty nor HDF5 (an empty or HDF5 file there
+   !> is taken for the partial output of an earlier run, which a kill may have left empty and a
+   !> failed write unreadable). The message names the file and says why.
+   subroutine check_output_path(output, input, error)
+      !> Output file.
+      character(len=*), intent(in) :: output
+      !> Input file of the run.
+      character(len=*), intent(in) :: input
+      !> Set when the output must not be written.
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: why
+      if (same_file(output, input)) then
+         call fatal_error(error, output//': is the input file '//input//'; writing the output there would '// &
+            & 'destroy it (name another output: -o OUT.h5, or &output file)')
+         return
+      end if
+      why = not_an_output(output, strict=.true.)
+      if (len(why) > 0) then
+         call fatal_error(error, output//': exists and is not a beamstops output ('//why//'); refusing to '// &
+            & 'overwrite it (name another output: -o OUT.h5, or &output file)')
+         return
+      end if
+      why = not_an_output(partial_path(output), strict=.false.)
+      if (len(why) > 0) call fatal_error(error, partial_path(output)//': exists and is not the partial output '// &
+         & 'of a beamstops run ('//why//'); refusing to overwrite it (move it away)')
+   end subroutine check_output_path
+
+   !> Why an existing `path` is not a beamstops output ('' when it is one, or does not exist);
+   !> not `strict`: any HDF5 file passes, and an empty file.
+   function not_an_output(path, strict) result(why)
+      character(len=*), intent(in) :: path
+      logical, intent(in) :: strict
+      character(len=:), allocatable :: why
+      integer(hid_t) :: file
+      integer :: hdferr, closing
+      integer(ik) :: bytes
+      logical :: hdf5_file, has_version, has_status
+      why = ''
+      if (.not. file_exists(path)) return
+      if (is_directory(path)) then
+         why = 'a folder'
+         return
+      end if
+      inquire (file=path, size=bytes)
+      if (.not. strict .and. bytes == 0) return
+      call h5open_f(hdferr)
+      call h5eset_auto_f(0, hdferr)
+      call h5fis_hdf5_f(path, hdf5_file, hdferr)
+      if (hdferr /= 0) then
+         why = 'unreadable'
+         return
+      end if
+      if (.not. hdf5_file) then
+         why = 'not an HDF5 file'
+         return
+      end if
+      if (.not. strict) return
+      call h5fopen_f(path, H5F_ACC_RDONLY_F, file, hdferr)
+      if (hdferr /= 0) then
+         why = 'an HDF5 file that cannot be opened'
+         return
+      end if
+      call h5aexists_f(file, 'version', has_version, hdferr)
+      if (hdferr /= 0) has_version = .false.
+      call h5aexists_f(file, 'status', has_status, hdferr)
+      if (hdferr /= 0) has_status = .false.
+      call h5fclose_f(file, closing)
+      if (.not. (has_version .and. has_status)) why = 'an HDF5 file without the root attributes version and status'
+   end function not_an_output
 
    !> What opening and reopening share: the run's names and sizes, the buffers, the HDF5
    !> library (its own error printing off: failures become messages).
@@ -299,6 +432,7 @@ contains
       type(model_type), intent(in) :: model
       integer :: hdferr
       self%path = path
+      self%partial = partial_path(path)
       self%scene = scene
       self%nodes = size(model%x)
       allocate (self%buffer(buffer_rows, n_columns))
@@ -361,7 +495,7 @@ contains
       call h5sselect_hyperslab_f(filespace, H5S_SELECT_SET_F, start(:rank), count(:rank), hdferr)
       call h5screate_simple_f(rank, count(:rank), memspace, hdferr)
       call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, count(:rank), hdferr, memspace, filespace)
-      if (hdferr /= 0) call fail(self, 'cannot write to the HDF5 file (disk full?)')
+      if (hdferr /= 0) call fail(self, write_failure(self))
       call h5sclose_f(memspace, hdferr)
       call h5sclose_f(filespace, hdferr)
    end subroutine append
@@ -397,7 +531,8 @@ contains
    subroutine dataset_units(dset, units)
       integer(hid_t), intent(in) :: dset
       character(len=*), intent(in) :: units
-      call text_attribute_on(dset, 'units', units)
+      logical :: ok
+      call text_attribute_on(dset, 'units', units, ok)
    end subroutine dataset_units
 
    !> Write the root attributes of a list (lists are datasets, not attributes: skipped).
@@ -423,14 +558,17 @@ contains
    subroutine attribute_text(self, name, value)
       class(hdf5_recorder), intent(inout) :: self
       character(len=*), intent(in) :: name, value
+      logical :: ok
       if (self%failed) return
-      call text_attribute_on(self%file, name, value)
+      call text_attribute_on(self%file, name, value, ok)
+      if (.not. ok) call fail(self, 'cannot write attribute '//name//' to '//self%partial)
    end subroutine attribute_text
 
-   !> Create or replace a scalar string attribute.
-   subroutine text_attribute_on(object, name, value)
+   !> Create or replace a scalar string attribute; ok is false on any HDF5 failure.
+   subroutine text_attribute_on(object, name, value, ok)
       integer(hid_t), intent(in) :: object
       character(len=*), intent(in) :: name, value
+      logical, intent(out) :: ok
       integer(hid_t) :: space, atype, attr
       integer(hsize_t) :: dims(1) = 1
       integer :: hdferr
@@ -441,7 +579,11 @@ contains
       call h5tcopy_f(H5T_C_S1, atype, hdferr)
       call h5tset_size_f(atype, int(max(1, len(value)), size_t), hdferr)
       call h5acreate_f(object, name, atype, space, attr, hdferr)
-      call h5awrite_f(attr, atype, value, dims, hdferr)
+      ok = hdferr == 0
+      if (ok) then
+         call h5awrite_f(attr, atype, value, dims, hdferr)
+         ok = hdferr == 0
+      end if
       call h5aclose_f(attr, hdferr)
       call h5tclose_f(atype, hdferr)
       call h5sclose_f(space, hdferr)
@@ -480,15 +622,23 @@ contains
       call h5screate_f(H5S_SCALAR_F, space, hdferr)
       call h5acreate_f(self%file, name, file_type, space, attr, hdferr)
       call h5awrite_f(attr, memory_type, value, hdferr)
-      if (hdferr /= 0) call fail(self, 'cannot write attribute '//name)
+      if (hdferr /= 0) call fail(self, 'cannot write attribute '//name//' to '//self%partial)
       call h5aclose_f(attr, hdferr)
       call h5sclose_f(space, hdferr)
    end subroutine attribute_scalar
 
+   !> Note the first failure: `what` went wrong with the output.
    subroutine fail(self, what)
       class(hdf5_recorder), intent(inout) :: self
       character(len=*), intent(in) :: what
       if (.not. self%failed) self%message = self%path//': '//what
       self%failed = .true.
    end subroutine fail
+
+   !> What a failed write says.
+   function write_failure(self) result(what)
+      class(hdf5_recorder), intent(in) :: self
+      character(len=:), allocatable :: what
+      what = 'cannot write to '//self%partial//' (disk full, or beyond the file-size limit?)'
+   end function write_failure
 end module beamstops_recorder_hdf5

@@ -8,23 +8,31 @@ The folder of a sweep (``-o DIR``)::
     DIR/points/NNNNN.h5  the program's own output
     DIR/points/NNNNN.json the point's record: parameters, status, message, figures, reductions
     DIR/summary.csv      one row per point (also summary.json, with full lists)
+    DIR/.lock            held (flock) by the sweep running into DIR; holds its pid and host
 
 Resuming: a point whose HDF5 says 'complete' (or 'diverged': the run went to its end)
 and whose record belongs to this specification is skipped; every other point (no
 output, an interrupted 'running' file, a failure) runs again. A folder holding another
 specification's results (another hash) is refused, so results never mix.
+
+One sweep at a time per folder: a sweep holds an exclusive lock (``fcntl.flock``) on
+``DIR/.lock`` while it runs, with its process id and host written in it; a second sweep (or
+a resume) into the same folder is refused with the first one's pid and host. The kernel
+drops the lock when its process dies, so the lock of a dead sweep is taken over (with a note).
 """
 
 from __future__ import annotations
 
 import csv
 import datetime
+import errno
 import io
 import json
 import math
 import os
 import shutil
 import signal
+import socket
 import sys
 import sysconfig
 import time
@@ -37,9 +45,12 @@ from .reductions import columns as reduction_columns
 from .spec import Spec
 from .worker import FINISHED, read_status, run_point
 
-__all__ = ["run_sweep", "read_summary", "find_program", "make_executor", "Outcome", "MANIFEST", "EXECUTORS"]
+__all__ = ["run_sweep", "read_summary", "find_program", "make_executor", "Outcome", "FolderLock", "MANIFEST",
+           "LOCK", "EXECUTORS"]
 
 MANIFEST = "sweep.json"
+#: The lock file of a sweep's folder.
+LOCK = ".lock"
 #: Executors of ``--executor``: auto (MPI under ``python -m mpi4py.futures``, else local), local, mpi.
 EXECUTORS = ("auto", "local", "mpi")
 _MANIFEST_FORMAT = 1
@@ -167,6 +178,96 @@ def _manifest(spec: Spec, program: str) -> dict[str, Any]:
             "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")}
 
 
+def check_folder(out: Path) -> None:
+    """Refuse a folder that is not a sweep's (a file, or a folder holding other things)."""
+    if (out / MANIFEST).is_file():
+        return
+    if out.exists() and (not out.is_dir() or any(p.name != LOCK for p in out.iterdir())):
+        raise ValueError(f"{out}: exists and is not a sweep folder (no {MANIFEST}); use another -o")
+
+
+class FolderLock:
+    """The exclusive lock of a sweep's folder: ``flock`` on ``DIR/.lock``, which holds the
+    holder's pid and host. :meth:`acquire` raises ValueError naming the holder when another
+    process holds it; a lock left by a dead process (the kernel released it) is taken over,
+    and :attr:`stale` then says whose it was. On a file system without ``flock`` (ENOLCK,
+    EOPNOTSUPP, ENOSYS) the pid and host in the file decide: a running process of this host,
+    or any process of another host, holds the folder."""
+
+    def __init__(self, folder: Path):
+        self.path = Path(folder) / LOCK
+        self.fd: Optional[int] = None
+        self.stale = ""
+        #: The file system refused flock: the lock is the pid in the file only.
+        self.unlocked = False
+
+    def acquire(self) -> "FolderLock":
+        import fcntl
+
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as exc:
+            holder = _read_holder(fd)
+            if exc.errno in (errno.ENOLCK, errno.EOPNOTSUPP, errno.ENOSYS) and not _alive_here(holder):
+                self.unlocked = True  # a file system without locks: the pid written in the file decides
+            else:
+                os.close(fd)
+                raise ValueError(f"{self.path.parent}: another sweep is running into this folder "
+                                 f"({holder or 'its process id is not written yet'}); wait for it to end, or stop "
+                                 "it, before running or resuming a sweep here") from None
+        self.stale = _read_holder(fd)
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"pid {os.getpid()} host {socket.gethostname()}\n".encode(), 0)
+        self.fd = fd
+        return self
+
+    def release(self) -> None:
+        import fcntl
+
+        if self.fd is None:
+            return
+        try:
+            os.ftruncate(self.fd, 0)
+            # explicitly: local workers forked while the lock was held share its descriptor
+            fcntl.flock(self.fd, fcntl.LOCK_UN)
+        except OSError:
+            pass
+        os.close(self.fd)
+        self.fd = None
+
+    def __enter__(self) -> "FolderLock":
+        return self.acquire()
+
+    def __exit__(self, *exc: Any) -> None:
+        self.release()
+
+
+def _alive_here(holder: str) -> bool:
+    """Whether ``pid N host H`` names a running process of this host (unknown hosts: assumed running)."""
+    words = holder.split()
+    if len(words) != 4 or words[0] != "pid" or words[2] != "host":
+        return False
+    if words[3] != socket.gethostname():
+        return True
+    try:
+        os.kill(int(words[1]), 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, ValueError):
+        return True
+    return True
+
+
+def _read_holder(fd: int) -> str:
+    """``pid N host H`` as written by the lock's holder ('' when empty)."""
+    try:
+        return os.pread(fd, 256, 0).decode("utf-8", "replace").strip()
+    except OSError:
+        return ""
+
+
 def prepare_folder(spec: Spec, out: Path, program: str) -> tuple[Path, Optional[str]]:
     """Create or reopen the sweep's folder; a note when the engine changed since the last call."""
     out = Path(out)
@@ -189,8 +290,7 @@ def prepare_folder(spec: Spec, out: Path, program: str) -> tuple[Path, Optional[
                     f"{old.get('program')}); this is {version()}, {program}: results may differ at round-off, "
                     "which impacts amplify; use a new folder for one build throughout")
     else:
-        if out.exists() and (not out.is_dir() or any(out.iterdir())):
-            raise ValueError(f"{out}: exists and is not a sweep folder (no {MANIFEST}); use another -o")
+        check_folder(out)
         (out / "points").mkdir(parents=True, exist_ok=True)
         (out / "spec.toml").write_text(spec.text, encoding="utf-8")
         tmp = manifest.with_name(MANIFEST + ".tmp")
@@ -248,9 +348,13 @@ def _clock(seconds: float) -> str:
     return f"{hours}:{rest // 60:02d}:{rest % 60:02d}" if hours else f"{rest // 60}:{rest % 60:02d}"
 
 
+#: The progress line: work done (each point weighted by its cost) and the points.
+_BAR = "{desc}: {percentage:3.0f}%|{bar}| {elapsed} elapsed, ~{remaining} left{postfix}"
+
+
 class Progress:
-    """Points done, failed and the time left, on one refreshed line (a terminal) or a line every
-    ``interval`` seconds (a log file, a batch job)."""
+    """Points done, failed and the time left (from the cost of the points done): a tqdm bar on
+    a terminal; on a log file (a batch job), the same text, one line every ``interval`` seconds."""
 
     def __init__(self, total: int, skipped: int, cost: float, stream: Optional[TextIO], interval: float = 10.0):
         self.total, self.skipped, self.cost = total, skipped, cost
@@ -261,29 +365,30 @@ class Progress:
         self.interval = interval
         self.start = time.perf_counter()
         self.last = -math.inf
+        self.bar: Any = None
+        if self.tty:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=cost, desc="sweep", bar_format=_BAR, file=stream, dynamic_ncols=True,
+                            mininterval=0.2, postfix=self.points())
+
+    def points(self) -> str:
+        return f"{self.skipped + self.done}/{self.total} points done, {self.failed} failed"
 
     def line(self) -> str:
-        elapsed = time.perf_counter() - self.start
-        finished = self.skipped + self.done
-        left = elapsed * (self.cost - self.done_cost) / self.done_cost if self.done_cost > 0 else math.inf
-        if finished >= self.total:
-            left = 0.0
-        width = 24
-        filled = int(width * finished / self.total) if self.total else width
-        bar = "#" * filled + "." * (width - filled)
-        return (f"sweep [{bar}] {finished}/{self.total} points done, {self.failed} failed, "
-                f"{_clock(elapsed)} elapsed, ~{_clock(left)} left")
+        from tqdm import tqdm
+
+        return tqdm.format_meter(min(self.done_cost, self.cost), self.cost, time.perf_counter() - self.start,
+                                 ncols=80, prefix="sweep", ascii=True, bar_format=_BAR, postfix=self.points())
 
     def show(self, force: bool = False) -> None:
         if self.stream is None:
             return
+        if self.bar is not None:
+            self.bar.set_postfix_str(self.points(), refresh=force)
+            return
         now = time.perf_counter()
-        if self.tty:
-            if force or now - self.last >= 0.2:
-                self.stream.write("\r" + self.line() + "\033[K")
-                self.stream.flush()
-                self.last = now
-        elif force or now - self.last >= self.interval:
+        if force or now - self.last >= self.interval:
             self.stream.write(self.line() + "\n")
             self.stream.flush()
             self.last = now
@@ -291,25 +396,30 @@ class Progress:
     def say(self, text: str) -> None:
         if self.stream is None:
             return
-        if self.tty:
-            self.stream.write("\r\033[K")
+        if self.bar is not None:
+            self.bar.write(text, file=self.stream)
+            return
         self.stream.write(text + "\n")
         self.stream.flush()
-        if self.tty:
-            self.show(force=True)
 
     def update(self, record: dict[str, Any], cost: float) -> None:
         self.done += 1
         self.done_cost += cost
         if record.get("status") == "failed":
             self.failed += 1
-        self.show()
+        if self.bar is not None:
+            self.bar.set_postfix_str(self.points(), refresh=False)
+            self.bar.update(cost)
+        else:
+            self.show()
 
     def close(self) -> None:
+        if self.bar is not None:
+            self.bar.set_postfix_str(self.points(), refresh=True)
+            self.bar.close()
+            self.bar = None
+            return
         self.show(force=True)
-        if self.tty and self.stream is not None:
-            self.stream.write("\n")
-            self.stream.flush()
 
 
 # ---------------------------------------------------------------------- summary
@@ -417,10 +527,21 @@ def run_sweep(spec: Spec, out: str | os.PathLike[str], *, executor: str = "auto"
 
     ``stream`` gets the progress and the notes (None: silent). A KeyboardInterrupt (or
     SIGTERM) stops the sweep after writing the summary of what is done; running the same
-    call again resumes it.
+    call again resumes it. The folder is locked while the sweep runs: another sweep into it
+    is refused (ValueError) with this one's pid and host.
     """
     _check_not_plain_mpi()
     program = find_program(program)
+    check_folder(Path(out))  # before the lock file is written into it
+    with FolderLock(Path(out)) as lock:
+        if lock.stale and stream is not None:
+            stream.write(f"sweep: note: took over the lock of a sweep that is no longer running ({lock.stale})\n")
+        return _run_sweep(spec, Path(out), executor=executor, jobs=jobs, program=program, timeout=timeout,
+                          stream=stream, interval=interval)
+
+
+def _run_sweep(spec: Spec, out: Path, *, executor: str, jobs: Optional[int], program: str,
+               timeout: Optional[float], stream: Optional[TextIO], interval: float) -> Outcome:
     timeout = timeout if timeout is not None else spec.timeout
     folder, note = prepare_folder(spec, Path(out), program)
     done, tasks = plan(spec, folder, program, timeout)

@@ -1,7 +1,9 @@
 """One point of a sweep, as an executor's task: write its namelist, run the program, reduce.
 
 The point runs as ``beamstops run NAME.nml -o NAME.h5`` in a child process, so a crash
-or a hang (``timeout``) fails that point only. Its record (parameters, status, message,
+or a hang (``timeout``) fails that point only. The program writes ``NAME.h5.partial`` and
+renames it onto ``NAME.h5`` only when the run went to its end (complete or diverged), so an
+existing ``NAME.h5`` is always a finished run. Its record (parameters, status, message,
 the run's figures and the reductions) is written next to its HDF5 file as ``NAME.json``
 (atomically) and returned. Tasks and records are plain data, so that any
 ``concurrent.futures`` executor carries them: local processes or MPI ranks.
@@ -145,7 +147,7 @@ def _run_program(task: dict[str, Any], nml: Path, h5: Path, record: dict[str, An
     record["wall_seconds"] = time.perf_counter() - start
     if done.returncode == 0:
         record["status"] = "complete"
-    elif done.returncode == 3:
+    elif done.returncode == 3 and h5.is_file():  # diverged: the program renamed its file into place
         record["status"] = "diverged"
         record["message"] = _message(done.stderr, done.stdout, done.returncode)
     else:

@@ -1,0 +1,193 @@
+!> The contact law at the tip, chosen by the scene: exact projection (Signorini, SPEC 4),
+!> normal compliance (SPEC 5) or none; and the tip step of the time loop built on it (the
+!> update of d and u along z = A^{-1} e_tip and the bookkeeping), shared by the reference
+!> and the fused paths. With a restitution coefficient e > 0 the projection acts on the
+!> combination (u^{n+1} + e u^{n-1})/(1 + e) (Paoli-Schatzman, SPEC 9); with mass redistribution
+!> (SPEC 10) the tip is massless, its reaction the residual of its row, and d stays the primary
+!> variable (no exact fix-up of the tip).
+module beamstops_contact_tip_contact
+   use beamstops_kinds, only: wp
+   use beamstops_scene, only: scene_type, law_none, law_signorini, law_compliance
+   use beamstops_model, only: model_type
+   use beamstops_state, only: state_type
+   use beamstops_band_solve, only: dot, diagonal_row
+   use beamstops_contact_mass_redistribution, only: massless_reaction
+   use beamstops_contact_tip_projection, only: project_tip
+   use beamstops_contact_compliance, only: spring_force, solve_spring_tip
+   use beamstops_ledger, only: move_on
+   implicit none
+   private
+   public :: spring_term, contact_law, tip_step, tip_step_massless, close_step, update, violation
+
+contains
+
+   !> The update of the step: d^n = d^{n-1} + x + c z, u^{n+1} = u^n + d^n.
+   pure subroutine update(x, c, z, d, u)
+      !> A^{-1} rhs and z = A^{-1} e_tip (n).
+      real(wp), intent(in), contiguous :: x(:), z(:)
+      !> Multiple of z (contact).
+      real(wp), intent(in) :: c
+      !> d^{n-1} and u^n on entry, d^n and u^{n+1} on return (n).
+      real(wp), intent(inout), contiguous :: d(:), u(:)
+      d = d + x + c*z
+      u = u + d
+   end subroutine update
+
+   !> dt^2 times the explicit part of the Newmark-weighted spring force, added to the tip row of
+   !> the right-hand side (normal compliance; zero otherwise).
+   pure function spring_term(scene, model, state) result(f)
+      !> Scene (law).
+      type(scene_type), intent(in) :: scene
+      !> Model (dt, beta).
+      type(model_type), intent(in) :: model
+      !> State (spring forces of u^{n-1}, u^n).
+      type(state_type), intent(in) :: state
+      real(wp) :: f
+      f = 0
+      if (scene%law == law_compliance) f = model%dt2*((1 - 2*model%beta)*state%p_now + model%beta*state%p_prev)
+   end function spring_term
+
+   !> The contact law at the tip: from the trial tip value u^n_tip + (A^{-1} rhs + d^{n-1})_tip,
+   !> the multiple c of z to add, the tip value, the reaction per unit mass of the step and
+   !> whether the tip is in contact (SPEC 4, 5).
+   subroutine contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
+      !> Scene (law, stops).
+      type(scene_type), intent(in) :: scene
+      !> Model (z, dt, beta).
+      type(model_type), intent(in) :: model
+      !> State (spring forces moved on under compliance).
+      type(state_type), intent(inout) :: state
+      !> Trial tip value.
+      real(wp), intent(in) :: trial
+      !> Multiple of z, tip value of u^{n+1}, reaction of the step.
+      real(wp), intent(out) :: c, tip_value, r_step
+      !> Whether the stops act.
+      logical, intent(out) :: contact
+      real(wp) :: p_next, e, u_old
+      select case (scene%law)
+      case (law_signorini)
+         if (scene%restitution > 0) then
+            ! (u^{n+1}_tip + e u^{n-1}_tip)/(1+e) in [g1, g2]: the projection of u^{n+1}_tip on the
+            ! bounds (1+e) g - e u^{n-1}_tip (u^{n-1} = u^n - d^{n-1}; the state is still at step n).
+            e = scene%restitution
+            u_old = state%u(model%tip) - state%d(model%tip)
+            call project_tip(trial, (1 + e)*scene%lower - e*u_old, (1 + e)*scene%upper - e*u_old, &
+               & model%z(model%tip), c, tip_value)
+         else
+            call project_tip(trial, scene%lower, scene%upper, model%z(model%tip), c, tip_value)
+         end if
+         contact = c /= 0
+         r_step = c/model%dt2
+      case (law_compliance)
+         tip_value = solve_spring_tip(trial, scene%lower, scene%upper, scene%stiffness_per_mass, &
+            & model%dt2*model%beta*model%z(model%tip))
+         p_next = spring_force(tip_value, scene%lower, scene%upper, scene%stiffness_per_mass)
+         c = model%dt2*model%beta*p_next
+         r_step = model%beta*p_next + (1 - 2*model%beta)*state%p_now + model%beta*state%p_prev
+         state%p_prev = state%p_now
+         state%p_now = p_next
+         contact = r_step /= 0
+      case default
+         c = 0
+         tip_value = trial
+         r_step = 0
+         contact = .false.
+      end select
+   end subroutine contact_law
+
+   !> The rest of a step once state%rhs holds A^{-1} rhs: the contact law at the tip, the
+   !> update d^n = d^{n-1} + A^{-1} rhs + c z, u^{n+1} = u^n + d^n, and close_step. Returns
+   !> u^n_tip, d^{n-1}_tip and the reaction r_{n-1} recorded with u^n.
+   subroutine tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      !> Model.
+      type(model_type), intent(in) :: model
+      !> State: rhs holds A^{-1} rhs on entry; u, d and the sums of step n on return.
+      type(state_type), intent(inout) :: state
+      !> Load average weight of the step and sigma_{n+1}.
+      real(wp), intent(in) :: weight, sigma_next
+      !> u^n_tip, d^{n-1}_tip and the reaction recorded with u^n.
+      real(wp), intent(out) :: u_tip_prev, d_tip_prev, r_prev
+      real(wp) :: trial, c, tip_value, r_step
+      logical :: contact
+      d_tip_prev = state%d(model%tip)
+      u_tip_prev = state%u(model%tip)
+      trial = u_tip_prev + (d_tip_prev + state%rhs(model%tip))
+      call contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
+      call update(state%rhs, c, model%z, state%d, state%u)
+      r_prev = state%reaction
+      call close_step(scene, model, state, contact, tip_value, dot(model%load, state%d), weight, r_step, &
+         & d_tip_prev, u_tip_prev, sigma_next, .true.)
+   end subroutine tip_step
+
+   !> tip_step with a massless tip (mass redistribution, SPEC 10): the same law and update (the
+   !> tip's row of rhs already holds its equilibrium), then the reaction of the step as the
+   !> residual of the tip's Newmark row (massless_reaction), and no exact fix-up of the tip: d
+   !> stays the primary variable.
+   subroutine tip_step_massless(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      !> Model.
+      type(model_type), intent(in) :: model
+      !> State: rhs holds A^{-1} rhs on entry; u, d and the sums of step n on return.
+      type(state_type), intent(inout) :: state
+      !> Load average weight of the step and sigma_{n+1}.
+      real(wp), intent(in) :: weight, sigma_next
+      !> u^n_tip, d^{n-1}_tip and the reaction recorded with u^n.
+      real(wp), intent(out) :: u_tip_prev, d_tip_prev, r_prev
+      real(wp) :: trial, c, tip_value, r_step, s_u, s_d_prev
+      logical :: contact
+      d_tip_prev = state%d(model%tip)
+      u_tip_prev = state%u(model%tip)
+      s_u = diagonal_row(model%stiffness_diagonals, state%u, model%tip)
+      s_d_prev = diagonal_row(model%stiffness_diagonals, state%d, model%tip)
+      trial = u_tip_prev + (d_tip_prev + state%rhs(model%tip))
+      call contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
+      call update(state%rhs, c, model%z, state%d, state%u)
+      r_step = massless_reaction(model%beta, weight, model%load(model%tip), s_u, s_d_prev, &
+         & diagonal_row(model%stiffness_diagonals, state%d, model%tip))
+      r_prev = state%reaction
+      call close_step(scene, model, state, contact, tip_value, dot(model%load, state%d), weight, r_step, &
+         & d_tip_prev, u_tip_prev, sigma_next, .false.)
+   end subroutine tip_step_massless
+
+   !> After the update: the exact tip value (Signorini), the violation of the stops, the energy
+   !> taken by the stops, and the sums of every path (beamstops_ledger's move_on).
+   pure subroutine close_step(scene, model, state, contact, tip_value, gd, weight, r_step, d_tip_prev, u_tip_prev, &
+      & sigma_next, exact)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      !> Model.
+      type(model_type), intent(in) :: model
+      !> State after the update.
+      type(state_type), intent(inout) :: state
+      !> Whether the stops act.
+      logical, intent(in) :: contact
+      !> Tip value of the law, g.d^n, weight, reaction, d^{n-1}_tip, u^n_tip and sigma_{n+1}.
+      real(wp), intent(in) :: tip_value, gd, weight, r_step, d_tip_prev, u_tip_prev, sigma_next
+      !> Whether a tip in contact is set exactly on the stop (not with a massless tip).
+      logical, intent(in) :: exact
+      integer :: tip
+      tip = model%tip
+      if (scene%law == law_signorini .and. contact .and. exact) then
+         ! The tip exactly on the stop, and d^n its exact increment (a tip resting on a stop
+         ! then has exactly zero velocity).
+         state%u(tip) = tip_value
+         state%d(tip) = tip_value - u_tip_prev
+      end if
+      if (scene%law /= law_none) state%max_violation = max(state%max_violation, violation(state%u(tip), scene))
+      call move_on(state, contact, gd, weight, r_step, sigma_next)
+      state%dissipated = state%dissipated - 0.5_wp*r_step*(state%d(tip) + d_tip_prev)
+   end subroutine close_step
+
+   !> Violation of the stops by a tip value (m).
+   pure function violation(u_tip, scene) result(v)
+      !> Tip value (m).
+      real(wp), intent(in) :: u_tip
+      !> Scene (stops).
+      type(scene_type), intent(in) :: scene
+      real(wp) :: v
+      v = max(u_tip - scene%upper, scene%lower - u_tip, 0.0_wp)
+   end function violation
+end module beamstops_contact_tip_contact

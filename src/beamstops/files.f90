@@ -1,0 +1,78 @@
+!> Files as the engine handles them: existence, identity (same file under two names),
+!> atomic replacement by rename, removal. The C library and src/beamstops/files.c do the work.
+module beamstops_files
+   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+   implicit none
+   private
+   public :: file_exists, is_directory, same_file, rename_file, remove_file
+
+   interface
+      function c_rename(from, to) bind(c, name='rename') result(status)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: from(*), to(*)
+         integer(c_int) :: status
+      end function c_rename
+      function c_remove(path) bind(c, name='remove') result(status)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int) :: status
+      end function c_remove
+      function c_same_file(a, b) bind(c, name='beamstops_same_file') result(same)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: a(*), b(*)
+         integer(c_int) :: same
+      end function c_same_file
+      function c_is_directory(path) bind(c, name='beamstops_is_directory') result(directory)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int) :: directory
+      end function c_is_directory
+   end interface
+
+contains
+
+   !> Whether `path` exists (a file or a directory).
+   function file_exists(path) result(exists)
+      !> Path.
+      character(len=*), intent(in) :: path
+      logical :: exists
+      inquire (file=path, exist=exists)
+   end function file_exists
+
+   !> Whether `path` is an existing directory.
+   function is_directory(path) result(directory)
+      !> Path.
+      character(len=*), intent(in) :: path
+      logical :: directory
+      directory = c_is_directory(path//c_null_char) == 1
+   end function is_directory
+
+   !> Whether two existing paths name the same file (same device and inode), however spelt.
+   function same_file(a, b) result(same)
+      !> First path.
+      character(len=*), intent(in) :: a
+      !> Second path.
+      character(len=*), intent(in) :: b
+      logical :: same
+      same = c_same_file(a//c_null_char, b//c_null_char) == 1
+   end function same_file
+
+   !> Rename `from` onto `to` (replacing `to` atomically when on the same file system).
+   subroutine rename_file(from, to, ok)
+      !> Existing file.
+      character(len=*), intent(in) :: from
+      !> New name.
+      character(len=*), intent(in) :: to
+      !> Whether the rename happened.
+      logical, intent(out) :: ok
+      ok = c_rename(from//c_null_char, to//c_null_char) == 0
+   end subroutine rename_file
+
+   !> Remove a file if it exists.
+   subroutine remove_file(path)
+      !> File.
+      character(len=*), intent(in) :: path
+      integer(c_int) :: status
+      status = c_remove(path//c_null_char)
+   end subroutine remove_file
+end module beamstops_files

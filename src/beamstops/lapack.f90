@@ -1,0 +1,161 @@
+!> The LAPACK routines the engine calls, declared once, and what each `info` code of theirs
+!> means, as a message (fortran-lang/stdlib's handle_<routine>_info, one per routine).
+!> Every other module calls LAPACK through these interfaces; none repeats them.
+module beamstops_lapack
+   use beamstops_kinds, only: wp
+   implicit none
+   private
+   public :: dpbtrf, dpbtrs, dsbgv, dgbtrf, dgbtrs, dsygv
+   public :: dpbtrf_message, dpbtrs_message, dsbgv_message, dgbtrf_message, dgbtrs_message, dsygv_message
+
+   interface
+      !> Cholesky factorization of a symmetric positive definite band matrix.
+      subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
+         import :: wp
+         character, intent(in) :: uplo
+         integer, intent(in) :: n, kd, ldab
+         real(wp), intent(inout) :: ab(ldab, *)
+         integer, intent(out) :: info
+      end subroutine dpbtrf
+      !> Solve with the band Cholesky factor of dpbtrf.
+      subroutine dpbtrs(uplo, n, kd, nrhs, ab, ldab, b, ldb, info)
+         import :: wp
+         character, intent(in) :: uplo
+         integer, intent(in) :: n, kd, nrhs, ldab, ldb
+         real(wp), intent(in) :: ab(ldab, *)
+         real(wp), intent(inout) :: b(ldb, *)
+         integer, intent(out) :: info
+      end subroutine dpbtrs
+      !> Generalized symmetric-definite band eigenproblem A x = lambda B x.
+      subroutine dsbgv(jobz, uplo, n, ka, kb, ab, ldab, bb, ldbb, w, z, ldz, work, info)
+         import :: wp
+         character, intent(in) :: jobz, uplo
+         integer, intent(in) :: n, ka, kb, ldab, ldbb, ldz
+         real(wp), intent(inout) :: ab(ldab, *), bb(ldbb, *)
+         real(wp), intent(out) :: w(*), z(ldz, *), work(*)
+         integer, intent(out) :: info
+      end subroutine dsbgv
+      !> LU factorization of a general band matrix.
+      subroutine dgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
+         import :: wp
+         integer, intent(in) :: m, n, kl, ku, ldab
+         real(wp), intent(inout) :: ab(ldab, *)
+         integer, intent(out) :: ipiv(*), info
+      end subroutine dgbtrf
+      !> Solve with the band LU factor of dgbtrf.
+      subroutine dgbtrs(trans, n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
+         import :: wp
+         character, intent(in) :: trans
+         integer, intent(in) :: n, kl, ku, nrhs, ldab, ipiv(*), ldb
+         real(wp), intent(in) :: ab(ldab, *)
+         real(wp), intent(inout) :: b(ldb, *)
+         integer, intent(out) :: info
+      end subroutine dgbtrs
+      !> Generalized symmetric-definite dense eigenproblem.
+      subroutine dsygv(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
+         import :: wp
+         integer, intent(in) :: itype, n, lda, ldb, lwork
+         character, intent(in) :: jobz, uplo
+         real(wp), intent(inout) :: a(lda, *), b(ldb, *)
+         real(wp), intent(out) :: w(*), work(*)
+         integer, intent(out) :: info
+      end subroutine dsygv
+   end interface
+
+contains
+
+   !> Message of dpbtrf's info (empty for 0); `what` names the matrix.
+   pure function dpbtrf_message(info, what) result(message)
+      !> LAPACK's info.
+      integer, intent(in) :: info
+      !> Name of the matrix factored.
+      character(len=*), intent(in) :: what
+      character(len=:), allocatable :: message
+      if (info > 0) then
+         message = 'dpbtrf: the leading minor of order '//itext(info)//' of '//what//' is not positive definite'
+      else
+         message = illegal('dpbtrf', info)
+      end if
+   end function dpbtrf_message
+
+   !> Message of dpbtrs's info (empty for 0).
+   pure function dpbtrs_message(info) result(message)
+      !> LAPACK's info.
+      integer, intent(in) :: info
+      character(len=:), allocatable :: message
+      message = illegal('dpbtrs', info)
+   end function dpbtrs_message
+
+   !> Message of dsbgv's info (empty for 0); n is the order of the problem.
+   pure function dsbgv_message(info, n) result(message)
+      !> LAPACK's info.
+      integer, intent(in) :: info
+      !> Order of the matrices.
+      integer, intent(in) :: n
+      character(len=:), allocatable :: message
+      if (info > n) then
+         message = 'dsbgv: the mass matrix is not positive definite (its factorization failed at order '// &
+            & itext(info - n)//')'
+      else if (info > 0) then
+         message = 'dsbgv: the tridiagonal QR iteration did not converge ('//itext(info)// &
+            & ' off-diagonal elements did not reach zero)'
+      else
+         message = illegal('dsbgv', info)
+      end if
+   end function dsbgv_message
+
+   !> Message of dgbtrf's info (empty for 0).
+   pure function dgbtrf_message(info) result(message)
+      !> LAPACK's info.
+      integer, intent(in) :: info
+      character(len=:), allocatable :: message
+      if (info > 0) then
+         message = 'dgbtrf: the matrix is exactly singular (U('//itext(info)//','//itext(info)//') = 0)'
+      else
+         message = illegal('dgbtrf', info)
+      end if
+   end function dgbtrf_message
+
+   !> Message of dgbtrs's info (empty for 0).
+   pure function dgbtrs_message(info) result(message)
+      !> LAPACK's info.
+      integer, intent(in) :: info
+      character(len=:), allocatable :: message
+      message = illegal('dgbtrs', info)
+   end function dgbtrs_message
+
+   !> Message of dsygv's info (empty for 0); n is the order of the problem.
+   pure function dsygv_message(info, n) result(message)
+      !> LAPACK's info.
+      integer, intent(in) :: info
+      !> Order of the matrices.
+      integer, intent(in) :: n
+      character(len=:), allocatable :: message
+      if (info > n) then
+         message = 'dsygv: the leading minor of order '//itext(info - n)//' of B is not positive definite'
+      else if (info > 0) then
+         message = 'dsygv: dsyev did not converge ('//itext(info)//' off-diagonal elements did not reach zero)'
+      else
+         message = illegal('dsygv', info)
+      end if
+   end function dsygv_message
+
+   !> The message of a negative info (an illegal argument), empty for 0.
+   pure function illegal(routine, info) result(message)
+      character(len=*), intent(in) :: routine
+      integer, intent(in) :: info
+      character(len=:), allocatable :: message
+      message = ''
+      if (info < 0) message = routine//': argument '//itext(-info)//' had an illegal value'
+      if (info > 0) message = routine//': failed with info = '//itext(info)
+   end function illegal
+
+   !> Text of an integer.
+   pure function itext(i) result(s)
+      integer, intent(in) :: i
+      character(len=:), allocatable :: s
+      character(len=16) :: buf
+      write (buf, '(i0)') i
+      s = trim(buf)
+   end function itext
+end module beamstops_lapack
