@@ -405,6 +405,17 @@ contains
          end associate
          text = text//trim(buf)//';'
       end do
+      if (summary%ensemble_members < 2 .or. .not. allocated(summary%ensemble%quantity)) return
+      write (buf, '(i0)') summary%ensemble_members
+      text = text//new_line('a')//'across '//trim(buf)//' members (95 %):'
+      do i = 1, size(names)
+         k = summary%ensemble%find(trim(names(i)))
+         if (k == 0) cycle
+         associate (q => summary%ensemble%quantity(k))
+            write (buf, '(1x,a,1x,es10.4," +- ",es8.2,1x,a)') trim(names(i)), q%value(1), q%half_width(1), q%unit
+         end associate
+         text = text//trim(buf)//';'
+      end do
    end function headline
 
    subroutine print_info(scene, model)

@@ -1,8 +1,12 @@
-!> The time loop of the paper's scheme in increment form (SPEC 4):
-!>   A (d^n - d^{n-1}) = dt^2 (G^n - S u^n),  u^{n+1} = u^n + d^n,
-!> followed by the contact law at the tip (or at the stops along the span, SPEC 7), with the
-!> energy bookkeeping of SPEC 6. The law is chosen once per call of advance.
-!> The loop allocates nothing and writes nothing: records go to a recorder.
+!> The time loop of the paper's scheme in increment form (SPEC 4), with Rayleigh damping (SPEC 8):
+!>   A (d^n - d^{n-1}) = dt^2 (G^n - S u^n) - dt C d^{n-1},  u^{n+1} = u^n + d^n,
+!> A = M + dt/2 C + dt^2 beta S, followed by the contact law at the tip (or at the stops along
+!> the span, SPEC 7; with restitution, SPEC 9), the rows of massless unknowns stepped as
+!> equilibria (mass redistribution, SPEC 10), and the energy bookkeeping of SPEC 6 (beamstops_ledger).
+!> The path is chosen once per call of advance: the paper's scheme (advance_fused, as before),
+!> with damping or massless unknowns (advance_fused_general), the reference (LAPACK) path, or the
+!> stops along the span. The start is beamstops_start's; the tip's contact law is in
+!> contact/tip_contact.f90. The loop allocates nothing and writes nothing: records go to a recorder.
 module beamstops_scheme
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_kinds, only: wp, ik

@@ -35,6 +35,10 @@ module beamstops_summary
       integer(ik) :: contact_phases = 0
       !> The statistics of the run (&statistics enabled; no quantities otherwise).
       type(statistics_table) :: statistics
+      !> With &ensemble members > 1: the statistics across the members that completed (mean and
+      !> t s/sqrt(K)), and their number K.
+      type(statistics_table) :: ensemble
+      integer :: ensemble_members = 0
       !> Its shocks, one column each in the order of shock_column_names (unallocated: none kept).
       real(wp), allocatable :: shocks(:, :)
       !> Records and snapshots written.

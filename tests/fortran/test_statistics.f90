@@ -105,7 +105,7 @@ contains
       call expect('in.nml: &statistics histogram_upper = 0.1 is out of range; allowed: histogram_upper > histogram_lower = 0.1 m')
       if (allocated(error)) return
       call validate_ensemble(0, 'in.nml', error)
-      call expect('in.nml: &statistics members = 0 is out of range; allowed: members >= 1'); if (allocated(error)) return
+      call expect('in.nml: &ensemble members = 0 is out of range; allowed: members >= 1'); if (allocated(error)) return
       call validate_statistics(1.0_wp, 10.0_wp, 2, 1, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
       call check(error, .not. allocated(error), 'batches = 2, bins = 1 accepted'); if (allocated(error)) return
       call validate_ensemble(1, 'in.nml', error)
@@ -738,7 +738,7 @@ contains
          call test_failed(error, 'no members accepted')
          return
       end if
-      if (error%message /= 'ensemble: &statistics members = 0 is out of range; allowed: members >= 1') then
+      if (error%message /= 'ensemble: &ensemble members = 0 is out of range; allowed: members >= 1') then
          call test_failed(error, 'message: '//error%message)
          return
       end if

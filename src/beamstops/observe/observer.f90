@@ -5,7 +5,7 @@
 !> are drained to the recorder and into the statistics.
 module beamstops_observe_observer
    use beamstops_kinds, only: wp, ik
-   use beamstops_error, only: error_type
+   use beamstops_error, only: error_type, fatal_error
    use beamstops_observe_shocks, only: shock_log, shock_row, new_shock_log, shock_row_values, n_shock_columns
    use beamstops_observe_statistics, only: statistics_type, statistics_table, new_statistics
    implicit none
@@ -43,6 +43,10 @@ module beamstops_observe_observer
       procedure :: drain
       !> Close the open shocks and the last batch at the end of the run; the table of statistics.
       procedure :: finish
+      !> The whole observer as one vector of reals (checkpoints).
+      procedure :: pack => pack_observer
+      !> The observer from a vector of pack.
+      procedure :: unpack => unpack_observer
    end type observer_type
 
 contains
@@ -158,4 +162,63 @@ contains
       table = self%stats%results()
       shocks = self%rows(:, :self%shocks_kept)
    end subroutine finish
+   !> The whole observer as reals: [m, rho, dt, dissipated_seen, kept, size of the log's vector,
+   !> the log's vector (shock_log%pack), size of the statistics' vector, its vector
+   !> (statistics_type%pack), the kept rows (13 per shock)].
+   subroutine pack_observer(self, values)
+      !> Observer (active).
+      class(observer_type), intent(in) :: self
+      !> Its state.
+      real(wp), allocatable, intent(out) :: values(:)
+      real(wp), allocatable :: log(:), stats(:)
+      call self%shocks%pack(log)
+      call self%stats%pack(stats)
+      values = [real(self%m, wp), self%rho, self%dt, self%dissipated_seen, real(self%shocks_kept, wp), &
+         & real(size(log), wp), log, real(size(stats), wp), stats]
+      if (self%shocks_kept > 0) values = [values, reshape(self%rows(:, :self%shocks_kept), [n_shock_columns* &
+         & self%shocks_kept])]
+   end subroutine pack_observer
+
+   !> Restore an observer from the vector of pack_observer.
+   subroutine unpack_observer(self, values, error)
+      !> Observer, active on return.
+      class(observer_type), intent(inout) :: self
+      !> The vector of pack_observer.
+      real(wp), intent(in) :: values(:)
+      !> Set when the vector is not an observer's.
+      type(error_type), allocatable, intent(out) :: error
+      integer :: at, n_log, n_stats
+      if (size(values) < 7) then
+         call fatal_error(error, 'the checkpoint''s shock log is damaged')
+         return
+      end if
+      self%m = nint(values(1))
+      self%rho = values(2)
+      self%dt = values(3)
+      self%dissipated_seen = values(4)
+      self%shocks_kept = nint(values(5))
+      n_log = nint(values(6))
+      at = 7
+      if (at + n_log > size(values)) then
+         call fatal_error(error, 'the checkpoint''s shock log is damaged')
+         return
+      end if
+      call self%shocks%unpack(values(at:at + n_log - 1), error)
+      if (allocated(error)) return
+      at = at + n_log
+      n_stats = nint(values(at))
+      if (at + n_stats + n_shock_columns*self%shocks_kept /= size(values)) then
+         call fatal_error(error, 'the checkpoint''s statistics are damaged')
+         return
+      end if
+      call self%stats%unpack(values(at + 1:at + n_stats), error)
+      if (allocated(error)) return
+      at = at + n_stats + 1
+      allocate (self%rows(n_shock_columns, max(256, self%shocks_kept)))
+      if (self%shocks_kept > 0) self%rows(:, :self%shocks_kept) = reshape(values(at:), &
+         & [n_shock_columns, self%shocks_kept])
+      if (allocated(self%u)) deallocate (self%u, self%r, self%e)
+      allocate (self%u(self%m), self%r(self%m), self%e(self%m))
+      self%active = .true.
+   end subroutine unpack_observer
 end module beamstops_observe_observer

@@ -183,7 +183,7 @@ contains
       character(len=*), intent(in) :: source
       !> Set when out of range.
       type(error_type), allocatable, intent(out) :: error
-      if (members < 1) call fatal_error(error, source//': &statistics members = '//fmt_int(int(members, ik))// &
+      if (members < 1) call fatal_error(error, source//': &ensemble members = '//fmt_int(int(members, ik))// &
          & ' is out of range; allowed: members >= 1')
    end subroutine validate_ensemble
 

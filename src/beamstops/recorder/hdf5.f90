@@ -217,7 +217,8 @@ contains
       call write_buffer(self)
       if (allocated(summary%shocks) .and. .not. self%failed) then
          call write_observations(self%file, summary%shocks, summary%statistics, self%scene%transient, &
-            & self%scene%batches, self%scene%bins, self%scene%rest_time, ok)
+            & self%scene%batches, self%scene%bins, self%scene%rest_time, ok, summary%ensemble, &
+            & summary%ensemble_members)
          if (.not. ok) call fail(self, 'cannot write /impacts or /statistics')
       end if
       call write_attributes(self, summary_attributes(summary))

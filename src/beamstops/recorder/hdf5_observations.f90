@@ -19,7 +19,7 @@ module beamstops_recorder_hdf5_observations
 contains
 
    !> Write /impacts and /statistics into an open file; `ok` false when a write failed.
-   subroutine write_observations(file, shocks, table, transient, batches, bins, rest_time, ok)
+   subroutine write_observations(file, shocks, table, transient, batches, bins, rest_time, ok, ensemble, members)
       !> Open HDF5 file.
       integer(hid_t), intent(in) :: file
       !> The shocks, one column each (n_shock_columns, shocks).
@@ -32,6 +32,10 @@ contains
       integer, intent(in) :: batches, bins
       !> False when something could not be written.
       logical, intent(out) :: ok
+      !> The statistics across the members of an ensemble (/ensemble, same layout as /statistics)
+      !> and their number (written when > 1).
+      type(statistics_table), intent(in), optional :: ensemble
+      integer, intent(in), optional :: members
       integer(hid_t) :: group
       integer :: hdferr, i
       real(wp), allocatable :: pair(:, :)
@@ -47,25 +51,38 @@ contains
       end do
       call h5gclose_f(group, hdferr)
       if (.not. allocated(table%quantity)) return
-      call h5gcreate_f(file, 'statistics', group, hdferr)
-      if (hdferr /= 0) then
-         ok = .false.
-         return
+      call write_table('statistics', table)
+      if (present(ensemble) .and. present(members)) then
+         if (members > 1 .and. allocated(ensemble%quantity)) call write_table('ensemble', ensemble, members)
       end if
-      call real_attribute(group, 'transient', transient)
-      call real_attribute(group, 'rest_time', rest_time)
-      call int_attribute(group, 'batches', int(batches, ik))
-      call int_attribute(group, 'bins', int(bins, ik))
-      do i = 1, size(table%quantity)
-         associate (q => table%quantity(i))
-            pair = reshape([q%value, q%half_width], [size(q%value), 2])
-            pair = transpose(pair)
-            call write_dataset(group, q%name, [2_hsize_t, size(q%value, kind=hsize_t)], pair, q%unit, q%axis)
-         end associate
-      end do
-      call h5gclose_f(group, hdferr)
 
    contains
+
+      !> A group of one dataset (count, 2) per quantity of `t`, with the settings as attributes.
+      subroutine write_table(name, t, members)
+         character(len=*), intent(in) :: name
+         type(statistics_table), intent(in) :: t
+         integer, intent(in), optional :: members
+         integer :: err
+         call h5gcreate_f(file, name, group, err)
+         if (err /= 0) then
+            ok = .false.
+            return
+         end if
+         call real_attribute(group, 'transient', transient)
+         call real_attribute(group, 'rest_time', rest_time)
+         call int_attribute(group, 'batches', int(batches, ik))
+         call int_attribute(group, 'bins', int(bins, ik))
+         if (present(members)) call int_attribute(group, 'members', int(members, ik))
+         do i = 1, size(t%quantity)
+            associate (q => t%quantity(i))
+               pair = reshape([q%value, q%half_width], [size(q%value), 2])
+               pair = transpose(pair)
+               call write_dataset(group, q%name, [2_hsize_t, size(q%value, kind=hsize_t)], pair, q%unit, q%axis)
+            end associate
+         end do
+         call h5gclose_f(group, err)
+      end subroutine write_table
 
       !> A dataset of `dims` (Fortran order) from `values`, with attributes units (and axis).
       subroutine write_dataset(where, name, dims, values, units, axis)
