@@ -213,7 +213,7 @@ contains
    !> alone. A member whose recorder fails or whose solution blows up stops (its summary says
    !> why) and the others go on. cpu_seconds of a summary is the member's share (1/K) of the
    !> group's time loop.
-   subroutine simulate_lockstep(scenes, model, recorders, summaries, error)
+   subroutine simulate_lockstep(scenes, model, recorders, summaries, error, initial_displacement)
       !> The members' validated scenes (K).
       type(scene_type), intent(in) :: scenes(:)
       !> The model built from scenes(1) (prepare_lockstep).
@@ -224,6 +224,9 @@ contains
       type(run_summary), intent(out) :: summaries(:)
       !> Set when the group cannot start (a member refused, or its start failed).
       type(error_type), allocatable, intent(out) :: error
+      !> Initial displacement u0 of the homogeneous unknown of each member (n, K), in place of
+      !> the model's (the members of an &ensemble: model%u0 plus their perturbation).
+      real(wp), intent(in), optional :: initial_displacement(:, :)
       type(operators_type) :: ops
       type(members_type) :: ms
       integer(ik) :: steps, last
@@ -240,7 +243,14 @@ contains
       call prepare_solver(model%factor, ops%solver)
       call prepare_diagonals(model%stiffness, ops%stiffness)
       call prepare_diagonals(model%mass, ops%mass)
-      call start_members(scenes, model, recorders, ms, error)
+      if (present(initial_displacement)) then
+         if (size(initial_displacement, 1) /= model%n .or. size(initial_displacement, 2) /= nk) then
+            call fatal_error(error, 'lockstep: the initial displacements must be (n, K) = ('// &
+               & fmt_int(int(model%n, ik))//', '//fmt_int(int(nk, ik))//')')
+            return
+         end if
+      end if
+      call start_members(scenes, model, recorders, ms, error, initial_displacement)
       if (allocated(error)) return
 
       steps = steps_of(scenes(1))
@@ -331,12 +341,13 @@ contains
    !> Start every member by the one-scene start (start_state, which hands each recorder its
    !> record of t = 0) with the member's load vector and initial velocity, and gather the
    !> states into the members' arrays.
-   subroutine start_members(scenes, model, recorders, ms, error)
+   subroutine start_members(scenes, model, recorders, ms, error, initial_displacement)
       type(scene_type), intent(in) :: scenes(:)
       type(model_type), intent(in) :: model
       class(recorder_type), intent(inout) :: recorders(:)
       type(members_type), intent(out) :: ms
       type(error_type), allocatable, intent(out) :: error
+      real(wp), intent(in), optional :: initial_displacement(:, :)
       type(model_type) :: member
       type(state_type) :: state
       real(wp), allocatable :: bh(:), b1(:)
@@ -389,6 +400,7 @@ contains
          end if
          member%v0(1::2) = -scenes(k)%amplitude*scenes(k)%omega*lift_shape(model%x(2:), scenes(k)%length)
          member%v0(2::2) = -scenes(k)%amplitude*scenes(k)%omega*lift_slope(model%x(2:), scenes(k)%length)
+         if (present(initial_displacement)) member%u0 = initial_displacement(:, k)
          call start_state(scenes(k), member, state, recorders(k), error)
          if (allocated(error)) then
             error%message = 'lockstep: member '//fmt_int(int(k, ik))//': '//error%message

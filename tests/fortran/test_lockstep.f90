@@ -13,6 +13,7 @@ module test_lockstep
       & simulate, record_count, snapshot_count, law_none, law_signorini, law_compliance, status_complete, &
       & prepare_lockstep, simulate_lockstep
    use beamstops_recorder, only: n_columns
+   use beamstops_ensemble, only: perturbation_of
    use beamstops_model, only: build_model
    use beamstops_band_solve, only: band_solver, band_diagonals, prepare_solver, prepare_diagonals, diagonal_matvec, &
       & forward_substitution, forward_substitution_energy, back_substitution, dot
@@ -43,6 +44,8 @@ contains
          & test_signorini_thirteen), &
          & new_unittest('K = 8, J = 100, Signorini, beta = 1/2', test_fine_eight), &
          & new_unittest('a member whose recorder fails stops; the others go on, still bit for bit', test_failing_member), &
+         & new_unittest('K = 6 ensemble members (perturbed initial displacements), Signorini: each as run alone', &
+         & test_ensemble), &
          & new_unittest('members that do not share A are refused', test_refused) &
          & ]
    end subroutine collect_lockstep
@@ -400,6 +403,43 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_failing_member
+
+   !> The members of an &ensemble (ensemble.f90: model%u0 plus perturbation_of(delta, seed, k)),
+   !> in lockstep through the initial displacements, against each run alone on a model with that
+   !> u0 (what run_members does).
+   subroutine test_ensemble(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: nk = 6
+      type(scene_type) :: scenes(nk)
+      type(array_recorder) :: group(nk), alone(nk)
+      type(run_summary) :: summaries(nk), summary
+      type(model_type) :: model, member_model
+      real(wp), allocatable :: u0(:, :)
+      integer :: k
+      scenes = base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.3_wp)
+      call prepare_lockstep(scenes, 'test group', model, error)
+      if (allocated(error)) return
+      allocate (u0(model%n, nk))
+      do k = 1, nk
+         u0(:, k) = model%u0 + perturbation_of(1.0e-4_wp, 7, k, model%n)
+         call reserve(group(k), scenes(k))
+      end do
+      call simulate_lockstep(scenes, model, group, summaries, error, initial_displacement=u0)
+      if (allocated(error)) return
+      do k = 1, nk
+         member_model = model
+         member_model%u0 = u0(:, k)
+         call reserve(alone(k), scenes(k))
+         call simulate(scenes(k), member_model, alone(k), summary, error)
+         if (allocated(error)) return
+         call same_summary(summaries(k), summary, 'ensemble member '//int_text(k), error)
+         if (allocated(error)) return
+         call same_records(group(k), alone(k), 'ensemble member '//int_text(k), error)
+         if (allocated(error)) return
+      end do
+      call check(error, any(group(1)%rows(2, :group(1)%filled) /= group(2)%rows(2, :group(2)%filled)), &
+         & 'the members differ')
+   end subroutine test_ensemble
 
    !> Members that differ in what A depends on, in the law, in the steps, or with stops along
    !> the span are refused, the message naming the member and the key.
