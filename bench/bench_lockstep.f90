@@ -1,8 +1,11 @@
 !> Lockstep ensembles against one member at a time (SPEC 13), measured in one run; prints a
 !> markdown table and `key value` lines, asserts nothing about time.
 !>
-!>   bench_lockstep [J [steps [repeats [every]]]]     defaults: 19, 200000 (J = 19) or
-!>                                                    3.8e6/J, 5, 0 (0: nothing recorded)
+!>   bench_lockstep [J [steps [repeats [every [observe]]]]]
+!>                                                    defaults: 19, 200000 (J = 19) or 3.8e6/J, 5,
+!>                                                    0 (0: nothing recorded), 1 (1: the shock log
+!>                                                    and statistics of every member, the scene's
+!>                                                    default; 0: &statistics off)
 !>
 !> Members: the paper's scene (Signorini, beta = 1/2, dt = 1e-6 s) with omega and amplitude
 !> varied per member. One at a time: start_state + advance of each member alone (the fused
@@ -27,7 +30,7 @@ program bench_lockstep
    implicit none
 
    integer, parameter :: groups(5) = [1, 2, 4, 8, 16]
-   integer :: elements, steps, repeats, every, rep, g, n
+   integer :: elements, steps, repeats, every, observe, rep, g, n
    real(wp), allocatable :: t_alone(:), t_group(:, :), t_latency(:), t_peak(:)
    real(wp) :: alone, latency, peak, ns, floor_chain, floor_ops, ops
    type(scene_type), allocatable :: scenes(:)
@@ -37,6 +40,7 @@ program bench_lockstep
    steps = int_argument(2, max(1000, int(3.8e6_wp/elements)))
    repeats = int_argument(3, 5)
    every = int_argument(4, 0)
+   observe = int_argument(5, 1)
    n = 2*elements
    allocate (t_alone(repeats), t_group(repeats, size(groups)), t_latency(repeats), t_peak(repeats))
    allocate (scenes(maxval(groups)))
@@ -60,6 +64,7 @@ program bench_lockstep
    call put('steps', real(steps, wp))
    call put('fma_latency_ns', latency)
    call put('fma_per_ns', peak)
+   call put('observe', real(observe, wp))
    call put('alone_ns_per_member_step', alone)
    print '(a)', ''
    write (line, '(a,i0,a,i0,a,i0,a)') '| J = ', elements, ' (n = ', n, '), ', steps, &
@@ -98,6 +103,7 @@ contains
          s(k)%record_every = huge(1)
          if (every > 0) s(k)%record_every = every
          s(k)%output_file = 'unused.h5'
+         s(k)%statistics = observe /= 0
       end do
    end subroutine members
 
