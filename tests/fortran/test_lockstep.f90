@@ -13,7 +13,10 @@ module test_lockstep
       & simulate, record_count, snapshot_count, law_none, law_signorini, law_compliance, status_complete, &
       & prepare_lockstep, simulate_lockstep
    use beamstops_recorder, only: n_columns
-   use beamstops_ensemble, only: perturbation_of
+   use beamstops_ensemble, only: perturbation_of, run_members
+   use beamstops_observe_statistics, only: statistics_table, ensemble_table
+   use beamstops_scheme, only: start_state, run_scheme
+   use beamstops_state, only: state_type
    use beamstops_model, only: build_model
    use beamstops_band_solve, only: band_solver, band_diagonals, prepare_solver, prepare_diagonals, diagonal_matvec, &
       & forward_substitution, forward_substitution_energy, back_substitution, dot
@@ -46,6 +49,8 @@ contains
          & new_unittest('a member whose recorder fails stops; the others go on, still bit for bit', test_failing_member), &
          & new_unittest('K = 6 ensemble members (perturbed initial displacements), Signorini: each as run alone', &
          & test_ensemble), &
+         & new_unittest('&ensemble members = 6: run_members (in lockstep) gives the table of the members run '// &
+         & 'one after the other', test_run_members), &
          & new_unittest('members that do not share A are refused', test_refused) &
          & ]
    end subroutine collect_lockstep
@@ -440,6 +445,64 @@ contains
       call check(error, any(group(1)%rows(2, :group(1)%filled) /= group(2)%rows(2, :group(2)%filled)), &
          & 'the members differ')
    end subroutine test_ensemble
+
+   !> run_members (ensemble.f90, members 2..K in lockstep) against the members run one after the
+   !> other as it ran them before (start_state + run_scheme on a model with the perturbed u0, no
+   !> records): the same ensemble table, bit for bit.
+   subroutine test_run_members(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene, member_scene
+      type(model_type) :: model, member_model
+      type(array_recorder) :: rec
+      type(array_recorder) :: quiet
+      type(run_summary) :: summary, member
+      type(state_type) :: state
+      type(statistics_table) :: tables(6), reference
+      integer :: k
+      scene = base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.3_wp)
+      scene%members = 6
+      scene%perturbation = 1.0e-4_wp
+      scene%seed = 3
+      call prepare_run(scene, 'test ensemble', model, error)
+      if (allocated(error)) return
+      call reserve(rec, scene)
+      member_scene = scene
+      member_scene%members = 1
+      call simulate(member_scene, model, rec, summary, error)
+      if (allocated(error)) return
+      tables(1) = summary%statistics
+      call run_members(scene, model, summary, error)
+      if (allocated(error)) return
+      member_scene%snapshot_every = 0
+      member_scene%record_every = huge(1)
+      call quiet%reserve(1_ik, 0_ik, scene%elements + 1)
+      do k = 2, 6
+         member_model = model
+         member_model%u0 = model%u0 + perturbation_of(scene%perturbation, scene%seed, k, size(model%u0))
+         quiet%filled = 0
+         call start_state(member_scene, member_model, state, quiet, error)
+         if (allocated(error)) return
+         member = run_summary()
+         call run_scheme(member_scene, member_model, state, quiet, member)
+         call check(error, member%status == status_complete, 'member '//int_text(k)//' completes')
+         if (allocated(error)) return
+         tables(k) = member%statistics
+      end do
+      call ensemble_table(tables, reference, error)
+      if (allocated(error)) return
+      call check(error, summary%ensemble_members == 6, 'six members: '//int_text(summary%ensemble_members))
+      if (allocated(error)) return
+      call check(error, allocated(reference%quantity), 'an ensemble table')
+      if (allocated(error)) return
+      call check(error, size(reference%quantity) > 0, 'an ensemble table with quantities')
+      if (allocated(error)) return
+      block
+         type(run_summary) :: a, b
+         a%statistics = summary%ensemble
+         b%statistics = reference
+         call same_observations(a, b, 'the ensemble table', error)
+      end block
+   end subroutine test_run_members
 
    !> Members that differ in what A depends on, in the law, in the steps, or with stops along
    !> the span are refused, the message naming the member and the key.
