@@ -109,7 +109,8 @@ contains
 
    !> Whether K scenes can run in lockstep with `model` (built from the first of them): the
    !> same A (mesh, beam, dt, beta), the same law and compliance stiffness, the same number of
-   !> steps, the paper's scheme (no damping, restitution or mass redistribution), no stops
+   !> steps, the paper's scheme on the full model (no damping, restitution, mass redistribution
+   !> or reduced model), no stops
    !> along the span, J >= 4. The message names the
    !> first member and key that differ.
    subroutine check_lockstep(scenes, model, error)
@@ -138,6 +139,11 @@ contains
          if (stop_count(scenes(k)) > 0) then
             call fatal_error(error, 'lockstep: member '//fmt_int(int(k, ik))//' has stops along the span '// &
                & '(&stops nodes or x); the lockstep path runs tip stops only: run it alone')
+            return
+         end if
+         if (scenes(k)%modes > 0) then
+            call fatal_error(error, 'lockstep: member '//fmt_int(int(k, ik))//' is a reduced model (&mesh modes = '// &
+               & fmt_int(int(scenes(k)%modes, ik))//'); the lockstep path runs the full model: run it alone')
             return
          end if
          if (scenes(k)%restitution /= 0 .or. scenes(k)%damping_mass /= 0 .or. scenes(k)%damping_stiffness /= 0 &

@@ -542,6 +542,10 @@ contains
       call expect_refusal(scenes, 'member 3 asks for damping, restitution or mass redistribution', error)
       if (allocated(error)) return
       scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      scenes(2)%modes = 6
+      call expect_refusal(scenes, 'member 2 is a reduced model', error)
+      if (allocated(error)) return
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
       scenes(1)%damping_mass = 1.0_wp
       call expect_refusal(scenes, 'member 1 asks for damping', error)
       if (allocated(error)) return
