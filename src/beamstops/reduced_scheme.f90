@@ -19,7 +19,7 @@ module beamstops_reduced_scheme
    use beamstops_reduced, only: reduced_model_type, block_solver_type, block_solve, reduced_stiffness_product, &
       & reduced_mass_product
    use beamstops_clock, only: thread_cpu_seconds
-   use beamstops_forcing, only: load_average, support_position
+   use beamstops_forcing, only: load_average, support_position, load_rotation, start_loads, next_load
    use beamstops_contact_tip_projection, only: project_tip
    use beamstops_contact_compliance, only: spring_force, solve_spring_tip
    use beamstops_contact_span_stops, only: span_stops_type, span_work_type, new_span_work, span_energy
@@ -34,18 +34,6 @@ module beamstops_reduced_scheme
 
    !> Steps between progress reports and divergence checks.
    integer(ik), parameter :: reduced_block_steps = 8192_ik
-
-   ! The load averages step after step by rotation, as the full loop's: a private copy of the
-   ! load_rotation that the physics branch moves into beamstops_forcing (same names, same
-   ! arithmetic); after the merge, use beamstops_forcing's and delete this one.
-   type :: load_rotation
-      integer(ik) :: k = 0
-      real(wp) :: sigma = 0, cosine = 0
-      real(wp) :: cos_step = 1, sin_step = 0
-      real(wp) :: dt = 0, omega = 0
-      logical :: centered = .true.
-   end type load_rotation
-   integer(ik), parameter :: restart_every = 64
 
    !> Everything the reduced loop carries from step n to step n + 1.
    type :: reduced_state_type
@@ -435,56 +423,6 @@ contains
       end do
       state%step = done + 1
    end subroutine advance_reduced
-
-   !> load_rotation at step k: from load_average at the last multiple of restart_every, then
-   !> rotated, so that the value of every step is the same however the run is cut into calls.
-   pure subroutine start_loads(loads, k, dt, omega, centered)
-      type(load_rotation), intent(out) :: loads
-      integer(ik), intent(in) :: k
-      real(wp), intent(in) :: dt, omega
-      logical, intent(in) :: centered
-      loads%dt = dt
-      loads%omega = omega
-      loads%centered = centered
-      call restart_loads(loads, (k/restart_every)*restart_every)
-      do while (loads%k < k)
-         call next_load(loads)
-      end do
-   end subroutine start_loads
-
-   !> load_rotation at step k, exact: load_average and the same centre and factor for the cosine.
-   pure subroutine restart_loads(loads, k)
-      type(load_rotation), intent(inout) :: loads
-      integer(ik), intent(in) :: k
-      real(wp) :: centre, x, factor
-      centre = real(k, wp)*loads%dt
-      if (.not. loads%centered) centre = (real(k, wp) + 0.5_wp)*loads%dt
-      x = 0.5_wp*loads%omega*loads%dt
-      if (abs(x) < 1.0e-8_wp) then
-         factor = 1 - x**2/6
-      else
-         factor = sin(x)/x
-      end if
-      loads%k = k
-      loads%sigma = load_average(k, loads%dt, loads%omega, loads%centered)
-      loads%cosine = factor*cos(loads%omega*centre)
-      loads%cos_step = cos(loads%omega*loads%dt)
-      loads%sin_step = sin(loads%omega*loads%dt)
-   end subroutine restart_loads
-
-   !> load_rotation moved on to step k + 1.
-   pure subroutine next_load(loads)
-      type(load_rotation), intent(inout) :: loads
-      real(wp) :: sigma
-      if (mod(loads%k + 1, restart_every) == 0) then
-         call restart_loads(loads, loads%k + 1)
-         return
-      end if
-      sigma = loads%sigma*loads%cos_step + loads%cosine*loads%sin_step
-      loads%cosine = loads%cosine*loads%cos_step - loads%sigma*loads%sin_step
-      loads%sigma = sigma
-      loads%k = loads%k + 1
-   end subroutine next_load
 
    !> The tip value of a reduced vector: its tip coordinate when the tip is a stop, else T(tip, :) q.
    pure function tip_value_of(reduced, q) result(u)
