@@ -19,6 +19,7 @@ module beamstops_reduced_scheme
    use beamstops_reduced, only: reduced_model_type, block_solver_type, block_solve, reduced_stiffness_product, &
       & reduced_mass_product
    use beamstops_clock, only: thread_cpu_seconds
+   use beamstops_ledger, only: first_events
    use beamstops_forcing, only: load_average, support_position, load_rotation, start_loads, next_load
    use beamstops_contact_tip_projection, only: project_tip
    use beamstops_contact_compliance, only: spring_force, solve_spring_tip
@@ -306,9 +307,7 @@ contains
       pt = tip_coordinate(reduced)
       span = reduced%stops%m > 0
       enforce = scene%law == law_signorini
-      next_record = next_multiple(state%step, int(scene%record_every, ik))
-      next_snapshot = huge(step)
-      if (scene%snapshot_every > 0) next_snapshot = next_multiple(state%step, int(scene%snapshot_every, ik))
+      call first_events(scene, state%step, next_record, next_snapshot)
       done = state%step - 1
       u_old_su = 0
       u_tip_prev = 0
@@ -812,13 +811,6 @@ contains
          end do
       end do
    end subroutine physical_shape
-
-   !> The first multiple of `every` at or after `step`.
-   pure function next_multiple(step, every) result(m)
-      integer(ik), intent(in) :: step, every
-      integer(ik) :: m
-      m = ((step + every - 1)/every)*every
-   end function next_multiple
 
    !> Text of a real for messages.
    function real_text(x) result(s)
