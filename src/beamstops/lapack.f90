@@ -5,8 +5,9 @@ module beamstops_lapack
    use beamstops_kinds, only: wp
    implicit none
    private
-   public :: dpbtrf, dpbtrs, dsbgv, dgbtrf, dgbtrs, dsygv
-   public :: dpbtrf_message, dpbtrs_message, dsbgv_message, dgbtrf_message, dgbtrs_message, dsygv_message
+   public :: dpbtrf, dpbtrs, dsbgv, dsbgvx, dgbtrf, dgbtrs, dpotrf, dsygv
+   public :: dpbtrf_message, dpbtrs_message, dsbgv_message, dsbgvx_message, dgbtrf_message, dgbtrs_message
+   public :: dpotrf_message, dsygv_message
 
    interface
       !> Cholesky factorization of a symmetric positive definite band matrix.
@@ -35,6 +36,18 @@ module beamstops_lapack
          real(wp), intent(out) :: w(*), z(ldz, *), work(*)
          integer, intent(out) :: info
       end subroutine dsbgv
+      !> Selected eigenvalues (and eigenvectors) of a generalized symmetric-definite band
+      !> eigenproblem A x = lambda B x.
+      subroutine dsbgvx(jobz, range, uplo, n, ka, kb, ab, ldab, bb, ldbb, q, ldq, vl, vu, il, iu, abstol, m, w, &
+         & z, ldz, work, iwork, ifail, info)
+         import :: wp
+         character, intent(in) :: jobz, range, uplo
+         integer, intent(in) :: n, ka, kb, ldab, ldbb, ldq, il, iu, ldz
+         real(wp), intent(inout) :: ab(ldab, *), bb(ldbb, *)
+         real(wp), intent(out) :: q(ldq, *), w(*), z(ldz, *), work(*)
+         real(wp), intent(in) :: vl, vu, abstol
+         integer, intent(out) :: m, iwork(*), ifail(*), info
+      end subroutine dsbgvx
       !> LU factorization of a general band matrix.
       subroutine dgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
          import :: wp
@@ -51,6 +64,14 @@ module beamstops_lapack
          real(wp), intent(inout) :: b(ldb, *)
          integer, intent(out) :: info
       end subroutine dgbtrs
+      !> Cholesky factorization of a dense symmetric positive definite matrix.
+      subroutine dpotrf(uplo, n, a, lda, info)
+         import :: wp
+         character, intent(in) :: uplo
+         integer, intent(in) :: n, lda
+         real(wp), intent(inout) :: a(lda, *)
+         integer, intent(out) :: info
+      end subroutine dpotrf
       !> Generalized symmetric-definite dense eigenproblem.
       subroutine dsygv(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
          import :: wp
@@ -104,6 +125,23 @@ contains
       end if
    end function dsbgv_message
 
+   !> Message of dsbgvx's info (empty for 0); n is the order of the problem.
+   pure function dsbgvx_message(info, n) result(message)
+      !> LAPACK's info.
+      integer, intent(in) :: info
+      !> Order of the matrices.
+      integer, intent(in) :: n
+      character(len=:), allocatable :: message
+      if (info > n) then
+         message = 'dsbgvx: the mass matrix is not positive definite (its factorization failed at order '// &
+            & itext(info - n)//')'
+      else if (info > 0) then
+         message = 'dsbgvx: '//itext(info)//' eigenvectors did not converge'
+      else
+         message = illegal('dsbgvx', info)
+      end if
+   end function dsbgvx_message
+
    !> Message of dgbtrf's info (empty for 0).
    pure function dgbtrf_message(info) result(message)
       !> LAPACK's info.
@@ -123,6 +161,20 @@ contains
       character(len=:), allocatable :: message
       message = illegal('dgbtrs', info)
    end function dgbtrs_message
+
+   !> Message of dpotrf's info (empty for 0); `what` names the matrix.
+   pure function dpotrf_message(info, what) result(message)
+      !> LAPACK's info.
+      integer, intent(in) :: info
+      !> Name of the matrix factored.
+      character(len=*), intent(in) :: what
+      character(len=:), allocatable :: message
+      if (info > 0) then
+         message = 'dpotrf: the leading minor of order '//itext(info)//' of '//what//' is not positive definite'
+      else
+         message = illegal('dpotrf', info)
+      end if
+   end function dpotrf_message
 
    !> Message of dsygv's info (empty for 0); n is the order of the problem.
    pure function dsygv_message(info, n) result(message)
