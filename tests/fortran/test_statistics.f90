@@ -10,7 +10,7 @@ module test_statistics
    use beamstops_observe_shocks, only: shock_log, shock_row, new_shock_log, shock_row_values
    use beamstops_observe_statistics, only: statistics_type, new_statistics, validate_statistics, validate_ensemble, &
       & statistics_table, quantity_type, ensemble_table, student_t_quantile, student_t_cdf
-   use test_shocks, only: uniform, same_bits
+   use test_shocks, only: uniform, same_bits, expect_message
    implicit none
    private
    public :: collect_statistics
@@ -89,40 +89,35 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(statistics_type) :: stats
       call validate_statistics(1.0_wp, 10.0_wp, 1, 10, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
-      call expect('in.nml: &statistics batches = 1 is out of range; allowed: batches >= 2'); if (allocated(error)) return
+      call expect_message(error, 'in.nml: &statistics batches = 1 is out of range; allowed: batches >= 2')
+      if (allocated(error)) return
       call validate_statistics(10.0_wp, 10.0_wp, 20, 10, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
-      call expect('in.nml: &statistics transient = 10 is out of range; allowed: 0 <= transient < t_end = 10 s')
+      call expect_message(error, 'in.nml: &statistics transient = 10 is out of range; allowed: 0 <= transient < t_end ='// &
+         & ' 10 s')
       if (allocated(error)) return
       call validate_statistics(-1.0_wp, 10.0_wp, 20, 10, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
-      call expect('in.nml: &statistics transient = -1 is out of range; allowed: 0 <= transient < t_end = 10 s')
+      call expect_message(error, 'in.nml: &statistics transient = -1 is out of range; allowed: 0 <= transient < t_end ='// &
+         & ' 10 s')
       if (allocated(error)) return
       call validate_statistics(1.0_wp, 10.0_wp, 20, 10, -2.0e-3_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
-      call expect('in.nml: &statistics rest_time = -0.002 is out of range; allowed: rest_time >= 0 s')
+      call expect_message(error, 'in.nml: &statistics rest_time = -0.002 is out of range; allowed: rest_time >= 0 s')
       if (allocated(error)) return
       call validate_statistics(1.0_wp, 10.0_wp, 20, 0, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
-      call expect('in.nml: &statistics bins = 0 is out of range; allowed: bins >= 1'); if (allocated(error)) return
+      call expect_message(error, 'in.nml: &statistics bins = 0 is out of range; allowed: bins >= 1')
+      if (allocated(error)) return
       call validate_statistics(1.0_wp, 10.0_wp, 20, 10, 0.0_wp, 0.1_wp, 0.1_wp, 'in.nml', error)
-      call expect('in.nml: &statistics histogram_upper = 0.1 is out of range; allowed: histogram_upper > histogram_lower = 0.1 m')
+      call expect_message(error, 'in.nml: &statistics histogram_upper = 0.1 is out of range; allowed: histogram_upper >'// &
+         & ' histogram_lower = 0.1 m')
       if (allocated(error)) return
       call validate_ensemble(0, 'in.nml', error)
-      call expect('in.nml: &ensemble members = 0 is out of range; allowed: members >= 1'); if (allocated(error)) return
+      call expect_message(error, 'in.nml: &ensemble members = 0 is out of range; allowed: members >= 1')
+      if (allocated(error)) return
       call validate_statistics(1.0_wp, 10.0_wp, 2, 1, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
       call check(error, .not. allocated(error), 'batches = 2, bins = 1 accepted'); if (allocated(error)) return
       call validate_ensemble(1, 'in.nml', error)
       call check(error, .not. allocated(error), 'members = 1 accepted'); if (allocated(error)) return
       call new_statistics(stats, 1, 0.0_wp, 1.0_wp, 1, 4, -1.0_wp, 1.0_wp, error)
-      call expect('statistics: &statistics batches = 1 is out of range; allowed: batches >= 2')
-   contains
-      subroutine expect(message)
-         character(len=*), intent(in) :: message
-         if (.not. allocated(error)) then
-            call test_failed(error, 'no error; expected "'//message//'"')
-         else if (error%message /= message) then
-            call test_failed(error, 'message "'//error%message//'", expected "'//message//'"')
-         else
-            deallocate (error)
-         end if
-      end subroutine expect
+      call expect_message(error, 'statistics: &statistics batches = 1 is out of range; allowed: batches >= 2')
    end subroutine test_bad_inputs
 
    !> Feed a one-stop sequence (t_k = k dt) to a shock log and to statistics, shocks drained every
@@ -662,47 +657,40 @@ contains
       if (allocated(error)) return
       call b%pack(vb)
       call b%unpack(va(1:n - 1), error)
-      call expect('statistics: unpack: '//int_text(n - 1)//' values, header length '//int_text(n)// &
+      call expect_message(error, 'statistics: unpack: '//int_text(n - 1)//' values, header length '//int_text(n)// &
          & '; the header (m = 2, batches = 4, bins = 7) needs '//int_text(n))
       if (allocated(error)) return
       call b%unpack(va(1:3), error)
-      call expect('statistics: unpack: 3 values, too short for the header (6)'); if (allocated(error)) return
+      call expect_message(error, 'statistics: unpack: 3 values, too short for the header (6)'); if (allocated(error)) return
       call b%unpack([va, 1.0_wp], error)
-      call expect('statistics: unpack: '//int_text(n + 1)//' values, header length '//int_text(n)// &
+      call expect_message(error, 'statistics: unpack: '//int_text(n + 1)//' values, header length '//int_text(n)// &
          & '; the header (m = 2, batches = 4, bins = 7) needs '//int_text(n))
       if (allocated(error)) return
       call new_shock_log(log, 1, 0.0_wp, [0.0_wp], error)
       if (allocated(error)) return
       call log%pack(vc)
       call b%unpack(vc, error)
-      call expect('statistics: unpack: tag 7301, version 1; expected tag 7302, version 1'); if (allocated(error)) return
+      call expect_message(error, 'statistics: unpack: tag 7301, version 1; expected tag 7302, version 1')
+      if (allocated(error)) return
       vc = va
       vc(5) = 1
       call b%unpack(vc, error)
-      call expect('statistics: unpack: header m = 2, batches = 1, bins = 7 is inconsistent'); if (allocated(error)) return
+      call expect_message(error, 'statistics: unpack: header m = 2, batches = 1, bins = 7 is inconsistent')
+      if (allocated(error)) return
       vc = va
       vc(6 + 7) = 5
       call b%unpack(vc, error)
-      call expect('statistics: unpack: value 13 = 5 is out of range (expected an integer, or a batch or bin index '// &
+      call expect_message(error, 'statistics: unpack: value 13 = 5 is out of range (expected an integer, or a batch or'// &
+         & ' bin index '// &
          & 'in range)'); if (allocated(error)) return
       vc = va
       vc(6 + 9) = 0.5_wp
       call b%unpack(vc, error)
-      call expect('statistics: unpack: value 15 = 0.5 is out of range (expected an integer, or a batch or bin index '// &
+      call expect_message(error, 'statistics: unpack: value 15 = 0.5 is out of range (expected an integer, or a batch or'// &
+         & ' bin index '// &
          & 'in range)'); if (allocated(error)) return
       call b%pack(vc)
       call check(error, size(vb) == size(vc) .and. all(same_bits(vb, vc)), 'unchanged after the errors')
-   contains
-      subroutine expect(message)
-         character(len=*), intent(in) :: message
-         if (.not. allocated(error)) then
-            call test_failed(error, 'no error; expected "'//message//'"')
-         else if (error%message /= message) then
-            call test_failed(error, 'message "'//error%message//'", expected "'//message//'"')
-         else
-            deallocate (error)
-         end if
-      end subroutine expect
    end subroutine test_unpack_bad
 
    subroutine test_ensemble(error)
