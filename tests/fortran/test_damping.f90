@@ -3,7 +3,7 @@
 module test_damping
    use testing
    use test_support, only: run_recorded, band_eigenvalues
-   use physics_support, only: open_run, modes, peaks
+   use physics_support, only: tube_scene, open_run, modes, peaks
    use beamstops, only: ik, scene_type, model_type, build_model, state_type, array_recorder, run_summary, &
       & law_none, law_signorini, steps_of
    use beamstops_scheme, only: advance
@@ -214,18 +214,7 @@ contains
       type(scene_type) :: scene
       type(array_recorder) :: rec
       type(run_summary) :: summary
-      scene%length = 1.5_wp
-      scene%k2 = 2.0e11_wp*1.6881e-10_wp/(8.0e3_wp*1.4923e-5_wp)
-      scene%mass_per_length = 8.0e3_wp*1.4923e-5_wp
-      scene%amplitude = 0.002_wp
-      scene%omega = 40.0_wp
-      scene%elements = 30
-      scene%stop_nodes = [10, 20, 30]
-      scene%stop_lower = [-0.002_wp, -0.002_wp, -0.004_wp]
-      scene%stop_upper = [0.002_wp, 0.002_wp, 0.004_wp]
-      scene%dt = 2.0e-5_wp
-      scene%t_end = 1.0_wp
-      scene%beta = 0.25_wp
+      scene = tube_scene(2.0e-5_wp, 1.0_wp)
       scene%damping_by_ratio = .true.
       scene%damping_ratio = [0.02_wp, 0.0_wp]
       call run_recorded(scene, rec, summary, error)

@@ -6,7 +6,7 @@
 module test_restitution
    use testing
    use test_support, only: run_recorded
-   use physics_support, only: open_run, step_once
+   use physics_support, only: tube_scene, open_run, step_once
    use beamstops, only: ik, scene_type, model_type, state_type, array_recorder, run_summary, law_signorini, &
       & steps_of
    use beamstops_forcing, only: support_position
@@ -132,18 +132,7 @@ contains
       integer(ik) :: step
       integer :: i, k, contacts
       ! the tube of input/tube_supports.nml, one second
-      scene%length = 1.5_wp
-      scene%k2 = 2.0e11_wp*1.6881e-10_wp/(8.0e3_wp*1.4923e-5_wp)
-      scene%mass_per_length = 8.0e3_wp*1.4923e-5_wp
-      scene%amplitude = 0.002_wp
-      scene%omega = 40.0_wp
-      scene%elements = 30
-      scene%stop_nodes = [10, 20, 30]
-      scene%stop_lower = [-0.002_wp, -0.002_wp, -0.004_wp]
-      scene%stop_upper = [0.002_wp, 0.002_wp, 0.004_wp]
-      scene%dt = 2.0e-5_wp
-      scene%t_end = 1.0_wp
-      scene%beta = 0.25_wp
+      scene = tube_scene(2.0e-5_wp, 1.0_wp)
       scene%restitution = e
       call open_run(scene, model, state, rec, error)
       if (allocated(error)) return
