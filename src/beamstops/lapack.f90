@@ -3,6 +3,7 @@
 !> Every other module calls LAPACK through these interfaces; none repeats them.
 module beamstops_lapack
    use beamstops_kinds, only: wp
+   use beamstops_strings, only: itoa
    implicit none
    private
    public :: dpbtrf, dpbtrs, dsbgv, dsbgvx, dgbtrf, dgbtrs, dpotrf, dsygv
@@ -93,7 +94,7 @@ contains
       character(len=*), intent(in) :: what
       character(len=:), allocatable :: message
       if (info > 0) then
-         message = 'dpbtrf: the leading minor of order '//itext(info)//' of '//what//' is not positive definite'
+         message = 'dpbtrf: the leading minor of order '//itoa(info)//' of '//what//' is not positive definite'
       else
          message = illegal('dpbtrf', info)
       end if
@@ -116,9 +117,9 @@ contains
       character(len=:), allocatable :: message
       if (info > n) then
          message = 'dsbgv: the mass matrix is not positive definite (its factorization failed at order '// &
-            & itext(info - n)//')'
+            & itoa(info - n)//')'
       else if (info > 0) then
-         message = 'dsbgv: the tridiagonal QR iteration did not converge ('//itext(info)// &
+         message = 'dsbgv: the tridiagonal QR iteration did not converge ('//itoa(info)// &
             & ' off-diagonal elements did not reach zero)'
       else
          message = illegal('dsbgv', info)
@@ -134,9 +135,9 @@ contains
       character(len=:), allocatable :: message
       if (info > n) then
          message = 'dsbgvx: the mass matrix is not positive definite (its factorization failed at order '// &
-            & itext(info - n)//')'
+            & itoa(info - n)//')'
       else if (info > 0) then
-         message = 'dsbgvx: '//itext(info)//' eigenvectors did not converge'
+         message = 'dsbgvx: '//itoa(info)//' eigenvectors did not converge'
       else
          message = illegal('dsbgvx', info)
       end if
@@ -148,7 +149,7 @@ contains
       integer, intent(in) :: info
       character(len=:), allocatable :: message
       if (info > 0) then
-         message = 'dgbtrf: the matrix is exactly singular (U('//itext(info)//','//itext(info)//') = 0)'
+         message = 'dgbtrf: the matrix is exactly singular (U('//itoa(info)//','//itoa(info)//') = 0)'
       else
          message = illegal('dgbtrf', info)
       end if
@@ -170,7 +171,7 @@ contains
       character(len=*), intent(in) :: what
       character(len=:), allocatable :: message
       if (info > 0) then
-         message = 'dpotrf: the leading minor of order '//itext(info)//' of '//what//' is not positive definite'
+         message = 'dpotrf: the leading minor of order '//itoa(info)//' of '//what//' is not positive definite'
       else
          message = illegal('dpotrf', info)
       end if
@@ -184,9 +185,9 @@ contains
       integer, intent(in) :: n
       character(len=:), allocatable :: message
       if (info > n) then
-         message = 'dsygv: the leading minor of order '//itext(info - n)//' of B is not positive definite'
+         message = 'dsygv: the leading minor of order '//itoa(info - n)//' of B is not positive definite'
       else if (info > 0) then
-         message = 'dsygv: dsyev did not converge ('//itext(info)//' off-diagonal elements did not reach zero)'
+         message = 'dsygv: dsyev did not converge ('//itoa(info)//' off-diagonal elements did not reach zero)'
       else
          message = illegal('dsygv', info)
       end if
@@ -198,16 +199,7 @@ contains
       integer, intent(in) :: info
       character(len=:), allocatable :: message
       message = ''
-      if (info < 0) message = routine//': argument '//itext(-info)//' had an illegal value'
-      if (info > 0) message = routine//': failed with info = '//itext(info)
+      if (info < 0) message = routine//': argument '//itoa(-info)//' had an illegal value'
+      if (info > 0) message = routine//': failed with info = '//itoa(info)
    end function illegal
-
-   !> Text of an integer.
-   pure function itext(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function itext
 end module beamstops_lapack
