@@ -455,11 +455,7 @@ contains
       !> Stop (default: all).
       integer, intent(in), optional :: i
       integer(ik) :: n
-      if (present(i)) then
-         n = self%shocks(i)
-      else
-         n = sum(self%shocks)
-      end if
+      n = count_at(self%shocks, i)
    end function shock_count
 
    !> Contact phases started so far at stop `i`, or at all stops.
@@ -469,12 +465,20 @@ contains
       !> Stop (default: all).
       integer, intent(in), optional :: i
       integer(ik) :: n
-      if (present(i)) then
-         n = self%phases(i)
-      else
-         n = sum(self%phases)
-      end if
+      n = count_at(self%phases, i)
    end function phase_count
+
+   !> counts(i), or the sum of counts when i is absent.
+   pure function count_at(counts, i) result(n)
+      integer(ik), intent(in) :: counts(:)
+      integer, intent(in), optional :: i
+      integer(ik) :: n
+      if (present(i)) then
+         n = counts(i)
+      else
+         n = sum(counts)
+      end if
+   end function count_at
 
    !> Rows dropped because the ring was full.
    pure function lost_count(self) result(n)
