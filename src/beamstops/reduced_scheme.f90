@@ -22,6 +22,7 @@ module beamstops_reduced_scheme
    use beamstops_ledger, only: first_events
    use beamstops_forcing, only: load_average, support_position, load_rotation, start_loads, next_load
    use beamstops_contact_tip_projection, only: project_tip
+   use beamstops_contact_tip_contact, only: violation
    use beamstops_contact_compliance, only: spring_force, solve_spring_tip
    use beamstops_contact_span_stops, only: span_stops_type, span_work_type, new_span_work, span_energy
    use beamstops_contact_box_qp, only: qp_solved, qp_message
@@ -788,14 +789,6 @@ contains
       e = 0.5_wp*dmd/reduced%dt2 + 0.5_wp*(reduced%beta*usu + reduced%beta*u_old_s_u_old &
          & + (1 - 2*reduced%beta)*(usu - dsu))
    end function energy
-
-   !> Violation of the stops by a tip value (m).
-   pure function violation(u_tip, scene) result(v)
-      real(wp), intent(in) :: u_tip
-      type(scene_type), intent(in) :: scene
-      real(wp) :: v
-      v = max(u_tip - scene%upper, scene%lower - u_tip, 0.0_wp)
-   end function violation
 
    !> Physical displacement (T q)(x_i) + h(x_i) phi(t) at the nodes x_0..x_J, O(J (r + m)).
    pure subroutine physical_shape(reduced, q, t, scene, shape)
