@@ -24,7 +24,7 @@ module beamstops_reduced_scheme
    use beamstops_contact_tip_projection, only: project_tip
    use beamstops_contact_tip_contact, only: violation
    use beamstops_contact_compliance, only: spring_force, solve_spring_tip
-   use beamstops_contact_span_stops, only: span_stops_type, span_work_type, new_span_work, span_energy
+   use beamstops_contact_span_stops, only: span_work_type, new_span_work, span_contact, span_settle, span_energy
    use beamstops_contact_box_qp, only: qp_solved, qp_message
    use beamstops_observe_observer, only: observer_type, new_observer
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
@@ -204,8 +204,8 @@ contains
       if (allocated(error)) return
       if (scene%law /= law_signorini) return
       state%x = 0
-      call stops_contact(reduced%stops, state%span, state%q, state%x, state%x, &
-         & support_position(reduced%dt, scene%amplitude, scene%omega), .true., state%span%info)
+      call span_contact(reduced%stops, state%span, state%q, state%x, state%x, &
+         & support_position(reduced%dt, scene%amplitude, scene%omega), .true., state%span%info, 0.0_wp, 0.0_wp)
       if (state%span%info /= qp_solved) then
          call fatal_error(error, 'the start q^1: '//qp_message(state%span%info))
          return
@@ -218,7 +218,7 @@ contains
       end if
       worst = 0
       state%x = 0
-      call stops_settle(reduced%stops, state%span, state%q, state%x, worst)
+      call span_settle(reduced%stops, state%span, state%q, state%x, worst, .true.)
       state%max_violation = worst
    end subroutine start_span
 
@@ -336,7 +336,9 @@ contains
          if (span) then
             phi_next = support_position(real(step + 1, wp)*reduced%dt, scene%amplitude, scene%omega)
             call stop_solve(reduced%a_solver, state%x)
-            call stops_contact(reduced%stops, state%span, state%q, state%d, state%x, phi_next, enforce, state%span%info)
+            ! The paper's law (no restitution in a reduced run): span_contact with e = 0.
+            call span_contact(reduced%stops, state%span, state%q, state%d, state%x, phi_next, enforce, &
+               & state%span%info, 0.0_wp, 0.0_wp)
             if (state%span%info /= qp_solved) exit
             state%n_active = 0
             if (state%span%contact) then
@@ -347,7 +349,7 @@ contains
             call modal_update(reduced%r, reduced%m, reduced%size, reduced%a_solver%w, reduced%z, reduced%load, &
                & state%n_active, state%active, state%multiplier, state%x, state%d, state%q, gd)
             contact = state%span%contact
-            if (enforce) call stops_settle(reduced%stops, state%span, state%q, state%d, state%max_violation)
+            if (enforce) call span_settle(reduced%stops, state%span, state%q, state%d, state%max_violation, .true.)
             r_step = 0
             if (reduced%stops%tip > 0) r_step = state%span%lambda(reduced%stops%tip)/dt2
             if (contact .and. .not. state%in_contact) state%impacts = state%impacts + 1
@@ -642,66 +644,6 @@ contains
          gd = gd + load(i)*d(i)
       end do
    end subroutine modal_update
-
-   !> The contact of a step with stops along the span (the paper's law: each stop's value at
-   !> t_{n+1} within its bounds): the trial values q^n + d^{n-1} + x at the stop coordinates, the
-   !> bounds of u at phi = phi(t_{n+1}), and the multipliers of the box QP on C_r (zero when no
-   !> trial value is out); keeps q^n and d^{n-1} there for the record and span_energy. Without
-   !> `enforce` (law 'none') only that. The reduced loop's own (the full loop's span_contact of
-   !> contact/span_stops.f90 carries restitution), on the same span_work_type.
-   subroutine stops_contact(stops, work, q, d, x, phi, enforce, info)
-      type(span_stops_type), intent(in) :: stops
-      type(span_work_type), intent(inout) :: work
-      real(wp), intent(in) :: q(:), d(:), x(:)
-      real(wp), intent(in) :: phi
-      logical, intent(in) :: enforce
-      integer, intent(out) :: info
-      integer :: i, k
-      logical :: out
-      info = qp_solved
-      out = .false.
-      do i = 1, stops%m
-         k = stops%unknown(i)
-         work%u_prev(i) = q(k)
-         work%d_prev(i) = d(k)
-         work%trial(i) = q(k) + (d(k) + x(k))
-         work%lo(i) = stops%lower(i) - stops%lift(i)*phi
-         work%hi(i) = stops%upper(i) - stops%lift(i)*phi
-         out = out .or. work%trial(i) < work%lo(i) .or. work%trial(i) > work%hi(i)
-      end do
-      if (.not. (out .and. enforce)) then
-         if (work%contact) then
-            work%lambda = 0
-            work%qp%n_active = 0
-         end if
-         work%contact = .false.
-         return
-      end if
-      call work%qp%solve(work%trial, work%lo, work%hi, work%lambda, work%y, info)
-      work%contact = work%qp%n_active > 0
-   end subroutine stops_contact
-
-   !> The active stops exactly on their bounds, d^n their exact increment there, and the largest
-   !> violation of a bound by the stop coordinates (the bounds of the step; 0 but for round-off).
-   subroutine stops_settle(stops, work, q, d, worst)
-      type(span_stops_type), intent(in) :: stops
-      type(span_work_type), intent(in) :: work
-      real(wp), intent(inout) :: q(:), d(:)
-      real(wp), intent(inout) :: worst
-      integer :: j, a, k
-      if (work%contact) then
-         do j = 1, work%qp%n_active
-            a = work%qp%active(j)
-            k = stops%unknown(a)
-            q(k) = work%y(a)
-            d(k) = work%y(a) - work%u_prev(a)
-         end do
-      end if
-      do j = 1, stops%m
-         k = stops%unknown(j)
-         worst = max(worst, q(k) - work%hi(j), work%lo(j) - q(k))
-      end do
-   end subroutine stops_settle
 
    !> The correction A_r^{-1} P_r lambda of a step with stops along the span: one active stop, its
    !> column `col` and multiplier c (the loop's rank-one update, as the tip's); more, the
