@@ -93,11 +93,7 @@ contains
       !> Name of the matrix factored.
       character(len=*), intent(in) :: what
       character(len=:), allocatable :: message
-      if (info > 0) then
-         message = 'dpbtrf: the leading minor of order '//itoa(info)//' of '//what//' is not positive definite'
-      else
-         message = illegal('dpbtrf', info)
-      end if
+      message = cholesky_message('dpbtrf', info, what)
    end function dpbtrf_message
 
    !> Message of dpbtrs's info (empty for 0).
@@ -170,11 +166,7 @@ contains
       !> Name of the matrix factored.
       character(len=*), intent(in) :: what
       character(len=:), allocatable :: message
-      if (info > 0) then
-         message = 'dpotrf: the leading minor of order '//itoa(info)//' of '//what//' is not positive definite'
-      else
-         message = illegal('dpotrf', info)
-      end if
+      message = cholesky_message('dpotrf', info, what)
    end function dpotrf_message
 
    !> Message of dsygv's info (empty for 0); n is the order of the problem.
@@ -192,6 +184,19 @@ contains
          message = illegal('dsygv', info)
       end if
    end function dsygv_message
+
+   !> The message of a Cholesky factorization's info (dpbtrf, dpotrf), empty for 0.
+   pure function cholesky_message(routine, info, what) result(message)
+      character(len=*), intent(in) :: routine
+      integer, intent(in) :: info
+      character(len=*), intent(in) :: what
+      character(len=:), allocatable :: message
+      if (info > 0) then
+         message = routine//': the leading minor of order '//itoa(info)//' of '//what//' is not positive definite'
+      else
+         message = illegal(routine, info)
+      end if
+   end function cholesky_message
 
    !> The message of a negative info (an illegal argument), empty for 0.
    pure function illegal(routine, info) result(message)
