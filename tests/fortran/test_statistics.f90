@@ -175,6 +175,14 @@ contains
       h = table%quantity(q)%half_width(i)
    end subroutine get
 
+   !> The value of quantity `name` (its first entry) in a table; NaN when it is not there.
+   function value_of(table, name) result(v)
+      type(statistics_table), intent(in) :: table
+      character(len=*), intent(in) :: name
+      real(wp) :: v, h
+      call get(table, name, v, h)
+   end function value_of
+
    !> Half-width t(0.975, 4) s/sqrt(5) of five batch values.
    pure function hw5(x) result(h)
       real(wp), intent(in) :: x(5)
@@ -420,31 +428,27 @@ contains
       call run_both(u, r, e, 0.0_wp, 0.5005_wp, n*dt, 10, 5, -0.1_wp, 0.1_wp, table, rows, error)
       if (allocated(error)) return
       call check(error, size(rows), 0, 'shock rows'); if (allocated(error)) return
-      call get(table, 'shocks', v, h)
-      call check(error, v, 0.0_wp, 'shocks'); if (allocated(error)) return
+      call check(error, value_of(table, 'shocks'), 0.0_wp, 'shocks'); if (allocated(error)) return
       call get(table, 'power', v, h)
       call check(error, v, 0.0_wp, 'power'); if (allocated(error)) return
       call check(error, h, 0.0_wp, 'power half-width'); if (allocated(error)) return
-      call get(table, 'shocks_per_second', v, h)
-      call check(error, v, 0.0_wp, 'shocks per second'); if (allocated(error)) return
-      call get(table, 'force_max', v, h)
-      call check(error, v, 0.0_wp, 'force_max'); if (allocated(error)) return
-      call get(table, 'contact_fraction', v, h)
-      call check(error, v, 0.0_wp, 'contact fraction'); if (allocated(error)) return
-      call get(table, 'rebounds_per_shock', v, h)
-      call check(error, ieee_is_nan(v), 'rebounds per shock undefined (NaN) without shocks'); if (allocated(error)) return
-      call get(table, 'force_mean_contact', v, h)
-      call check(error, ieee_is_nan(v), 'force over contact time undefined (NaN)'); if (allocated(error)) return
-      call get(table, 'shock_duration_max', v, h)
-      call check(error, ieee_is_nan(v), 'shock duration max undefined (NaN)'); if (allocated(error)) return
-      call get(table, 'window', v, h)
-      call check(error, v, (n - 500)*dt, 'window', rel=.true., thr=1.0e-12_wp)
+      call check(error, value_of(table, 'shocks_per_second'), 0.0_wp, 'shocks per second'); if (allocated(error)) return
+      call check(error, value_of(table, 'force_max'), 0.0_wp, 'force_max'); if (allocated(error)) return
+      call check(error, value_of(table, 'contact_fraction'), 0.0_wp, 'contact fraction'); if (allocated(error)) return
+      call check(error, ieee_is_nan(value_of(table, 'rebounds_per_shock')), &
+         & 'rebounds per shock undefined (NaN) without shocks')
+      if (allocated(error)) return
+      call check(error, ieee_is_nan(value_of(table, 'force_mean_contact')), 'force over contact time undefined (NaN)')
+      if (allocated(error)) return
+      call check(error, ieee_is_nan(value_of(table, 'shock_duration_max')), 'shock duration max undefined (NaN)')
+      if (allocated(error)) return
+      call check(error, value_of(table, 'window'), (n - 500)*dt, 'window', rel=.true., thr=1.0e-12_wp)
    end subroutine test_no_contact
 
    subroutine test_transient(error)
       type(error_type), allocatable, intent(out) :: error
       integer, parameter :: n = 1000
-      real(wp) :: u(n), r(n), e(n), v, h
+      real(wp) :: u(n), r(n), e(n)
       type(statistics_table) :: table
       type(shock_row), allocatable :: rows(:)
       ! A big excursion and shock in the transient, one shock after.
@@ -459,16 +463,12 @@ contains
       call run_both(u, r, e, 5*dt, 0.3005_wp, n*dt, 4, 2, -0.1_wp, 0.1_wp, table, rows, error)
       if (allocated(error)) return
       call check(error, size(rows), 2, 'rows'); if (allocated(error)) return
-      call get(table, 'shocks', v, h)
-      call check(error, v, 1.0_wp, 'shocks after the transient'); if (allocated(error)) return
-      call get(table, 'tip_max', v, h)
-      call check(error, v, 0.01_wp, 'tip_max'); if (allocated(error)) return
-      call get(table, 'force_max', v, h)
-      call check(error, v, 2.0_wp, 'force_max'); if (allocated(error)) return
-      call get(table, 'power', v, h)
-      call check(error, v, 0.5_wp/((n - 300)*dt), 'power', rel=.true., thr=1.0e-12_wp); if (allocated(error)) return
-      call get(table, 'impulse_rate', v, h)
-      call check(error, v, 4*dt/((n - 300)*dt), 'impulse rate', rel=.true., thr=1.0e-12_wp)
+      call check(error, value_of(table, 'shocks'), 1.0_wp, 'shocks after the transient'); if (allocated(error)) return
+      call check(error, value_of(table, 'tip_max'), 0.01_wp, 'tip_max'); if (allocated(error)) return
+      call check(error, value_of(table, 'force_max'), 2.0_wp, 'force_max'); if (allocated(error)) return
+      call check(error, value_of(table, 'power'), 0.5_wp/((n - 300)*dt), 'power', rel=.true., thr=1.0e-12_wp)
+      if (allocated(error)) return
+      call check(error, value_of(table, 'impulse_rate'), 4*dt/((n - 300)*dt), 'impulse rate', rel=.true., thr=1.0e-12_wp)
    end subroutine test_transient
 
    subroutine test_step_tip(error)
