@@ -128,7 +128,6 @@ contains
       real(wp), intent(in) :: dt
       type(scene_type) :: scene
       type(model_type) :: model
-      type(reduced_model_type) :: reduced
       type(array_recorder) :: full, red
       type(run_summary) :: summary
       type(error_type), allocatable :: error
@@ -148,12 +147,7 @@ contains
          r = int_argument(k, 1)
          if (r > 2*elements - stop_unknowns(scene)) cycle
          scene%modes = r
-         call build_reduced(scene, model, reduced, error)
-         call fail_on(error)
-         if (allocated(red%rows)) deallocate (red%rows, red%snap_t, red%snap_u, red%stops_u, red%stops_reaction)
-         call red%reserve(record_count(scene), 0_ik, elements + 1)
-         call simulate_reduced(scene, reduced, red, summary, error)
-         call fail_on(error)
+         call run_reduced_recorded(scene, model, red, summary)
          before = 0
          through = 0
          do j = 1, full%filled
@@ -170,7 +164,6 @@ contains
       real(wp), intent(in) :: dt, t0, t1
       type(scene_type) :: scene
       type(model_type) :: model
-      type(reduced_model_type) :: reduced
       type(array_recorder) :: rec
       type(run_summary) :: summary
       type(error_type), allocatable :: error
@@ -189,16 +182,28 @@ contains
          r = int_argument(k, 1)
          if (r > 2*elements - stop_unknowns(scene)) cycle
          scene%modes = r
-         call build_reduced(scene, model, reduced, error)
-         call fail_on(error)
-         deallocate (rec%rows, rec%snap_t, rec%snap_u, rec%stops_u, rec%stops_reaction)
-         call rec%reserve(record_count(scene), 0_ik, elements + 1)
-         call simulate_reduced(scene, reduced, rec, summary, error)
-         call fail_on(error)
+         call run_reduced_recorded(scene, model, rec, summary)
          write (*, '(a, i0, a)', advance='no') 'r ', r, ' '
          call report('', rec, summary, t0, t1)
       end do
    end subroutine bench_stats
+
+   !> The reduced model of `scene` (scene%modes modes) built and run into `rec`, reserved anew for
+   !> every record.
+   subroutine run_reduced_recorded(scene, model, rec, summary)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(array_recorder), intent(inout) :: rec
+      type(run_summary), intent(out) :: summary
+      type(reduced_model_type) :: reduced
+      type(error_type), allocatable :: error
+      call build_reduced(scene, model, reduced, error)
+      call fail_on(error)
+      if (allocated(rec%rows)) deallocate (rec%rows, rec%snap_t, rec%snap_u, rec%stops_u, rec%stops_reaction)
+      call rec%reserve(record_count(scene), 0_ik, scene%elements + 1)
+      call simulate_reduced(scene, reduced, rec, summary, error)
+      call fail_on(error)
+   end subroutine run_reduced_recorded
 
    subroutine report(name, rec, summary, t0, t1)
          character(len=*), intent(in) :: name

@@ -3,10 +3,12 @@
 !> Every other module calls LAPACK through these interfaces; none repeats them.
 module beamstops_lapack
    use beamstops_kinds, only: wp
+   use beamstops_strings, only: itoa
    implicit none
    private
-   public :: dpbtrf, dpbtrs, dsbgv, dgbtrf, dgbtrs, dsygv
-   public :: dpbtrf_message, dpbtrs_message, dsbgv_message, dgbtrf_message, dgbtrs_message, dsygv_message
+   public :: dpbtrf, dpbtrs, dsbgv, dsbgvx, dgbtrf, dgbtrs, dpotrf, dsygv
+   public :: dpbtrf_message, dpbtrs_message, dsbgv_message, dsbgvx_message, dgbtrf_message, dgbtrs_message
+   public :: dpotrf_message, dsygv_message
 
    interface
       !> Cholesky factorization of a symmetric positive definite band matrix.
@@ -35,6 +37,18 @@ module beamstops_lapack
          real(wp), intent(out) :: w(*), z(ldz, *), work(*)
          integer, intent(out) :: info
       end subroutine dsbgv
+      !> Selected eigenvalues (and eigenvectors) of a generalized symmetric-definite band
+      !> eigenproblem A x = lambda B x.
+      subroutine dsbgvx(jobz, range, uplo, n, ka, kb, ab, ldab, bb, ldbb, q, ldq, vl, vu, il, iu, abstol, m, w, &
+         & z, ldz, work, iwork, ifail, info)
+         import :: wp
+         character, intent(in) :: jobz, range, uplo
+         integer, intent(in) :: n, ka, kb, ldab, ldbb, ldq, il, iu, ldz
+         real(wp), intent(inout) :: ab(ldab, *), bb(ldbb, *)
+         real(wp), intent(out) :: q(ldq, *), w(*), z(ldz, *), work(*)
+         real(wp), intent(in) :: vl, vu, abstol
+         integer, intent(out) :: m, iwork(*), ifail(*), info
+      end subroutine dsbgvx
       !> LU factorization of a general band matrix.
       subroutine dgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
          import :: wp
@@ -51,6 +65,14 @@ module beamstops_lapack
          real(wp), intent(inout) :: b(ldb, *)
          integer, intent(out) :: info
       end subroutine dgbtrs
+      !> Cholesky factorization of a dense symmetric positive definite matrix.
+      subroutine dpotrf(uplo, n, a, lda, info)
+         import :: wp
+         character, intent(in) :: uplo
+         integer, intent(in) :: n, lda
+         real(wp), intent(inout) :: a(lda, *)
+         integer, intent(out) :: info
+      end subroutine dpotrf
       !> Generalized symmetric-definite dense eigenproblem.
       subroutine dsygv(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
          import :: wp
@@ -71,11 +93,7 @@ contains
       !> Name of the matrix factored.
       character(len=*), intent(in) :: what
       character(len=:), allocatable :: message
-      if (info > 0) then
-         message = 'dpbtrf: the leading minor of order '//itext(info)//' of '//what//' is not positive definite'
-      else
-         message = illegal('dpbtrf', info)
-      end if
+      message = cholesky_message('dpbtrf', info, what)
    end function dpbtrf_message
 
    !> Message of dpbtrs's info (empty for 0).
@@ -95,14 +113,31 @@ contains
       character(len=:), allocatable :: message
       if (info > n) then
          message = 'dsbgv: the mass matrix is not positive definite (its factorization failed at order '// &
-            & itext(info - n)//')'
+            & itoa(info - n)//')'
       else if (info > 0) then
-         message = 'dsbgv: the tridiagonal QR iteration did not converge ('//itext(info)// &
+         message = 'dsbgv: the tridiagonal QR iteration did not converge ('//itoa(info)// &
             & ' off-diagonal elements did not reach zero)'
       else
          message = illegal('dsbgv', info)
       end if
    end function dsbgv_message
+
+   !> Message of dsbgvx's info (empty for 0); n is the order of the problem.
+   pure function dsbgvx_message(info, n) result(message)
+      !> LAPACK's info.
+      integer, intent(in) :: info
+      !> Order of the matrices.
+      integer, intent(in) :: n
+      character(len=:), allocatable :: message
+      if (info > n) then
+         message = 'dsbgvx: the mass matrix is not positive definite (its factorization failed at order '// &
+            & itoa(info - n)//')'
+      else if (info > 0) then
+         message = 'dsbgvx: '//itoa(info)//' eigenvectors did not converge'
+      else
+         message = illegal('dsbgvx', info)
+      end if
+   end function dsbgvx_message
 
    !> Message of dgbtrf's info (empty for 0).
    pure function dgbtrf_message(info) result(message)
@@ -110,7 +145,7 @@ contains
       integer, intent(in) :: info
       character(len=:), allocatable :: message
       if (info > 0) then
-         message = 'dgbtrf: the matrix is exactly singular (U('//itext(info)//','//itext(info)//') = 0)'
+         message = 'dgbtrf: the matrix is exactly singular (U('//itoa(info)//','//itoa(info)//') = 0)'
       else
          message = illegal('dgbtrf', info)
       end if
@@ -124,6 +159,16 @@ contains
       message = illegal('dgbtrs', info)
    end function dgbtrs_message
 
+   !> Message of dpotrf's info (empty for 0); `what` names the matrix.
+   pure function dpotrf_message(info, what) result(message)
+      !> LAPACK's info.
+      integer, intent(in) :: info
+      !> Name of the matrix factored.
+      character(len=*), intent(in) :: what
+      character(len=:), allocatable :: message
+      message = cholesky_message('dpotrf', info, what)
+   end function dpotrf_message
+
    !> Message of dsygv's info (empty for 0); n is the order of the problem.
    pure function dsygv_message(info, n) result(message)
       !> LAPACK's info.
@@ -132,13 +177,26 @@ contains
       integer, intent(in) :: n
       character(len=:), allocatable :: message
       if (info > n) then
-         message = 'dsygv: the leading minor of order '//itext(info - n)//' of B is not positive definite'
+         message = 'dsygv: the leading minor of order '//itoa(info - n)//' of B is not positive definite'
       else if (info > 0) then
-         message = 'dsygv: dsyev did not converge ('//itext(info)//' off-diagonal elements did not reach zero)'
+         message = 'dsygv: dsyev did not converge ('//itoa(info)//' off-diagonal elements did not reach zero)'
       else
          message = illegal('dsygv', info)
       end if
    end function dsygv_message
+
+   !> The message of a Cholesky factorization's info (dpbtrf, dpotrf), empty for 0.
+   pure function cholesky_message(routine, info, what) result(message)
+      character(len=*), intent(in) :: routine
+      integer, intent(in) :: info
+      character(len=*), intent(in) :: what
+      character(len=:), allocatable :: message
+      if (info > 0) then
+         message = routine//': the leading minor of order '//itoa(info)//' of '//what//' is not positive definite'
+      else
+         message = illegal(routine, info)
+      end if
+   end function cholesky_message
 
    !> The message of a negative info (an illegal argument), empty for 0.
    pure function illegal(routine, info) result(message)
@@ -146,16 +204,7 @@ contains
       integer, intent(in) :: info
       character(len=:), allocatable :: message
       message = ''
-      if (info < 0) message = routine//': argument '//itext(-info)//' had an illegal value'
-      if (info > 0) message = routine//': failed with info = '//itext(info)
+      if (info < 0) message = routine//': argument '//itoa(-info)//' had an illegal value'
+      if (info > 0) message = routine//': failed with info = '//itoa(info)
    end function illegal
-
-   !> Text of an integer.
-   pure function itext(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
-   end function itext
 end module beamstops_lapack

@@ -39,8 +39,6 @@
 !> fixed-interface modes: p0 = u0(b), a0 = Phi^T M (u0 - Psi p0) (and the same for v0). With
 !> r = n - m, T is square and invertible, this is q0 = T^{-1} u0 exactly, and the reduced model is
 !> the full one in another basis: the scheme gives the full model's results to round-off.
-!>
-!> (The LAPACK interfaces below belong in beamstops_lapack once the branches are merged.)
 module beamstops_reduced
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_positive_inf
    use beamstops_kinds, only: wp, ik
@@ -51,6 +49,8 @@ module beamstops_reduced
    use beamstops_model, only: model_type, build_model
    use beamstops_contact_span_stops, only: span_stops_type
    use beamstops_contact_box_qp, only: box_qp_type, new_box_qp
+   use beamstops_lapack, only: dsbgvx, dgbtrf, dgbtrs, dpotrf, dsygv, dsbgvx_message, dgbtrf_message, &
+      & dpotrf_message, dsygv_message
    implicit none
    private
    public :: reduced_model_type, block_solver_type, build_reduced, prepare_reduced, validate_reduced
@@ -130,48 +130,6 @@ module beamstops_reduced
       !> Linear Newmark limit 2/sqrt((1 - 4 beta) kappa) for beta < 1/4, +Inf otherwise (s).
       real(wp) :: dt_newmark = 0
    end type reduced_model_type
-
-   interface
-      subroutine dsbgvx(jobz, range, uplo, n, ka, kb, ab, ldab, bb, ldbb, q, ldq, vl, vu, il, iu, abstol, m, w, &
-         & z, ldz, work, iwork, ifail, info)
-         import :: wp
-         character, intent(in) :: jobz, range, uplo
-         integer, intent(in) :: n, ka, kb, ldab, ldbb, ldq, il, iu, ldz
-         real(wp), intent(inout) :: ab(ldab, *), bb(ldbb, *)
-         real(wp), intent(out) :: q(ldq, *), w(*), z(ldz, *), work(*)
-         real(wp), intent(in) :: vl, vu, abstol
-         integer, intent(out) :: m, iwork(*), ifail(*), info
-      end subroutine dsbgvx
-      subroutine dgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
-         import :: wp
-         integer, intent(in) :: m, n, kl, ku, ldab
-         real(wp), intent(inout) :: ab(ldab, *)
-         integer, intent(out) :: ipiv(*), info
-      end subroutine dgbtrf
-      subroutine dgbtrs(trans, n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
-         import :: wp
-         character, intent(in) :: trans
-         integer, intent(in) :: n, kl, ku, nrhs, ldab, ipiv(*), ldb
-         real(wp), intent(in) :: ab(ldab, *)
-         real(wp), intent(inout) :: b(ldb, *)
-         integer, intent(out) :: info
-      end subroutine dgbtrs
-      subroutine dpotrf(uplo, n, a, lda, info)
-         import :: wp
-         character, intent(in) :: uplo
-         integer, intent(in) :: n, lda
-         real(wp), intent(inout) :: a(lda, *)
-         integer, intent(out) :: info
-      end subroutine dpotrf
-      subroutine dsygv(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
-         import :: wp
-         integer, intent(in) :: itype, n, lda, ldb, lwork
-         character, intent(in) :: jobz, uplo
-         real(wp), intent(inout) :: a(lda, *), b(ldb, *)
-         real(wp), intent(out) :: w(*), work(*)
-         integer, intent(out) :: info
-      end subroutine dsygv
-   end interface
 
 contains
 
@@ -430,9 +388,13 @@ contains
       if (r == ni) range = 'A'
       call dsbgvx(jobz, range, 'U', ni, kd, kd, sa, kd + 1, ma, kd + 1, q, size(q, 1), 0.0_wp, 0.0_wp, 1, r, &
          & 2*tiny(1.0_wp), found, w, phi, ni, work, iwork, ifail, info)
-      if (info /= 0 .or. found /= r) then
+      if (info /= 0) then
+         call fatal_error(error, 'reduced model: '//dsbgvx_message(info, ni))
+         return
+      end if
+      if (found /= r) then
          call fatal_error(error, 'reduced model: dsbgvx found '//fmt_int(int(found, ik))//' of '//fmt_int(int(r, ik))// &
-            & ' fixed-interface modes (info = '//fmt_int(int(info, ik))//')')
+            & ' fixed-interface modes')
          return
       end if
       lambda = w(1:r)
@@ -472,7 +434,8 @@ contains
             shift = shift*(1 + 8*epsilon(1.0_wp)) + tiny(1.0_wp)
          end do
          if (info /= 0) then
-            call fatal_error(error, 'reduced model: dgbtrf: S - lambda M singular for mode '//fmt_int(int(k, ik)))
+            call fatal_error(error, 'reduced model: S - lambda M for mode '//fmt_int(int(k, ik))//': '// &
+               & dgbtrf_message(info))
             return
          end if
          ! A start with components along every mode (a fixed pseudo-random sequence).
@@ -579,8 +542,7 @@ contains
       self%hfac = 0.5_wp*(self%hfac + transpose(self%hfac))
       call dpotrf('U', m, self%hfac, m, info)
       if (info /= 0) then
-         call fatal_error(error, 'reduced model: dpotrf: the leading minor of order '//fmt_int(int(info, ik))// &
-            & ' of the Schur complement of '//what//' is not positive definite')
+         call fatal_error(error, 'reduced model: '//dpotrf_message(info, 'the Schur complement of '//what))
          return
       end if
       do j = 1, m
@@ -745,7 +707,7 @@ contains
       allocate (w(s), work(max(1, 3*s)))
       call dsygv(1, 'N', 'U', s, sr, s, mr, s, w, work, size(work), info)
       if (info /= 0) then
-         call fatal_error(error, 'reduced model: dsygv failed on (S_r, M_r), info = '//fmt_int(int(info, ik)))
+         call fatal_error(error, 'reduced model: (S_r, M_r): '//dsygv_message(info, s))
          return
       end if
       reduced%kappa = w(s)

@@ -19,10 +19,12 @@ module beamstops_reduced_scheme
    use beamstops_reduced, only: reduced_model_type, block_solver_type, block_solve, reduced_stiffness_product, &
       & reduced_mass_product
    use beamstops_clock, only: thread_cpu_seconds
-   use beamstops_forcing, only: load_average, support_position
+   use beamstops_ledger, only: first_events
+   use beamstops_forcing, only: load_average, support_position, load_rotation, start_loads, next_load
    use beamstops_contact_tip_projection, only: project_tip
+   use beamstops_contact_tip_contact, only: violation
    use beamstops_contact_compliance, only: spring_force, solve_spring_tip
-   use beamstops_contact_span_stops, only: span_stops_type, span_work_type, new_span_work, span_energy
+   use beamstops_contact_span_stops, only: span_work_type, new_span_work, span_contact, span_settle, span_energy
    use beamstops_contact_box_qp, only: qp_solved, qp_message
    use beamstops_observe_observer, only: observer_type, new_observer
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
@@ -34,18 +36,6 @@ module beamstops_reduced_scheme
 
    !> Steps between progress reports and divergence checks.
    integer(ik), parameter :: reduced_block_steps = 8192_ik
-
-   ! The load averages step after step by rotation, as the full loop's: a private copy of the
-   ! load_rotation that the physics branch moves into beamstops_forcing (same names, same
-   ! arithmetic); after the merge, use beamstops_forcing's and delete this one.
-   type :: load_rotation
-      integer(ik) :: k = 0
-      real(wp) :: sigma = 0, cosine = 0
-      real(wp) :: cos_step = 1, sin_step = 0
-      real(wp) :: dt = 0, omega = 0
-      logical :: centered = .true.
-   end type load_rotation
-   integer(ik), parameter :: restart_every = 64
 
    !> Everything the reduced loop carries from step n to step n + 1.
    type :: reduced_state_type
@@ -214,8 +204,8 @@ contains
       if (allocated(error)) return
       if (scene%law /= law_signorini) return
       state%x = 0
-      call stops_contact(reduced%stops, state%span, state%q, state%x, state%x, &
-         & support_position(reduced%dt, scene%amplitude, scene%omega), .true., state%span%info)
+      call span_contact(reduced%stops, state%span, state%q, state%x, state%x, &
+         & support_position(reduced%dt, scene%amplitude, scene%omega), .true., state%span%info, 0.0_wp, 0.0_wp)
       if (state%span%info /= qp_solved) then
          call fatal_error(error, 'the start q^1: '//qp_message(state%span%info))
          return
@@ -228,7 +218,7 @@ contains
       end if
       worst = 0
       state%x = 0
-      call stops_settle(reduced%stops, state%span, state%q, state%x, worst)
+      call span_settle(reduced%stops, state%span, state%q, state%x, worst, .true.)
       state%max_violation = worst
    end subroutine start_span
 
@@ -318,9 +308,7 @@ contains
       pt = tip_coordinate(reduced)
       span = reduced%stops%m > 0
       enforce = scene%law == law_signorini
-      next_record = next_multiple(state%step, int(scene%record_every, ik))
-      next_snapshot = huge(step)
-      if (scene%snapshot_every > 0) next_snapshot = next_multiple(state%step, int(scene%snapshot_every, ik))
+      call first_events(scene, state%step, next_record, next_snapshot)
       done = state%step - 1
       u_old_su = 0
       u_tip_prev = 0
@@ -348,7 +336,9 @@ contains
          if (span) then
             phi_next = support_position(real(step + 1, wp)*reduced%dt, scene%amplitude, scene%omega)
             call stop_solve(reduced%a_solver, state%x)
-            call stops_contact(reduced%stops, state%span, state%q, state%d, state%x, phi_next, enforce, state%span%info)
+            ! The paper's law (no restitution in a reduced run): span_contact with e = 0.
+            call span_contact(reduced%stops, state%span, state%q, state%d, state%x, phi_next, enforce, &
+               & state%span%info, 0.0_wp, 0.0_wp)
             if (state%span%info /= qp_solved) exit
             state%n_active = 0
             if (state%span%contact) then
@@ -359,7 +349,7 @@ contains
             call modal_update(reduced%r, reduced%m, reduced%size, reduced%a_solver%w, reduced%z, reduced%load, &
                & state%n_active, state%active, state%multiplier, state%x, state%d, state%q, gd)
             contact = state%span%contact
-            if (enforce) call stops_settle(reduced%stops, state%span, state%q, state%d, state%max_violation)
+            if (enforce) call span_settle(reduced%stops, state%span, state%q, state%d, state%max_violation, .true.)
             r_step = 0
             if (reduced%stops%tip > 0) r_step = state%span%lambda(reduced%stops%tip)/dt2
             if (contact .and. .not. state%in_contact) state%impacts = state%impacts + 1
@@ -435,56 +425,6 @@ contains
       end do
       state%step = done + 1
    end subroutine advance_reduced
-
-   !> load_rotation at step k: from load_average at the last multiple of restart_every, then
-   !> rotated, so that the value of every step is the same however the run is cut into calls.
-   pure subroutine start_loads(loads, k, dt, omega, centered)
-      type(load_rotation), intent(out) :: loads
-      integer(ik), intent(in) :: k
-      real(wp), intent(in) :: dt, omega
-      logical, intent(in) :: centered
-      loads%dt = dt
-      loads%omega = omega
-      loads%centered = centered
-      call restart_loads(loads, (k/restart_every)*restart_every)
-      do while (loads%k < k)
-         call next_load(loads)
-      end do
-   end subroutine start_loads
-
-   !> load_rotation at step k, exact: load_average and the same centre and factor for the cosine.
-   pure subroutine restart_loads(loads, k)
-      type(load_rotation), intent(inout) :: loads
-      integer(ik), intent(in) :: k
-      real(wp) :: centre, x, factor
-      centre = real(k, wp)*loads%dt
-      if (.not. loads%centered) centre = (real(k, wp) + 0.5_wp)*loads%dt
-      x = 0.5_wp*loads%omega*loads%dt
-      if (abs(x) < 1.0e-8_wp) then
-         factor = 1 - x**2/6
-      else
-         factor = sin(x)/x
-      end if
-      loads%k = k
-      loads%sigma = load_average(k, loads%dt, loads%omega, loads%centered)
-      loads%cosine = factor*cos(loads%omega*centre)
-      loads%cos_step = cos(loads%omega*loads%dt)
-      loads%sin_step = sin(loads%omega*loads%dt)
-   end subroutine restart_loads
-
-   !> load_rotation moved on to step k + 1.
-   pure subroutine next_load(loads)
-      type(load_rotation), intent(inout) :: loads
-      real(wp) :: sigma
-      if (mod(loads%k + 1, restart_every) == 0) then
-         call restart_loads(loads, loads%k + 1)
-         return
-      end if
-      sigma = loads%sigma*loads%cos_step + loads%cosine*loads%sin_step
-      loads%cosine = loads%cosine*loads%cos_step - loads%sigma*loads%sin_step
-      loads%sigma = sigma
-      loads%k = loads%k + 1
-   end subroutine next_load
 
    !> The tip value of a reduced vector: its tip coordinate when the tip is a stop, else T(tip, :) q.
    pure function tip_value_of(reduced, q) result(u)
@@ -705,66 +645,6 @@ contains
       end do
    end subroutine modal_update
 
-   !> The contact of a step with stops along the span (the paper's law: each stop's value at
-   !> t_{n+1} within its bounds): the trial values q^n + d^{n-1} + x at the stop coordinates, the
-   !> bounds of u at phi = phi(t_{n+1}), and the multipliers of the box QP on C_r (zero when no
-   !> trial value is out); keeps q^n and d^{n-1} there for the record and span_energy. Without
-   !> `enforce` (law 'none') only that. The reduced loop's own (the full loop's span_contact of
-   !> contact/span_stops.f90 carries restitution), on the same span_work_type.
-   subroutine stops_contact(stops, work, q, d, x, phi, enforce, info)
-      type(span_stops_type), intent(in) :: stops
-      type(span_work_type), intent(inout) :: work
-      real(wp), intent(in) :: q(:), d(:), x(:)
-      real(wp), intent(in) :: phi
-      logical, intent(in) :: enforce
-      integer, intent(out) :: info
-      integer :: i, k
-      logical :: out
-      info = qp_solved
-      out = .false.
-      do i = 1, stops%m
-         k = stops%unknown(i)
-         work%u_prev(i) = q(k)
-         work%d_prev(i) = d(k)
-         work%trial(i) = q(k) + (d(k) + x(k))
-         work%lo(i) = stops%lower(i) - stops%lift(i)*phi
-         work%hi(i) = stops%upper(i) - stops%lift(i)*phi
-         out = out .or. work%trial(i) < work%lo(i) .or. work%trial(i) > work%hi(i)
-      end do
-      if (.not. (out .and. enforce)) then
-         if (work%contact) then
-            work%lambda = 0
-            work%qp%n_active = 0
-         end if
-         work%contact = .false.
-         return
-      end if
-      call work%qp%solve(work%trial, work%lo, work%hi, work%lambda, work%y, info)
-      work%contact = work%qp%n_active > 0
-   end subroutine stops_contact
-
-   !> The active stops exactly on their bounds, d^n their exact increment there, and the largest
-   !> violation of a bound by the stop coordinates (the bounds of the step; 0 but for round-off).
-   subroutine stops_settle(stops, work, q, d, worst)
-      type(span_stops_type), intent(in) :: stops
-      type(span_work_type), intent(in) :: work
-      real(wp), intent(inout) :: q(:), d(:)
-      real(wp), intent(inout) :: worst
-      integer :: j, a, k
-      if (work%contact) then
-         do j = 1, work%qp%n_active
-            a = work%qp%active(j)
-            k = stops%unknown(a)
-            q(k) = work%y(a)
-            d(k) = work%y(a) - work%u_prev(a)
-         end do
-      end if
-      do j = 1, stops%m
-         k = stops%unknown(j)
-         worst = max(worst, q(k) - work%hi(j), work%lo(j) - q(k))
-      end do
-   end subroutine stops_settle
-
    !> The correction A_r^{-1} P_r lambda of a step with stops along the span: one active stop, its
    !> column `col` and multiplier c (the loop's rank-one update, as the tip's); more, the
    !> correction folded into x (col = 0, c = 0); none, col = 0, c = 0.
@@ -852,14 +732,6 @@ contains
          & + (1 - 2*reduced%beta)*(usu - dsu))
    end function energy
 
-   !> Violation of the stops by a tip value (m).
-   pure function violation(u_tip, scene) result(v)
-      real(wp), intent(in) :: u_tip
-      type(scene_type), intent(in) :: scene
-      real(wp) :: v
-      v = max(u_tip - scene%upper, scene%lower - u_tip, 0.0_wp)
-   end function violation
-
    !> Physical displacement (T q)(x_i) + h(x_i) phi(t) at the nodes x_0..x_J, O(J (r + m)).
    pure subroutine physical_shape(reduced, q, t, scene, shape)
       type(reduced_model_type), intent(in) :: reduced
@@ -874,13 +746,6 @@ contains
          end do
       end do
    end subroutine physical_shape
-
-   !> The first multiple of `every` at or after `step`.
-   pure function next_multiple(step, every) result(m)
-      integer(ik), intent(in) :: step, every
-      integer(ik) :: m
-      m = ((step + every - 1)/every)*every
-   end function next_multiple
 
    !> Text of a real for messages.
    function real_text(x) result(s)

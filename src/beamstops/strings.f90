@@ -73,9 +73,7 @@ contains
       !> Value.
       integer, intent(in) :: i
       character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      s = trim(buf)
+      s = fmt_int(int(i, ik))
    end function itoa
 
    !> A real as a namelist literal that reads back exactly and always looks real

@@ -1,5 +1,5 @@
-!> Helpers of the physics suites (damping, restitution, mass redistribution): a run stepped
-!> one step at a time, the modes of a model, peaks of a sampled signal.
+!> Helpers of the physics suites (damping, restitution, mass redistribution): the tube scene, a
+!> run stepped one step at a time, the modes of a model, peaks of a sampled signal.
 module physics_support
    use testing, only: wp, error_type, fatal_error, int_text
    use beamstops, only: ik, scene_type, model_type, build_model, state_type, start_state, array_recorder, &
@@ -8,9 +8,31 @@ module physics_support
    use beamstops_lapack, only: dsbgv, dsbgv_message
    implicit none
    private
-   public :: open_run, step_once, modes, peaks
+   public :: tube_scene, open_run, step_once, modes, peaks
 
 contains
+
+   !> The tube of input/tube_supports.nml (30 elements, three stops along the span, beta = 1/4)
+   !> with the given step and duration; the suites add the law they test.
+   function tube_scene(dt, t_end) result(scene)
+      !> Time step (s).
+      real(wp), intent(in) :: dt
+      !> Duration (s).
+      real(wp), intent(in) :: t_end
+      type(scene_type) :: scene
+      scene%length = 1.5_wp
+      scene%k2 = 2.0e11_wp*1.6881e-10_wp/(8.0e3_wp*1.4923e-5_wp)
+      scene%mass_per_length = 8.0e3_wp*1.4923e-5_wp
+      scene%amplitude = 0.002_wp
+      scene%omega = 40.0_wp
+      scene%elements = 30
+      scene%stop_nodes = [10, 20, 30]
+      scene%stop_lower = [-0.002_wp, -0.002_wp, -0.004_wp]
+      scene%stop_upper = [0.002_wp, 0.002_wp, 0.004_wp]
+      scene%dt = dt
+      scene%t_end = t_end
+      scene%beta = 0.25_wp
+   end function tube_scene
 
    !> Build the model of a scene (optionally with the initial data replaced) and start a run whose
    !> recorder keeps every record.

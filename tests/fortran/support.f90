@@ -1,13 +1,14 @@
 !> Helpers shared by the suites: LAPACK eigenvalues computed by the tests themselves,
-!> and a whole run of a scene into an array recorder.
+!> a whole run of a scene into an array recorder, and two runs' records compared bit for bit.
 module test_support
    use testing, only: int_text   ! public here too, for the suites that take it from this module
    use beamstops, only: wp, ik, error_type, fatal_error, scene_type, validate_scene, model_type, &
       & prepare_run, simulate, record_count, array_recorder, run_summary, status_complete, stop_count
    use beamstops_lapack, only: dsbgv, dsygv, dsbgv_message, dsygv_message
+   use beamstops_recorder, only: n_columns
    implicit none
    private
-   public :: band_eigenvalues, dense_eigenvalues, run_recorded, int_text
+   public :: band_eigenvalues, dense_eigenvalues, run_recorded, same_columns, int_text
    public :: basis_coefficients, product_integral, poly, exact_element, dense_assembly, lift, lift_prime
    public :: simpson_load, solve_spd
 
@@ -252,4 +253,26 @@ contains
       if (rec%filled /= record_count(scene)) call fatal_error(error, 'the run recorded '//int_text(rec%filled)// &
          & ' rows, record_count gives '//int_text(record_count(scene)))
    end subroutine run_recorded
+
+   !> Fail with "[what: ]column c differs" at the first record column whose rows differ between
+   !> two recorders (each compared as its filled rows).
+   subroutine same_columns(error, a, b, what)
+      !> Set at the first column that differs.
+      type(error_type), allocatable, intent(inout) :: error
+      !> The two runs' records.
+      type(array_recorder), intent(in) :: a, b
+      !> What is compared, leading the message.
+      character(len=*), intent(in), optional :: what
+      integer :: c
+      do c = 1, n_columns
+         if (any(a%rows(c, 1:a%filled) /= b%rows(c, 1:b%filled))) then
+            if (present(what)) then
+               call fatal_error(error, what//': column '//int_text(c)//' differs')
+            else
+               call fatal_error(error, 'column '//int_text(c)//' differs')
+            end if
+            return
+         end if
+      end do
+   end subroutine same_columns
 end module test_support

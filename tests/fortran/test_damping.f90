@@ -2,14 +2,14 @@
 !> with the damping's column, and zero damping equal to the undamped engine.
 module test_damping
    use testing
-   use test_support, only: run_recorded, band_eigenvalues
-   use physics_support, only: open_run, modes, peaks
+   use test_support, only: run_recorded, same_columns, band_eigenvalues
+   use physics_support, only: tube_scene, open_run, modes, peaks
    use beamstops, only: ik, scene_type, model_type, build_model, state_type, array_recorder, run_summary, &
       & law_none, law_signorini, steps_of
    use beamstops_scheme, only: advance
    use beamstops_checkpoint, only: write_checkpoint, read_checkpoint
    use beamstops_files, only: remove_file
-   use beamstops_recorder, only: col_t, col_u, col_energy, col_work, col_dissipated, col_damped, n_columns
+   use beamstops_recorder, only: col_t, col_u, col_energy, col_work, col_dissipated, col_damped
    implicit none
    private
    public :: collect_damping
@@ -186,7 +186,6 @@ contains
       type(scene_type) :: plain, zero
       type(array_recorder) :: a, b
       type(run_summary) :: summary
-      integer :: c
       plain%elements = 8
       plain%dt = 5.0e-5_wp
       plain%t_end = 0.5_wp
@@ -200,12 +199,8 @@ contains
       if (allocated(error)) return
       call run_recorded(zero, b, summary, error)
       if (allocated(error)) return
-      do c = 1, n_columns
-         if (any(a%rows(c, 1:a%filled) /= b%rows(c, 1:b%filled))) then
-            call test_failed(error, 'column '//int_text(c)//' differs')
-            return
-         end if
-      end do
+      call same_columns(error, a, b)
+      if (allocated(error)) return
       call check(error, maxval(abs(b%rows(col_damped, 1:b%filled))), 0.0_wp, 'nothing damped')
    end subroutine test_zero_damping
 
@@ -214,18 +209,7 @@ contains
       type(scene_type) :: scene
       type(array_recorder) :: rec
       type(run_summary) :: summary
-      scene%length = 1.5_wp
-      scene%k2 = 2.0e11_wp*1.6881e-10_wp/(8.0e3_wp*1.4923e-5_wp)
-      scene%mass_per_length = 8.0e3_wp*1.4923e-5_wp
-      scene%amplitude = 0.002_wp
-      scene%omega = 40.0_wp
-      scene%elements = 30
-      scene%stop_nodes = [10, 20, 30]
-      scene%stop_lower = [-0.002_wp, -0.002_wp, -0.004_wp]
-      scene%stop_upper = [0.002_wp, 0.002_wp, 0.004_wp]
-      scene%dt = 2.0e-5_wp
-      scene%t_end = 1.0_wp
-      scene%beta = 0.25_wp
+      scene = tube_scene(2.0e-5_wp, 1.0_wp)
       scene%damping_by_ratio = .true.
       scene%damping_ratio = [0.02_wp, 0.0_wp]
       call run_recorded(scene, rec, summary, error)

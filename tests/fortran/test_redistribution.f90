@@ -6,7 +6,7 @@
 module test_redistribution
    use testing
    use test_support, only: run_recorded, band_eigenvalues
-   use physics_support, only: open_run, step_once
+   use physics_support, only: tube_scene, open_run, step_once
    use beamstops, only: ik, scene_type, model_type, build_model, state_type, array_recorder, run_summary, &
       & steps_of, validate_scene
    use beamstops_band, only: kd, band_matvec, cholesky_factor
@@ -312,18 +312,7 @@ contains
       type(run_summary) :: summary
       real(wp) :: defect, scale
       integer(ik) :: j
-      scene%length = 1.5_wp
-      scene%k2 = 2.0e11_wp*1.6881e-10_wp/(8.0e3_wp*1.4923e-5_wp)
-      scene%mass_per_length = 8.0e3_wp*1.4923e-5_wp
-      scene%amplitude = 0.002_wp
-      scene%omega = 40.0_wp
-      scene%elements = 30
-      scene%stop_nodes = [10, 20, 30]
-      scene%stop_lower = [-0.002_wp, -0.002_wp, -0.004_wp]
-      scene%stop_upper = [0.002_wp, 0.002_wp, 0.004_wp]
-      scene%dt = 1.0e-5_wp
-      scene%t_end = 0.5_wp
-      scene%beta = 0.25_wp
+      scene = tube_scene(1.0e-5_wp, 0.5_wp)
       scene%redistributed_mass = .true.
       call run_recorded(scene, rec, summary, error)
       if (allocated(error)) return

@@ -5,12 +5,12 @@
 !> as dt -> 0.
 module test_restitution
    use testing
-   use test_support, only: run_recorded
-   use physics_support, only: open_run, step_once
+   use test_support, only: run_recorded, same_columns
+   use physics_support, only: tube_scene, open_run, step_once
    use beamstops, only: ik, scene_type, model_type, state_type, array_recorder, run_summary, law_signorini, &
       & steps_of
    use beamstops_forcing, only: support_position
-   use beamstops_recorder, only: col_t, col_u, col_reaction, n_columns
+   use beamstops_recorder, only: col_t, col_u, col_reaction
    implicit none
    private
    public :: collect_restitution
@@ -47,7 +47,6 @@ contains
       type(array_recorder) :: a, b
       type(run_summary) :: summary
       type(scene_type) :: scene
-      integer :: c
       scene = paper(1.0e-5_wp, 0.5_wp, 0.0_wp)
       call run_recorded(scene, a, summary, error)
       if (allocated(error)) return
@@ -55,12 +54,7 @@ contains
       scene%restitution = 0
       call run_recorded(scene, b, summary, error)
       if (allocated(error)) return
-      do c = 1, n_columns
-         if (any(a%rows(c, 1:a%filled) /= b%rows(c, 1:b%filled))) then
-            call test_failed(error, 'column '//int_text(c)//' differs')
-            return
-         end if
-      end do
+      call same_columns(error, a, b)
    end subroutine test_zero
 
    !> Step a tip scene one step at a time, checking the KKT conditions of the combination;
@@ -132,18 +126,7 @@ contains
       integer(ik) :: step
       integer :: i, k, contacts
       ! the tube of input/tube_supports.nml, one second
-      scene%length = 1.5_wp
-      scene%k2 = 2.0e11_wp*1.6881e-10_wp/(8.0e3_wp*1.4923e-5_wp)
-      scene%mass_per_length = 8.0e3_wp*1.4923e-5_wp
-      scene%amplitude = 0.002_wp
-      scene%omega = 40.0_wp
-      scene%elements = 30
-      scene%stop_nodes = [10, 20, 30]
-      scene%stop_lower = [-0.002_wp, -0.002_wp, -0.004_wp]
-      scene%stop_upper = [0.002_wp, 0.002_wp, 0.004_wp]
-      scene%dt = 2.0e-5_wp
-      scene%t_end = 1.0_wp
-      scene%beta = 0.25_wp
+      scene = tube_scene(2.0e-5_wp, 1.0_wp)
       scene%restitution = e
       call open_run(scene, model, state, rec, error)
       if (allocated(error)) return
@@ -241,7 +224,7 @@ contains
       type(scene_type) :: tip, span
       type(array_recorder) :: a, b
       type(run_summary) :: summary
-      integer :: c, k
+      integer :: k
       do k = 1, 2
          tip = paper(1.0e-5_wp, 0.5_wp, 0.5_wp)
          tip%redistributed_mass = k == 2
@@ -253,12 +236,8 @@ contains
          if (allocated(error)) return
          call run_recorded(span, b, summary, error)
          if (allocated(error)) return
-         do c = 1, n_columns
-            if (any(a%rows(c, 1:a%filled) /= b%rows(c, 1:b%filled))) then
-               call test_failed(error, merge('massless  ', 'consistent', k == 2)//': column '//int_text(c)//' differs')
-               return
-            end if
-         end do
+         call same_columns(error, a, b, merge('massless  ', 'consistent', k == 2))
+         if (allocated(error)) return
       end do
    end subroutine test_one_stop
 end module test_restitution

@@ -8,7 +8,7 @@ module test_shocks
       & shock_column_names, side_lower, side_upper
    implicit none
    private
-   public :: collect_shocks, lecuyer, uniform, same_bits
+   public :: collect_shocks, lecuyer, uniform, same_bits, expect_message
 
    !> Time step of the synthetic sequences (s).
    real(wp), parameter :: dt = 1.0e-3_wp
@@ -290,33 +290,14 @@ contains
       type(shock_row) :: row
       type(shock_row), allocatable :: got(:), want(:)
       real(wp) :: a(n_shock_columns), b(n_shock_columns), sum_impulse, sum_energy
-      logical :: contact
       real(wp), parameter :: rests(6) = [0.0_wp, 0.5_wp*dt, dt, 2*dt, 3.5_wp*dt, 12*dt]
       allocate (r(m, n), u(m, n), e(m, n))
       s1 = 12345
       s2 = 67890
       do trial = 1, 6
          rest = rests(trial)
-         ! Contact bursts: a two-state chain (free -> contact rarely, contact -> free often), sign
-         ! switches rarely.
-         do i = 1, m
-            contact = .false.
-            do k = 1, n
-               if (contact) then
-                  contact = uniform(s1, s2) < 0.6_wp
-               else
-                  contact = uniform(s1, s2) < 0.08_wp
-               end if
-               u(i, k) = 0.05_wp*sin(0.01_wp*k + i) + 1.0e-3_wp*uniform(s1, s2)
-               if (contact) then
-                  r(i, k) = (0.5_wp + uniform(s1, s2))*merge(1, -1, mod(k/700 + i, 2) == 0)
-                  e(i, k) = uniform(s1, s2)
-               else
-                  r(i, k) = 0
-                  e(i, k) = 0
-               end if
-            end do
-         end do
+         ! Contact bursts, sign switches rarely.
+         call bursts(700, s1, s2, u, r, e)
          call new_shock_log(log, m, rest, [0.0_wp, 0.0_wp], error, capacity=64)
          if (allocated(error)) return
          allocate (got(0))
@@ -500,24 +481,14 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(shock_log) :: log
       call new_shock_log(log, 1, -1.0_wp, [0.0_wp], error)
-      call expect('shock log: rest_time = -1 is out of range; allowed: rest_time >= 0 s'); if (allocated(error)) return
+      call expect_message(error, 'shock log: rest_time = -1 is out of range; allowed: rest_time >= 0 s')
+      if (allocated(error)) return
       call new_shock_log(log, 0, 0.0_wp, [real(wp) ::], error)
-      call expect('shock log: stops = 0 is out of range; allowed: stops >= 1'); if (allocated(error)) return
+      call expect_message(error, 'shock log: stops = 0 is out of range; allowed: stops >= 1'); if (allocated(error)) return
       call new_shock_log(log, 2, 0.0_wp, [0.0_wp], error)
-      call expect('shock log: u0 has 1 values; allowed: one per stop (2)'); if (allocated(error)) return
+      call expect_message(error, 'shock log: u0 has 1 values; allowed: one per stop (2)'); if (allocated(error)) return
       call new_shock_log(log, 1, 0.0_wp, [0.0_wp], error, capacity=0)
-      call expect('shock log: capacity = 0 is out of range; allowed: capacity >= 1')
-   contains
-      subroutine expect(message)
-         character(len=*), intent(in) :: message
-         if (.not. allocated(error)) then
-            call test_failed(error, 'no error; expected "'//message//'"')
-         else if (error%message /= message) then
-            call test_failed(error, 'message "'//error%message//'", expected "'//message//'"')
-         else
-            deallocate (error)
-         end if
-      end subroutine expect
+      call expect_message(error, 'shock log: capacity = 0 is out of range; allowed: capacity >= 1')
    end subroutine test_bad_inputs
 
    subroutine test_row_values(error)
@@ -557,14 +528,23 @@ contains
       integer(ik), intent(in) :: seed
       real(wp), allocatable, intent(out) :: u(:, :), r(:, :), e(:, :)
       integer(ik) :: s1, s2
-      integer :: i, k
-      logical :: contact
       allocate (u(m, n), r(m, n), e(m, n))
       s1 = seed
       s2 = 2*seed + 1
-      do i = 1, m
+      call bursts(300, s1, s2, u, r, e)
+   end subroutine synthetic
+
+   !> Fill u, r, e (stops x steps) with contact bursts (a two-state chain: free -> contact rarely,
+   !> contact -> free often) whose sign switches every `period` steps, drawing from s1, s2.
+   subroutine bursts(period, s1, s2, u, r, e)
+      integer, intent(in) :: period
+      integer(ik), intent(inout) :: s1, s2
+      real(wp), intent(out) :: u(:, :), r(:, :), e(:, :)
+      integer :: i, k
+      logical :: contact
+      do i = 1, size(u, 1)
          contact = .false.
-         do k = 1, n
+         do k = 1, size(u, 2)
             if (contact) then
                contact = uniform(s1, s2) < 0.6_wp
             else
@@ -572,7 +552,7 @@ contains
             end if
             u(i, k) = 0.05_wp*sin(0.01_wp*k + i) + 1.0e-3_wp*uniform(s1, s2)
             if (contact) then
-               r(i, k) = (0.5_wp + uniform(s1, s2))*merge(1, -1, mod(k/300 + i, 2) == 0)
+               r(i, k) = (0.5_wp + uniform(s1, s2))*merge(1, -1, mod(k/period + i, 2) == 0)
                e(i, k) = uniform(s1, s2)
             else
                r(i, k) = 0
@@ -580,7 +560,7 @@ contains
             end if
          end do
       end do
-   end subroutine synthetic
+   end subroutine bursts
 
    !> pack at random midpoints, unpack into a fresh log, continue both with the same steps: the
    !> same rows, counts and packed state, bit for bit (rings of several sizes, some overflowing).
@@ -696,23 +676,24 @@ contains
       if (allocated(error)) return
       call b%pack(vb)
       call b%unpack(va(1:n - 1), error)
-      call expect('shock log: unpack: '//int_text(n - 1)//' values, header length '//int_text(n)// &
+      call expect_message(error, 'shock log: unpack: '//int_text(n - 1)//' values, header length '//int_text(n)// &
          & '; the header (m = 2, held = '//int_text(int(a%shock_count()))//') needs '//int_text(n))
       if (allocated(error)) return
       call b%unpack(va(1:5), error)
-      call expect('shock log: unpack: 5 values, too short for the header (6)'); if (allocated(error)) return
+      call expect_message(error, 'shock log: unpack: 5 values, too short for the header (6)'); if (allocated(error)) return
       call b%unpack([va, 0.0_wp], error)
-      call expect('shock log: unpack: '//int_text(n + 1)//' values, header length '//int_text(n)// &
+      call expect_message(error, 'shock log: unpack: '//int_text(n + 1)//' values, header length '//int_text(n)// &
          & '; the header (m = 2, held = '//int_text(int(a%shock_count()))//') needs '//int_text(n))
       if (allocated(error)) return
       vc = va
       vc(1) = 7302
       call b%unpack(vc, error)
-      call expect('shock log: unpack: tag 7302, version 1; expected tag 7301, version 1'); if (allocated(error)) return
+      call expect_message(error, 'shock log: unpack: tag 7302, version 1; expected tag 7301, version 1')
+      if (allocated(error)) return
       vc = va
       vc(4) = 2.5_wp
       call b%unpack(vc, error)
-      call expect('shock log: unpack: header value 4 = 2.5 is not an integer'); if (allocated(error)) return
+      call expect_message(error, 'shock log: unpack: header value 4 = 2.5 is not an integer'); if (allocated(error)) return
       vc = va
       vc(10 + 5*2 + 1) = 0.5_wp
       call b%unpack(vc, error)
@@ -731,18 +712,23 @@ contains
       deallocate (error)
       call b%pack(vc)
       call check(error, size(vb) == size(vc) .and. all(same_bits(vb, vc)), 'unchanged after the errors')
-   contains
-      subroutine expect(message)
-         character(len=*), intent(in) :: message
-         if (.not. allocated(error)) then
-            call test_failed(error, 'no error; expected "'//message//'"')
-         else if (error%message /= message) then
-            call test_failed(error, 'message "'//error%message//'", expected "'//message//'"')
-         else
-            deallocate (error)
-         end if
-      end subroutine expect
    end subroutine test_unpack_bad
+
+   !> Expect the error `message`: a failure in `error` when there is none or another, else
+   !> `error` deallocated (the next call can go on).
+   subroutine expect_message(error, message)
+      !> The error of the call checked; on return, unallocated or the failure.
+      type(error_type), allocatable, intent(inout) :: error
+      !> The message expected.
+      character(len=*), intent(in) :: message
+      if (.not. allocated(error)) then
+         call test_failed(error, 'no error; expected "'//message//'"')
+      else if (error%message /= message) then
+         call test_failed(error, 'message "'//error%message//'", expected "'//message//'"')
+      else
+         deallocate (error)
+      end if
+   end subroutine expect_message
 
    !> L'Ecuyer's combined generator (1988): deterministic, portable (int64, no overflow).
    function lecuyer(s1, s2) result(z)

@@ -10,7 +10,7 @@ module test_statistics
    use beamstops_observe_shocks, only: shock_log, shock_row, new_shock_log, shock_row_values
    use beamstops_observe_statistics, only: statistics_type, new_statistics, validate_statistics, validate_ensemble, &
       & statistics_table, quantity_type, ensemble_table, student_t_quantile, student_t_cdf
-   use test_shocks, only: uniform, same_bits
+   use test_shocks, only: uniform, same_bits, expect_message
    implicit none
    private
    public :: collect_statistics
@@ -89,40 +89,35 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(statistics_type) :: stats
       call validate_statistics(1.0_wp, 10.0_wp, 1, 10, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
-      call expect('in.nml: &statistics batches = 1 is out of range; allowed: batches >= 2'); if (allocated(error)) return
+      call expect_message(error, 'in.nml: &statistics batches = 1 is out of range; allowed: batches >= 2')
+      if (allocated(error)) return
       call validate_statistics(10.0_wp, 10.0_wp, 20, 10, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
-      call expect('in.nml: &statistics transient = 10 is out of range; allowed: 0 <= transient < t_end = 10 s')
+      call expect_message(error, 'in.nml: &statistics transient = 10 is out of range; allowed: 0 <= transient < t_end ='// &
+         & ' 10 s')
       if (allocated(error)) return
       call validate_statistics(-1.0_wp, 10.0_wp, 20, 10, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
-      call expect('in.nml: &statistics transient = -1 is out of range; allowed: 0 <= transient < t_end = 10 s')
+      call expect_message(error, 'in.nml: &statistics transient = -1 is out of range; allowed: 0 <= transient < t_end ='// &
+         & ' 10 s')
       if (allocated(error)) return
       call validate_statistics(1.0_wp, 10.0_wp, 20, 10, -2.0e-3_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
-      call expect('in.nml: &statistics rest_time = -0.002 is out of range; allowed: rest_time >= 0 s')
+      call expect_message(error, 'in.nml: &statistics rest_time = -0.002 is out of range; allowed: rest_time >= 0 s')
       if (allocated(error)) return
       call validate_statistics(1.0_wp, 10.0_wp, 20, 0, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
-      call expect('in.nml: &statistics bins = 0 is out of range; allowed: bins >= 1'); if (allocated(error)) return
+      call expect_message(error, 'in.nml: &statistics bins = 0 is out of range; allowed: bins >= 1')
+      if (allocated(error)) return
       call validate_statistics(1.0_wp, 10.0_wp, 20, 10, 0.0_wp, 0.1_wp, 0.1_wp, 'in.nml', error)
-      call expect('in.nml: &statistics histogram_upper = 0.1 is out of range; allowed: histogram_upper > histogram_lower = 0.1 m')
+      call expect_message(error, 'in.nml: &statistics histogram_upper = 0.1 is out of range; allowed: histogram_upper >'// &
+         & ' histogram_lower = 0.1 m')
       if (allocated(error)) return
       call validate_ensemble(0, 'in.nml', error)
-      call expect('in.nml: &ensemble members = 0 is out of range; allowed: members >= 1'); if (allocated(error)) return
+      call expect_message(error, 'in.nml: &ensemble members = 0 is out of range; allowed: members >= 1')
+      if (allocated(error)) return
       call validate_statistics(1.0_wp, 10.0_wp, 2, 1, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
       call check(error, .not. allocated(error), 'batches = 2, bins = 1 accepted'); if (allocated(error)) return
       call validate_ensemble(1, 'in.nml', error)
       call check(error, .not. allocated(error), 'members = 1 accepted'); if (allocated(error)) return
       call new_statistics(stats, 1, 0.0_wp, 1.0_wp, 1, 4, -1.0_wp, 1.0_wp, error)
-      call expect('statistics: &statistics batches = 1 is out of range; allowed: batches >= 2')
-   contains
-      subroutine expect(message)
-         character(len=*), intent(in) :: message
-         if (.not. allocated(error)) then
-            call test_failed(error, 'no error; expected "'//message//'"')
-         else if (error%message /= message) then
-            call test_failed(error, 'message "'//error%message//'", expected "'//message//'"')
-         else
-            deallocate (error)
-         end if
-      end subroutine expect
+      call expect_message(error, 'statistics: &statistics batches = 1 is out of range; allowed: batches >= 2')
    end subroutine test_bad_inputs
 
    !> Feed a one-stop sequence (t_k = k dt) to a shock log and to statistics, shocks drained every
@@ -179,6 +174,14 @@ contains
       v = table%quantity(q)%value(i)
       h = table%quantity(q)%half_width(i)
    end subroutine get
+
+   !> The value of quantity `name` (its first entry) in a table; NaN when it is not there.
+   function value_of(table, name) result(v)
+      type(statistics_table), intent(in) :: table
+      character(len=*), intent(in) :: name
+      real(wp) :: v, h
+      call get(table, name, v, h)
+   end function value_of
 
    !> Half-width t(0.975, 4) s/sqrt(5) of five batch values.
    pure function hw5(x) result(h)
@@ -425,31 +428,27 @@ contains
       call run_both(u, r, e, 0.0_wp, 0.5005_wp, n*dt, 10, 5, -0.1_wp, 0.1_wp, table, rows, error)
       if (allocated(error)) return
       call check(error, size(rows), 0, 'shock rows'); if (allocated(error)) return
-      call get(table, 'shocks', v, h)
-      call check(error, v, 0.0_wp, 'shocks'); if (allocated(error)) return
+      call check(error, value_of(table, 'shocks'), 0.0_wp, 'shocks'); if (allocated(error)) return
       call get(table, 'power', v, h)
       call check(error, v, 0.0_wp, 'power'); if (allocated(error)) return
       call check(error, h, 0.0_wp, 'power half-width'); if (allocated(error)) return
-      call get(table, 'shocks_per_second', v, h)
-      call check(error, v, 0.0_wp, 'shocks per second'); if (allocated(error)) return
-      call get(table, 'force_max', v, h)
-      call check(error, v, 0.0_wp, 'force_max'); if (allocated(error)) return
-      call get(table, 'contact_fraction', v, h)
-      call check(error, v, 0.0_wp, 'contact fraction'); if (allocated(error)) return
-      call get(table, 'rebounds_per_shock', v, h)
-      call check(error, ieee_is_nan(v), 'rebounds per shock undefined (NaN) without shocks'); if (allocated(error)) return
-      call get(table, 'force_mean_contact', v, h)
-      call check(error, ieee_is_nan(v), 'force over contact time undefined (NaN)'); if (allocated(error)) return
-      call get(table, 'shock_duration_max', v, h)
-      call check(error, ieee_is_nan(v), 'shock duration max undefined (NaN)'); if (allocated(error)) return
-      call get(table, 'window', v, h)
-      call check(error, v, (n - 500)*dt, 'window', rel=.true., thr=1.0e-12_wp)
+      call check(error, value_of(table, 'shocks_per_second'), 0.0_wp, 'shocks per second'); if (allocated(error)) return
+      call check(error, value_of(table, 'force_max'), 0.0_wp, 'force_max'); if (allocated(error)) return
+      call check(error, value_of(table, 'contact_fraction'), 0.0_wp, 'contact fraction'); if (allocated(error)) return
+      call check(error, ieee_is_nan(value_of(table, 'rebounds_per_shock')), &
+         & 'rebounds per shock undefined (NaN) without shocks')
+      if (allocated(error)) return
+      call check(error, ieee_is_nan(value_of(table, 'force_mean_contact')), 'force over contact time undefined (NaN)')
+      if (allocated(error)) return
+      call check(error, ieee_is_nan(value_of(table, 'shock_duration_max')), 'shock duration max undefined (NaN)')
+      if (allocated(error)) return
+      call check(error, value_of(table, 'window'), (n - 500)*dt, 'window', rel=.true., thr=1.0e-12_wp)
    end subroutine test_no_contact
 
    subroutine test_transient(error)
       type(error_type), allocatable, intent(out) :: error
       integer, parameter :: n = 1000
-      real(wp) :: u(n), r(n), e(n), v, h
+      real(wp) :: u(n), r(n), e(n)
       type(statistics_table) :: table
       type(shock_row), allocatable :: rows(:)
       ! A big excursion and shock in the transient, one shock after.
@@ -464,16 +463,12 @@ contains
       call run_both(u, r, e, 5*dt, 0.3005_wp, n*dt, 4, 2, -0.1_wp, 0.1_wp, table, rows, error)
       if (allocated(error)) return
       call check(error, size(rows), 2, 'rows'); if (allocated(error)) return
-      call get(table, 'shocks', v, h)
-      call check(error, v, 1.0_wp, 'shocks after the transient'); if (allocated(error)) return
-      call get(table, 'tip_max', v, h)
-      call check(error, v, 0.01_wp, 'tip_max'); if (allocated(error)) return
-      call get(table, 'force_max', v, h)
-      call check(error, v, 2.0_wp, 'force_max'); if (allocated(error)) return
-      call get(table, 'power', v, h)
-      call check(error, v, 0.5_wp/((n - 300)*dt), 'power', rel=.true., thr=1.0e-12_wp); if (allocated(error)) return
-      call get(table, 'impulse_rate', v, h)
-      call check(error, v, 4*dt/((n - 300)*dt), 'impulse rate', rel=.true., thr=1.0e-12_wp)
+      call check(error, value_of(table, 'shocks'), 1.0_wp, 'shocks after the transient'); if (allocated(error)) return
+      call check(error, value_of(table, 'tip_max'), 0.01_wp, 'tip_max'); if (allocated(error)) return
+      call check(error, value_of(table, 'force_max'), 2.0_wp, 'force_max'); if (allocated(error)) return
+      call check(error, value_of(table, 'power'), 0.5_wp/((n - 300)*dt), 'power', rel=.true., thr=1.0e-12_wp)
+      if (allocated(error)) return
+      call check(error, value_of(table, 'impulse_rate'), 4*dt/((n - 300)*dt), 'impulse rate', rel=.true., thr=1.0e-12_wp)
    end subroutine test_transient
 
    subroutine test_step_tip(error)
@@ -662,47 +657,40 @@ contains
       if (allocated(error)) return
       call b%pack(vb)
       call b%unpack(va(1:n - 1), error)
-      call expect('statistics: unpack: '//int_text(n - 1)//' values, header length '//int_text(n)// &
+      call expect_message(error, 'statistics: unpack: '//int_text(n - 1)//' values, header length '//int_text(n)// &
          & '; the header (m = 2, batches = 4, bins = 7) needs '//int_text(n))
       if (allocated(error)) return
       call b%unpack(va(1:3), error)
-      call expect('statistics: unpack: 3 values, too short for the header (6)'); if (allocated(error)) return
+      call expect_message(error, 'statistics: unpack: 3 values, too short for the header (6)'); if (allocated(error)) return
       call b%unpack([va, 1.0_wp], error)
-      call expect('statistics: unpack: '//int_text(n + 1)//' values, header length '//int_text(n)// &
+      call expect_message(error, 'statistics: unpack: '//int_text(n + 1)//' values, header length '//int_text(n)// &
          & '; the header (m = 2, batches = 4, bins = 7) needs '//int_text(n))
       if (allocated(error)) return
       call new_shock_log(log, 1, 0.0_wp, [0.0_wp], error)
       if (allocated(error)) return
       call log%pack(vc)
       call b%unpack(vc, error)
-      call expect('statistics: unpack: tag 7301, version 1; expected tag 7302, version 1'); if (allocated(error)) return
+      call expect_message(error, 'statistics: unpack: tag 7301, version 1; expected tag 7302, version 1')
+      if (allocated(error)) return
       vc = va
       vc(5) = 1
       call b%unpack(vc, error)
-      call expect('statistics: unpack: header m = 2, batches = 1, bins = 7 is inconsistent'); if (allocated(error)) return
+      call expect_message(error, 'statistics: unpack: header m = 2, batches = 1, bins = 7 is inconsistent')
+      if (allocated(error)) return
       vc = va
       vc(6 + 7) = 5
       call b%unpack(vc, error)
-      call expect('statistics: unpack: value 13 = 5 is out of range (expected an integer, or a batch or bin index '// &
+      call expect_message(error, 'statistics: unpack: value 13 = 5 is out of range (expected an integer, or a batch or'// &
+         & ' bin index '// &
          & 'in range)'); if (allocated(error)) return
       vc = va
       vc(6 + 9) = 0.5_wp
       call b%unpack(vc, error)
-      call expect('statistics: unpack: value 15 = 0.5 is out of range (expected an integer, or a batch or bin index '// &
+      call expect_message(error, 'statistics: unpack: value 15 = 0.5 is out of range (expected an integer, or a batch or'// &
+         & ' bin index '// &
          & 'in range)'); if (allocated(error)) return
       call b%pack(vc)
       call check(error, size(vb) == size(vc) .and. all(same_bits(vb, vc)), 'unchanged after the errors')
-   contains
-      subroutine expect(message)
-         character(len=*), intent(in) :: message
-         if (.not. allocated(error)) then
-            call test_failed(error, 'no error; expected "'//message//'"')
-         else if (error%message /= message) then
-            call test_failed(error, 'message "'//error%message//'", expected "'//message//'"')
-         else
-            deallocate (error)
-         end if
-      end subroutine expect
    end subroutine test_unpack_bad
 
    subroutine test_ensemble(error)

@@ -59,6 +59,7 @@ def _text(value: Any) -> str:
 
 
 def _plain(value: Any) -> Any:
+    """An HDF5 attribute as a plain Python value (texts decoded, numpy scalars as int or float)."""
     if isinstance(value, (bytes, np.bytes_, str)):
         return _text(value)
     if isinstance(value, np.ndarray) and value.shape == ():

@@ -45,7 +45,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from .observations import Statistic, impacts_frame, read_impacts, read_statistics, statistics_frame
+from .observations import Statistic, _plain, impacts_frame, read_impacts, read_statistics, statistics_frame
 
 __all__ = ["Result", "Statistic", "IncompleteRunError", "load", "ARRAYS"]
 
@@ -151,19 +151,6 @@ class Result:
                 f"cpu_seconds={a.get('cpu_seconds')!r})")
 
 
-def _attribute(value: Any) -> Any:
-    """An HDF5 attribute as a plain Python value."""
-    if isinstance(value, (bytes, np.bytes_)):
-        return bytes(value).decode("utf-8", errors="replace").rstrip(" \x00")
-    if isinstance(value, np.ndarray) and value.shape == ():
-        value = value[()]
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, np.floating):
-        return float(value)
-    return value
-
-
 def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result:
     """Read the HDF5 output of ``beamstops run``.
 
@@ -181,7 +168,7 @@ def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result
     except OSError as exc:
         raise OSError(f"{path}: cannot read as HDF5 ({exc})") from None
     with file as f:
-        attrs = {name: _attribute(value) for name, value in f.attrs.items()}
+        attrs = {name: _plain(value) for name, value in f.attrs.items()}
         if "status" not in attrs:
             raise ValueError(f"{path}: not a beamstops output (no status attribute)")
         arrays: dict[str, np.ndarray] = {}

@@ -38,10 +38,12 @@
 !> happens on contact samples and at the few samples after a phase, in procedures kept out of
 !> line so that the common path stays a leaf without register saves.
 module beamstops_observe_shocks
-   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_positive_inf
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
    use beamstops_scene, only: fmt_real, fmt_int
+   use beamstops_observe_pack, only: put, ik_value, logical_value, take_header, take_real, take_int, take_ik, &
+      & take_logical
    implicit none
    private
    public :: shock_log, shock_row, new_shock_log, shock_row_values
@@ -453,11 +455,7 @@ contains
       !> Stop (default: all).
       integer, intent(in), optional :: i
       integer(ik) :: n
-      if (present(i)) then
-         n = self%shocks(i)
-      else
-         n = sum(self%shocks)
-      end if
+      n = count_at(self%shocks, i)
    end function shock_count
 
    !> Contact phases started so far at stop `i`, or at all stops.
@@ -467,12 +465,20 @@ contains
       !> Stop (default: all).
       integer, intent(in), optional :: i
       integer(ik) :: n
-      if (present(i)) then
-         n = self%phases(i)
-      else
-         n = sum(self%phases)
-      end if
+      n = count_at(self%phases, i)
    end function phase_count
+
+   !> counts(i), or the sum of counts when i is absent.
+   pure function count_at(counts, i) result(n)
+      integer(ik), intent(in) :: counts(:)
+      integer, intent(in), optional :: i
+      integer(ik) :: n
+      if (present(i)) then
+         n = counts(i)
+      else
+         n = sum(counts)
+      end if
+   end function count_at
 
    !> Rows dropped because the ring was full.
    pure function lost_count(self) result(n)
@@ -558,29 +564,15 @@ contains
       !> Set when the vector is not a packed shock log.
       type(error_type), allocatable, intent(out) :: error
       type(shock_log) :: new
-      integer :: i, j, p, m, cap, held, head, n, bad
+      integer :: i, j, p, m, cap, held, head, n, bad, header(pack_header - 2)
       integer(ik) :: want
-      if (size(values) < pack_header) then
-         call fatal_error(error, 'shock log: unpack: '//fmt_int(int(size(values), ik))// &
-            & ' values, too short for the header ('//fmt_int(int(pack_header, ik))//')')
-         return
-      end if
-      if (.not. (values(1) == pack_tag .and. values(2) == pack_version)) then
-         call fatal_error(error, 'shock log: unpack: tag '//fmt_real(values(1))//', version '//fmt_real(values(2))// &
-            & '; expected tag '//fmt_real(pack_tag)//', version '//fmt_real(pack_version))
-         return
-      end if
+      call take_header(values, 'shock log', pack_tag, pack_version, header, error)
+      if (allocated(error)) return
+      n = header(1)
+      m = header(2)
+      cap = header(3)
+      held = header(4)
       bad = 0
-      p = 2
-      call take_int(values, p, n, bad)
-      call take_int(values, p, m, bad)
-      call take_int(values, p, cap, bad)
-      call take_int(values, p, held, bad)
-      if (bad /= 0) then
-         call fatal_error(error, 'shock log: unpack: header value '//fmt_int(int(bad, ik))//' = '// &
-            & fmt_real(values(bad))//' is not an integer')
-         return
-      end if
       if (m < 0 .or. cap < 0 .or. held < 0 .or. held > cap .or. ((m == 0) .neqv. (cap == 0))) then
          call fatal_error(error, 'shock log: unpack: header m = '//fmt_int(int(m, ik))//', capacity = '// &
             & fmt_int(int(cap, ik))//', held = '//fmt_int(int(held, ik))//' is inconsistent')
@@ -677,90 +669,6 @@ contains
       call take_real(values, p, row%contact_time)
       call take_logical(values, p, row%truncated, bad)
    end subroutine take_row
-
-   !> Store x at values(p+1:), advance p.
-   pure subroutine put(values, p, x)
-      real(wp), intent(inout) :: values(:)
-      integer, intent(inout) :: p
-      real(wp), intent(in) :: x(:)
-      values(p + 1:p + size(x)) = x
-      p = p + size(x)
-   end subroutine put
-
-   !> An integer(ik) as a real: exact below 2**53; huge(1_ik) as +Infinity.
-   elemental function ik_value(x) result(v)
-      integer(ik), intent(in) :: x
-      real(wp) :: v
-      if (x == huge(1_ik)) then
-         v = ieee_value(v, ieee_positive_inf)
-      else
-         v = real(x, wp)
-      end if
-   end function ik_value
-
-   !> A logical as 1 or 0.
-   elemental function logical_value(x) result(v)
-      logical, intent(in) :: x
-      real(wp) :: v
-      v = merge(1.0_wp, 0.0_wp, x)
-   end function logical_value
-
-   !> Read values(p+1) as a real, advance p.
-   pure subroutine take_real(values, p, x)
-      real(wp), intent(in) :: values(:)
-      integer, intent(inout) :: p
-      real(wp), intent(out) :: x
-      p = p + 1
-      x = values(p)
-   end subroutine take_real
-
-   !> Read values(p+1) as an integer(ik) (+Infinity: huge(1_ik)), advance p; bad = p when it is
-   !> not one (and bad was 0).
-   pure subroutine take_ik(values, p, x, bad)
-      real(wp), intent(in) :: values(:)
-      integer, intent(inout) :: p
-      integer(ik), intent(out) :: x
-      integer, intent(inout) :: bad
-      real(wp) :: v
-      p = p + 1
-      v = values(p)
-      x = 0
-      if (v > huge(v)) then
-         x = huge(1_ik)
-      else if (abs(v) <= 2.0_wp**62 .and. aint(v) == v) then
-         x = int(v, ik)
-      else if (bad == 0) then
-         bad = p
-      end if
-   end subroutine take_ik
-
-   !> Read values(p+1) as a default integer, advance p; bad = p when it is not one.
-   pure subroutine take_int(values, p, x, bad)
-      real(wp), intent(in) :: values(:)
-      integer, intent(inout) :: p
-      integer, intent(out) :: x
-      integer, intent(inout) :: bad
-      real(wp) :: v
-      p = p + 1
-      v = values(p)
-      x = 0
-      if (abs(v) <= real(huge(x), wp) .and. aint(v) == v) then
-         x = int(v)
-      else if (bad == 0) then
-         bad = p
-      end if
-   end subroutine take_int
-
-   !> Read values(p+1) as a logical (1 or 0), advance p; bad = p when it is neither.
-   pure subroutine take_logical(values, p, x, bad)
-      real(wp), intent(in) :: values(:)
-      integer, intent(inout) :: p
-      logical, intent(out) :: x
-      integer, intent(inout) :: bad
-      p = p + 1
-      x = values(p) == 1
-      if (.not. (values(p) == 1 .or. values(p) == 0) .and. bad == 0) bad = p
-   end subroutine take_logical
 
    !> A quiet NaN.
    function nan() result(x)

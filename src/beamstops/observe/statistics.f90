@@ -39,6 +39,7 @@ module beamstops_observe_statistics
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
    use beamstops_scene, only: fmt_real, fmt_int
+   use beamstops_observe_pack, only: put, take_header, take_real, take_reals, take_int, take_ik, take_iks
    use beamstops_observe_shocks, only: shock_row
    implicit none
    private
@@ -635,29 +636,15 @@ contains
       !> Set when the vector is not packed statistics.
       type(error_type), allocatable, intent(out) :: error
       type(statistics_type) :: s
-      integer :: p, n, m, b, k, bad
+      integer :: p, n, m, b, k, bad, header(pack_header - 2)
       real(wp) :: want
-      if (size(values) < pack_header) then
-         call fatal_error(error, 'statistics: unpack: '//fmt_int(int(size(values), ik))// &
-            & ' values, too short for the header ('//fmt_int(int(pack_header, ik))//')')
-         return
-      end if
-      if (.not. (values(1) == pack_tag .and. values(2) == pack_version)) then
-         call fatal_error(error, 'statistics: unpack: tag '//fmt_real(values(1))//', version '//fmt_real(values(2))// &
-            & '; expected tag '//fmt_real(pack_tag)//', version '//fmt_real(pack_version))
-         return
-      end if
+      call take_header(values, 'statistics', pack_tag, pack_version, header, error)
+      if (allocated(error)) return
+      n = header(1)
+      m = header(2)
+      b = header(3)
+      k = header(4)
       bad = 0
-      p = 2
-      call take_int(values, p, n, bad)
-      call take_int(values, p, m, bad)
-      call take_int(values, p, b, bad)
-      call take_int(values, p, k, bad)
-      if (bad /= 0) then
-         call fatal_error(error, 'statistics: unpack: header value '//fmt_int(int(bad, ik))//' = '// &
-            & fmt_real(values(bad))//' is not an integer')
-         return
-      end if
       if (.not. ((m >= 1 .and. b >= 2 .and. k >= 1) .or. (m == 0 .and. b == 0 .and. k == 0))) then
          call fatal_error(error, 'statistics: unpack: header m = '//fmt_int(int(m, ik))//', batches = '// &
             & fmt_int(int(b, ik))//', bins = '//fmt_int(int(k, ik))//' is inconsistent')
@@ -691,8 +678,8 @@ contains
          call take_int(values, p, s%batch, bad)
          if (bad == 0 .and. (s%batch < 0 .or. s%batch > b)) bad = p
          call take_real(values, p, s%next_edge)
-         call take_ik(values, p, s%n, bad)
-         call take_ik(values, p, s%run_start, bad)
+         call take_ik(values, p, s%n, bad, finite=.true.)
+         call take_ik(values, p, s%run_start, bad, finite=.true.)
          call take_int(values, p, s%run_bin, bad)
          if (bad == 0 .and. (s%run_bin < 0 .or. s%run_bin > k - 1)) bad = p
          call take_real(values, p, s%su)
@@ -700,25 +687,25 @@ contains
          call take_real(values, p, s%umin)
          call take_real(values, p, s%umax)
          call take_reals(values, p, size(s%edge), s%edge)
-         call take_iks(values, p, size(s%hist), s%hist, bad)
-         call take_iks(values, p, size(s%contact), s%contact, bad)
+         call take_iks(values, p, size(s%hist), s%hist, bad, finite=.true.)
+         call take_iks(values, p, size(s%contact), s%contact, bad, finite=.true.)
          call take_reals(values, p, size(s%sr), s%sr)
          call take_reals(values, p, size(s%srr), s%srr)
          call take_reals(values, p, size(s%rmax), s%rmax)
          call take_reals(values, p, size(s%se), s%se)
-         call take_iks(values, p, size(s%bn), s%bn, bad)
+         call take_iks(values, p, size(s%bn), s%bn, bad, finite=.true.)
          call take_reals(values, p, size(s%bsu), s%bsu)
          call take_reals(values, p, size(s%bsuu), s%bsuu)
          call take_reals(values, p, size(s%bumin), s%bumin)
          call take_reals(values, p, size(s%bumax), s%bumax)
-         call take_iks(values, p, size(s%bhist), s%bhist, bad)
-         call take_iks(values, p, size(s%bcontact), s%bcontact, bad)
+         call take_iks(values, p, size(s%bhist), s%bhist, bad, finite=.true.)
+         call take_iks(values, p, size(s%bcontact), s%bcontact, bad, finite=.true.)
          call take_reals(values, p, size(s%bsr), s%bsr)
          call take_reals(values, p, size(s%bsrr), s%bsrr)
          call take_reals(values, p, size(s%brmax), s%brmax)
          call take_reals(values, p, size(s%bse), s%bse)
-         call take_iks(values, p, size(s%bshocks), s%bshocks, bad)
-         call take_iks(values, p, size(s%brebounds), s%brebounds, bad)
+         call take_iks(values, p, size(s%bshocks), s%bshocks, bad, finite=.true.)
+         call take_iks(values, p, size(s%brebounds), s%brebounds, bad, finite=.true.)
          call take_reals(values, p, size(s%bdur), s%bdur)
          call take_reals(values, p, size(s%bdurmin), s%bdurmin)
          call take_reals(values, p, size(s%bdurmax), s%bdurmax)
@@ -772,83 +759,6 @@ contains
       call move_alloc(s%bdurmax, self%bdurmax)
       call move_alloc(s%bimp, self%bimp)
    end subroutine unpack_statistics
-
-   !> Store x at values(p+1:), advance p.
-   pure subroutine put(values, p, x)
-      real(wp), intent(inout) :: values(:)
-      integer, intent(inout) :: p
-      real(wp), intent(in) :: x(:)
-      values(p + 1:p + size(x)) = x
-      p = p + size(x)
-   end subroutine put
-
-   !> Read values(p+1) as a real, advance p.
-   pure subroutine take_real(values, p, x)
-      real(wp), intent(in) :: values(:)
-      integer, intent(inout) :: p
-      real(wp), intent(out) :: x
-      p = p + 1
-      x = values(p)
-   end subroutine take_real
-
-   !> Read n reals into x (explicit shape: an array of any rank by sequence association, in
-   !> array element order), advance p.
-   pure subroutine take_reals(values, p, n, x)
-      real(wp), intent(in) :: values(:)
-      integer, intent(inout) :: p
-      integer, intent(in) :: n
-      real(wp), intent(out) :: x(n)
-      x = values(p + 1:p + n)
-      p = p + n
-   end subroutine take_reals
-
-   !> Read n integer(ik) into x as take_reals, advance p; bad = the index of the first value
-   !> that is not an integer below 2**62 (when bad was 0).
-   pure subroutine take_iks(values, p, n, x, bad)
-      real(wp), intent(in) :: values(:)
-      integer, intent(inout) :: p
-      integer, intent(in) :: n
-      integer(ik), intent(out) :: x(n)
-      integer, intent(inout) :: bad
-      integer :: i
-      do i = 1, n
-         call take_ik(values, p, x(i), bad)
-      end do
-   end subroutine take_iks
-
-   !> Read values(p+1) as an integer(ik), advance p; bad = p when it is not one (and bad was 0).
-   pure subroutine take_ik(values, p, x, bad)
-      real(wp), intent(in) :: values(:)
-      integer, intent(inout) :: p
-      integer(ik), intent(out) :: x
-      integer, intent(inout) :: bad
-      real(wp) :: v
-      p = p + 1
-      v = values(p)
-      x = 0
-      if (abs(v) <= 2.0_wp**62 .and. aint(v) == v) then
-         x = int(v, ik)
-      else if (bad == 0) then
-         bad = p
-      end if
-   end subroutine take_ik
-
-   !> Read values(p+1) as a default integer, advance p; bad = p when it is not one.
-   pure subroutine take_int(values, p, x, bad)
-      real(wp), intent(in) :: values(:)
-      integer, intent(inout) :: p
-      integer, intent(out) :: x
-      integer, intent(inout) :: bad
-      real(wp) :: v
-      p = p + 1
-      v = values(p)
-      x = 0
-      if (abs(v) <= real(huge(x), wp) .and. aint(v) == v) then
-         x = int(v)
-      else if (bad == 0) then
-         bad = p
-      end if
-   end subroutine take_int
 
    !> a / b, NaN when b = 0.
    elemental function ratio(a, b) result(r)
