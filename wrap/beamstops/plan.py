@@ -181,6 +181,7 @@ class Plan:
     runs: int = 0
     stopped: Optional[str] = None
     """Why the search stopped before finding a qualifying candidate (budget), or None."""
+    notes: list[str] = field(default_factory=list)
 
     def table(self) -> str:
         """The candidates as a markdown table."""
@@ -215,6 +216,7 @@ class Plan:
             state = "qualifies" if c.qualifies else "does NOT qualify (best estimate found)"
             out.append(f"choice: {c.model.describe()}: value {_g(c.value)}, estimated error {_g(c.error)} "
                        f"{self.unit}, {_g(c.cpu_per_second)} CPU s per simulated s; {state}")
+        out += [f"note: {note}" for note in self.notes]
         if self.check is not None:
             k = self.check
             overlap = "" if k.overlap is None else f"; intervals {'overlap' if k.overlap else 'do NOT overlap'}"
@@ -282,6 +284,7 @@ class _Runner:
         self.refused: dict[Model, str] = {}
         self.cpu = 0.0
         self.rate: Optional[float] = None  # CPU s per (element-step), from the runs so far
+        self.shock_rate = 0.0  # shocks per simulated second, the most seen (room in the shock log)
 
     def scene(self, model: Model) -> Scene:
         return _scene_of(self.base, model)
@@ -318,11 +321,12 @@ class _Runner:
         else:
             scene = scene.replace(record_every=max(1, math.ceil(steps / _RECORDS)))
         try:
-            result = run(scene)
+            result = run(scene, shock_capacity=4096 + int(2 * self.shock_rate * scene.t_end))
         except IncompleteRunError as exc:
             self.refused[model] = f"run {exc.result.status if exc.result else 'failed'}"
             return None
         entry = self._entry(result, scene)
+        self.shock_rate = max(self.shock_rate, result.shocks / scene.t_end)
         self.cache[model] = entry
         self.cpu += entry.cpu
         work = steps * (model.elements + _STEP_WORK)
@@ -421,7 +425,7 @@ def plan(scene: Scene, qoi: Union[str, Quantity], tol: Union[str, float], *, unt
         raise ValueError(f"the scene's window after its transient is empty (t_end {base.t_end} ≤ transient "
                          f"{base.transient})")
     meshes = _mesh_ladder(base)
-    runner = _Runner(base, quantity, grid, budget)
+    runner = pilot_runner = _Runner(base, quantity, grid, budget)
     own = Model(reference_law, base.elements, int(getattr(base, "modes")) if reduced_available() else 0, base.dt)
     pilot = runner.get(own)
     if pilot is None:
@@ -444,8 +448,8 @@ def plan(scene: Scene, qoi: Union[str, Quantity], tol: Union[str, float], *, unt
         out.window = needed
         if needed != window:
             base = base.replace(t_end=base.transient + needed)
-            runner = _Runner(base, quantity, grid, budget)
-            runner.cpu = pilot.cpu  # the pilot's CPU counts
+            pilot_runner, runner = runner, _Runner(base, quantity, grid, budget)
+            runner.cpu, runner.rate, runner.shock_rate = pilot_runner.cpu, pilot_runner.rate, pilot_runner.shock_rate
     done: set[Model] = set()
     for round_ in range(extend + 1):
         if round_:  # nothing qualified: one rung finer in Δt and in the mesh
@@ -480,7 +484,11 @@ def plan(scene: Scene, qoi: Union[str, Quantity], tol: Union[str, float], *, unt
                                                             members=scene.members, enabled=scene.enabled)
         out.scene = out.scene.replace(t_end=scene.t_end if quantity.deterministic else base.t_end)
         out.check = _check(out.choice, runner, meshes, reference_law, tolerance)
-    out.cpu_seconds, out.runs = runner.cpu, len(runner.cache)
+    if out.choice is not None and out.choice.qualifies and out.choice.model.dt == dts[0]:
+        out.notes.append("the choice is on the coarsest Δt rung: a coarser Δt may qualify too (coarser=, --coarser)")
+    if out.choice is not None and out.choice.qualifies and (out.choice.model.elements, out.choice.model.modes) == meshes[0]:
+        out.notes.append("the choice is on the coarsest mesh rung")
+    out.cpu_seconds, out.runs = runner.cpu, len(runner.cache) + (runner is not pilot_runner)
     return out
 
 

@@ -17,7 +17,7 @@ def _handler(args: argparse.Namespace) -> int:
     scene = Scene.from_namelist(args.scene)
     laws = [law.strip() for law in args.laws.split(",") if law.strip()] if args.laws else None
     result = plan(scene, args.qoi, args.tol, until=args.until, budget=args.budget, laws=laws, safety=args.safety,
-                  exhaustive=args.all, quiet=args.quiet)
+                  coarser=args.coarser, finer=args.finer, exhaustive=args.all, quiet=args.quiet)
     print(result.table())
     print(result.summary())
     if result.scene is not None:
@@ -49,6 +49,9 @@ def register_plan(subparsers: argparse._SubParsersAction) -> None:
                                        f"{', '.join(LAWS)} (default: the scene's own)")
     parser.add_argument("--safety", type=float,
                         help="factor on the error estimates (default 2 for tip, 1 for statistics)")
+    parser.add_argument("--coarser", type=int, default=2,
+                        help="Δt ladder: from the scene's Δt × 2^COARSER (default 2) ...")
+    parser.add_argument("--finer", type=int, default=3, help="... down to Δt / 2^FINER (default 3, at least 2)")
     parser.add_argument("--all", action="store_true",
                         help="estimate every candidate (within the budget), not only up to the first that qualifies")
     parser.add_argument("-o", "--output", type=Path, help="chosen scene (default SCENE_plan.nml)")
