@@ -254,13 +254,13 @@ def _dt_ladder(scene: Scene, coarser: int, finer: int) -> list[float]:
     return [scene.dt * 2.0**k for k in range(coarser, -finer - 1, -1)]
 
 
-def _scene_of(base: Scene, model: Model) -> Scene:
+def _scene_of(base: Scene, model: Model, record_every: int) -> Scene:
     changes: dict[str, object] = dict(LAWS[model.law])
     if base.nodes and model.elements != base.elements:
         changes["nodes"] = tuple(node * model.elements // base.elements for node in base.nodes)
     if reduced_available():
         changes["modes"] = model.modes
-    return base.replace(elements=model.elements, dt=model.dt, **changes)
+    return base.replace(elements=model.elements, dt=model.dt, record_every=record_every, **changes)
 
 
 # ----------------------------------------------------------------------------------- runs
@@ -287,7 +287,12 @@ class _Runner:
         self.shock_rate = 0.0  # shocks per simulated second, the most seen (room in the shock log)
 
     def scene(self, model: Model) -> Scene:
-        return _scene_of(self.base, model)
+        if self.quantity.deterministic:
+            assert self.grid is not None
+            every = max(1, round(self.grid / model.dt))
+        else:
+            every = max(1, math.ceil(self.base.t_end / model.dt / _RECORDS))
+        return _scene_of(self.base, model, every)
 
     def predicted(self, model: Model) -> float:
         steps = self.base.t_end / model.dt
@@ -315,11 +320,6 @@ class _Runner:
             self.refused[model] = f"Δt beyond the stability limit {limits.dt_limit_newmark:.3g} s"
             return None
         steps = max(1, round(scene.t_end / scene.dt))
-        if self.quantity.deterministic:
-            assert self.grid is not None
-            scene = scene.replace(record_every=max(1, round(self.grid / scene.dt)))
-        else:
-            scene = scene.replace(record_every=max(1, math.ceil(steps / _RECORDS)))
         try:
             result = run(scene, shock_capacity=4096 + int(2 * self.shock_rate * scene.t_end))
         except IncompleteRunError as exc:
@@ -447,7 +447,8 @@ def plan(scene: Scene, qoi: Union[str, Quantity], tol: Union[str, float], *, unt
         needed = float(f"{needed:.3g}")
         out.window = needed
         if needed != window:
-            base = base.replace(t_end=base.transient + needed)
+            t_end = base.transient + needed
+            base = base.replace(t_end=t_end, record_every=max(1, math.ceil(t_end / min(dts) / _RECORDS)))
             pilot_runner, runner = runner, _Runner(base, quantity, grid, budget)
             runner.cpu, runner.rate, runner.shock_rate = pilot_runner.cpu, pilot_runner.rate, pilot_runner.shock_rate
     done: set[Model] = set()
@@ -472,22 +473,40 @@ def plan(scene: Scene, qoi: Union[str, Quantity], tol: Union[str, float], *, unt
                 break
         if out.stopped or any(c.qualifies for c in out.candidates):
             break
+        if not quantity.deterministic and out.candidates and \
+                min(c.half_width for c in out.candidates) > 0.5 * tolerance:
+            out.notes.append("no candidate qualifies and the half-widths exceed half the tolerance: a longer window "
+                             "(max_window), not a finer model, is what is missing")
+            break
     qualified = [c for c in out.candidates if c.qualifies]
     if qualified:
         out.choice = min(qualified, key=lambda c: c.cpu_per_second)
     elif out.candidates:
         out.choice = min(out.candidates, key=lambda c: c.error)
     if out.choice is not None:
-        out.scene = runner.scene(out.choice.model).replace(file=scene.file, record_every=scene.record_every,
-                                                            snapshot_every=scene.snapshot_every,
-                                                            checkpoint_every=scene.checkpoint_every,
-                                                            members=scene.members, enabled=scene.enabled)
-        out.scene = out.scene.replace(t_end=scene.t_end if quantity.deterministic else base.t_end)
+        steps = (scene.t_end if quantity.deterministic else base.t_end) / out.choice.model.dt
+        every = max(scene.record_every, math.ceil(steps / 1e6))
+        if every != scene.record_every:
+            out.notes.append(f"the chosen scene records every {every} steps (at most a million records)")
+        keep = {"file": scene.file, "record_every": every, "checkpoint_every": scene.checkpoint_every,
+                "members": scene.members, "enabled": scene.enabled,
+                "t_end": scene.t_end if quantity.deterministic else base.t_end}
+        chosen = runner.scene(out.choice.model)
+        try:
+            out.scene = chosen.replace(snapshot_every=scene.snapshot_every, **keep)
+        except ValueError as exc:  # the scene's snapshots would not fit at the chosen Δt
+            out.scene = chosen.replace(snapshot_every=0, **keep)
+            out.notes.append(f"the chosen scene has no snapshots ({exc})")
         out.check = _check(out.choice, runner, meshes, reference_law, tolerance)
     if out.choice is not None and out.choice.qualifies and out.choice.model.dt == dts[0]:
         out.notes.append("the choice is on the coarsest Δt rung: a coarser Δt may qualify too (coarser=, --coarser)")
     if out.choice is not None and out.choice.qualifies and (out.choice.model.elements, out.choice.model.modes) == meshes[0]:
         out.notes.append("the choice is on the coarsest mesh rung")
+    refused = {**pilot_runner.refused, **runner.refused}
+    if refused:
+        first = next(iter(refused.items()))
+        out.notes.append(f"{len(refused)} model(s) refused by the engine and skipped (e.g. {first[0].describe()}: "
+                         f"{first[1]})")
     out.cpu_seconds, out.runs = runner.cpu, len(runner.cache) + (runner is not pilot_runner)
     return out
 

@@ -16,7 +16,7 @@ def _handler(args: argparse.Namespace) -> int:
     parse_tolerance(args.tol)
     scene = Scene.from_namelist(args.scene)
     laws = [law.strip() for law in args.laws.split(",") if law.strip()] if args.laws else None
-    result = plan(scene, args.qoi, args.tol, until=args.until, budget=args.budget, laws=laws, safety=args.safety,
+    result = plan(scene, Quantity(args.qoi, until=args.until, stop=args.stop), args.tol, until=args.until, budget=args.budget, laws=laws, safety=args.safety,
                   coarser=args.coarser, finer=args.finer, exhaustive=args.all, quiet=args.quiet)
     print(result.table())
     print(result.summary())
@@ -43,6 +43,8 @@ def register_plan(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--tol", required=True,
                         help="tolerance: absolute in the quantity's unit (m, W, N, 1/s, 1), or relative (2%%)")
     parser.add_argument("--until", type=float, help="tip: end of the window [0, UNTIL] (s)")
+    parser.add_argument("--stop", type=int, default=0,
+                        help="statistics per stop: which entry (0: the tip's stops, or the first stop along the span)")
     parser.add_argument("--budget", type=float, metavar="SECONDS",
                         help="engine CPU seconds for the search; stop refining when exceeded")
     parser.add_argument("--laws", help=f"comma-separated contact models the search may use, among "
