@@ -232,22 +232,53 @@ def _g(x: float) -> str:
 
 # ----------------------------------------------------------------------------------- ladders
 
-def _mesh_ladder(scene: Scene) -> list[tuple[int, int]]:
-    """(elements, modes) from coarse to fine: J/4, J/2, J, 2J (those that keep the stops' nodes),
-    then, with the reduced model, modes 4, 8, 16, … below the full model at the scene's J."""
+Rung = tuple[int, int]
+"""A mesh: (elements J, reduced modes r; 0 = the full model)."""
+
+
+@dataclass
+class _Ladder:
+    """Meshes and the next finer mesh of each: J/4 → J/2 → J → 2J (full models), and with the reduced
+    model r = 4 → 8 → … → the full model at the scene's J."""
+
+    rungs: list[Rung]
+    finer: dict[Rung, Rung]
+
+    def chain(self, rung: Rung, length: int) -> list[Rung]:
+        """``rung`` and up to ``length - 1`` finer rungs after it."""
+        out = [rung]
+        while len(out) < length and out[-1] in self.finer:
+            out.append(self.finer[out[-1]])
+        return out
+
+    def refinable(self) -> list[Rung]:
+        """Rungs with a finer one (the candidates)."""
+        return [rung for rung in self.rungs if rung in self.finer]
+
+    def extend(self) -> None:
+        """One finer full model: 2J after the finest."""
+        top = max(rung[0] for rung in self.rungs)
+        self.finer[(top, 0)] = (2 * top, 0)
+        self.rungs.append((2 * top, 0))
+
+
+def _mesh_ladder(scene: Scene) -> _Ladder:
     j = scene.elements
-    out: list[tuple[int, int]] = []
+    full: list[Rung] = []
     for factor in (0.25, 0.5, 1.0, 2.0):
         n = max(1, round(j * factor))
         if scene.nodes and any((node * n) % j for node in scene.nodes):
             continue  # the stops along the span would not be nodes
-        if (n, 0) not in out:
-            out.append((n, 0))
+        if (n, 0) not in full:
+            full.append((n, 0))
+    finer = {a: b for a, b in zip(full, full[1:])}
+    rungs = list(full)
     if reduced_available():
-        modes = [r for r in (4, 8, 16, 32, 64) if r < 2 * j - max(len(scene.nodes), 1)]
-        full = out.index((j, 0))
-        out[full:full] = [(j, r) for r in modes]
-    return out
+        modes = [(j, r) for r in (4, 8, 16, 32, 64) if r < 2 * j - max(len(scene.nodes), 1)]
+        chain = modes + [(j, 0)]
+        finer.update({a: b for a, b in zip(chain, chain[1:])})
+        rungs = modes + rungs
+    return _Ladder(rungs, finer)
 
 
 def _dt_ladder(scene: Scene, coarser: int, finer: int) -> list[float]:
@@ -455,8 +486,8 @@ def plan(scene: Scene, qoi: Union[str, Quantity], tol: Union[str, float], *, unt
     for round_ in range(extend + 1):
         if round_:  # nothing qualified: one rung finer in Δt and in the mesh
             dts.append(dts[-1] / 2)
-            meshes.append((2 * meshes[-1][0], 0))
-        models = [Model(law, j, r, dt) for law in chosen_laws for (j, r) in meshes[:-1] for dt in dts[:-1]]
+            meshes.extend()
+        models = [Model(law, j, r, dt) for law in chosen_laws for (j, r) in meshes.refinable() for dt in dts[:-1]]
         models = sorted((m for m in models if m not in done), key=_cost)
         for model in progress(models, f"plan (round {round_ + 1})", total=len(models), quiet=quiet):
             needs = _needs(model, meshes, dts, reference_law, quantity)
@@ -500,7 +531,7 @@ def plan(scene: Scene, qoi: Union[str, Quantity], tol: Union[str, float], *, unt
         out.check = _check(out.choice, runner, meshes, reference_law, tolerance)
     if out.choice is not None and out.choice.qualifies and out.choice.model.dt == dts[0]:
         out.notes.append("the choice is on the coarsest Δt rung: a coarser Δt may qualify too (coarser=, --coarser)")
-    if out.choice is not None and out.choice.qualifies and (out.choice.model.elements, out.choice.model.modes) == meshes[0]:
+    if out.choice is not None and out.choice.qualifies and (out.choice.model.elements, out.choice.model.modes) == meshes.rungs[0]:
         out.notes.append("the choice is on the coarsest mesh rung")
     refused = {**pilot_runner.refused, **runner.refused}
     if refused:
@@ -516,37 +547,29 @@ def _cost(model: Model) -> float:
     return ((model.modes or model.elements) + _STEP_WORK) / model.dt
 
 
-def _finer_mesh(meshes: Sequence[tuple[int, int]], mesh: tuple[int, int]) -> tuple[int, int]:
-    i = meshes.index(mesh)
-    if i + 1 < len(meshes):
-        return meshes[i + 1]
-    return (2 * mesh[0], 0)
-
-
-def _needs(model: Model, meshes: Sequence[tuple[int, int]], dts: Sequence[float], reference_law: str,
+def _needs(model: Model, meshes: _Ladder, dts: Sequence[float], reference_law: str,
            quantity: Quantity) -> list[Model]:
     """The runs the estimate of ``model`` uses."""
-    i, k = meshes.index((model.elements, model.modes)), dts.index(model.dt)
+    rungs, k = meshes.chain((model.elements, model.modes), 3), dts.index(model.dt)
     if not quantity.deterministic:
-        j, r = meshes[i + 1]
+        j, r = rungs[1]
         return [model, Model(reference_law, j, r, dts[k + 1])]
     out = [model] + [Model(model.law, model.elements, model.modes, dt) for dt in dts[k + 1:k + 3]]
-    out += [Model(model.law, j, r, model.dt) for (j, r) in meshes[i + 1:i + 3]]
+    out += [Model(model.law, j, r, model.dt) for (j, r) in rungs[1:]]
     if model.law != reference_law:
         out.append(Model(reference_law, model.elements, model.modes, model.dt))
     return out
 
 
-def _estimate(model: Model, runner: _Runner, meshes: Sequence[tuple[int, int]], dts: Sequence[float],
+def _estimate(model: Model, runner: _Runner, meshes: _Ladder, dts: Sequence[float],
               reference_law: str, quantity: Quantity, safety: float, tolerance: float) -> Optional[Candidate]:
     own = runner.get(model)
     if own is None:
         return None  # refused by the engine (stability): not a candidate
     cpu_rate = own.cpu / own.simulated
-    i, k = meshes.index((model.elements, model.modes)), dts.index(model.dt)
+    rungs, k = meshes.chain((model.elements, model.modes), 3), dts.index(model.dt)
     if quantity.deterministic:
         in_dt = [runner.get(Model(model.law, model.elements, model.modes, dt)) for dt in dts[k:k + 3]]
-        rungs = meshes[i:i + 3]
         in_mesh = [runner.get(Model(model.law, j, r, model.dt)) for (j, r) in rungs]
         nominal_dt = 1.0 if runner.base.load_rule == "paper" else 2.0
         e_dt = _richardson(in_dt, [2.0, 2.0], nominal_dt, safety)
@@ -559,7 +582,7 @@ def _estimate(model: Model, runner: _Runner, meshes: Sequence[tuple[int, int]], 
         error = sum(parts.values())
         half = math.nan
     else:
-        j, r = meshes[i + 1]
+        j, r = rungs[1]
         finer = runner.get(Model(reference_law, j, r, dts[k + 1]))
         difference = abs(own.value - finer.value) if finer is not None else math.inf
         parts = {"difference": difference, "half_width": own.half_width}
@@ -573,7 +596,7 @@ def _estimate(model: Model, runner: _Runner, meshes: Sequence[tuple[int, int]], 
                      cpu_per_second=cpu_rate, verdict=verdict)
 
 
-def _ratio(coarse: tuple[int, int], fine: tuple[int, int]) -> float:
+def _ratio(coarse: Rung, fine: Rung) -> float:
     """Refinement ratio of two rungs of the mesh ladder (elements, or modes; all modes = 2J)."""
     (j0, r0), (j1, r1) = coarse, fine
     if j0 != j1:
@@ -581,10 +604,11 @@ def _ratio(coarse: tuple[int, int], fine: tuple[int, int]) -> float:
     return (r1 or 2 * j1) / (r0 or 2 * j0)
 
 
-def _check(choice: Candidate, runner: _Runner, meshes: Sequence[tuple[int, int]], reference_law: str,
+def _check(choice: Candidate, runner: _Runner, meshes: _Ladder, reference_law: str,
            tolerance: float) -> Optional[Check]:
     model = choice.model
-    j, r = _finer_mesh(meshes, (model.elements, model.modes))
+    rung = (model.elements, model.modes)
+    j, r = meshes.finer.get(rung, (2 * model.elements, 0))
     finer = Model(reference_law, j, r, model.dt / 2)
     a, b = runner.get(model), runner.get(finer)
     if a is None or b is None:
