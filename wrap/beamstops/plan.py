@@ -32,7 +32,7 @@ import dataclasses
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
-from typing import Optional, Union
+from typing import Any, Optional, Union
 
 import numpy as np
 
@@ -286,7 +286,7 @@ def _dt_ladder(scene: Scene, coarser: int, finer: int) -> list[float]:
 
 
 def _scene_of(base: Scene, model: Model, record_every: int) -> Scene:
-    changes: dict[str, object] = dict(LAWS[model.law])
+    changes: dict[str, Any] = dict(LAWS[model.law])
     if base.nodes and model.elements != base.elements:
         changes["nodes"] = tuple(node * model.elements // base.elements for node in base.nodes)
     if reduced_available():
@@ -519,7 +519,7 @@ def plan(scene: Scene, qoi: Union[str, Quantity], tol: Union[str, float], *, unt
         every = max(scene.record_every, math.ceil(steps / 1e6))
         if every != scene.record_every:
             out.notes.append(f"the chosen scene records every {every} steps (at most a million records)")
-        keep = {"file": scene.file, "record_every": every, "checkpoint_every": scene.checkpoint_every,
+        keep: dict[str, Any] = {"file": scene.file, "record_every": every, "checkpoint_every": scene.checkpoint_every,
                 "members": scene.members, "enabled": scene.enabled,
                 "t_end": scene.t_end if quantity.deterministic else base.t_end}
         chosen = runner.scene(out.choice.model)
