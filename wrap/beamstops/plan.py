@@ -492,7 +492,8 @@ def plan(scene: Scene, qoi: Union[str, Quantity], tol: Union[str, float], *, unt
         for model in progress(models, f"plan (round {round_ + 1})", total=len(models), quiet=quiet):
             needs = _needs(model, meshes, dts, reference_law, quantity)
             if not runner.affordable(needs):
-                out.stopped = (f"budget of {budget:g} CPU s reached after {len(runner.cache)} runs "
+                runs = len(runner.cache) + (runner is not pilot_runner)
+                out.stopped = (f"budget of {budget:g} CPU s reached after {runs} runs "
                                f"({runner.cpu:.3g} s); finer candidates were not estimated")
                 break
             done.add(model)

@@ -17,7 +17,8 @@ def _handler(args: argparse.Namespace) -> int:
     scene = Scene.from_namelist(args.scene)
     laws = [law.strip() for law in args.laws.split(",") if law.strip()] if args.laws else None
     result = plan(scene, Quantity(args.qoi, until=args.until, stop=args.stop), args.tol, until=args.until, budget=args.budget, laws=laws, safety=args.safety,
-                  coarser=args.coarser, finer=args.finer, exhaustive=args.all, quiet=args.quiet)
+                  coarser=args.coarser, finer=args.finer, exhaustive=args.all, max_window=args.max_window,
+                  quiet=args.quiet)
     print(result.table())
     print(result.summary())
     if result.scene is not None:
@@ -51,6 +52,8 @@ def register_plan(subparsers: argparse._SubParsersAction) -> None:
                                        f"{', '.join(LAWS)} (default: the scene's own)")
     parser.add_argument("--safety", type=float,
                         help="factor on the error estimates (default 2 for tip, 1 for statistics)")
+    parser.add_argument("--max-window", type=float, metavar="SECONDS",
+                        help="statistics: longest window after the transient the search may use (s)")
     parser.add_argument("--coarser", type=int, default=2,
                         help="Δt ladder: from the scene's Δt × 2^COARSER (default 2) ...")
     parser.add_argument("--finer", type=int, default=3, help="... down to Δt / 2^FINER (default 3, at least 2)")
