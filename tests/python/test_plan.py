@@ -138,3 +138,24 @@ def test_mesh_ladder_with_and_without_the_reduced_model(monkeypatch: pytest.Monk
     reduced = module._mesh_ladder(PAPER_SHORT)
     assert reduced.chain((19, 4), 7) == [(19, 4), (19, 8), (19, 16), (19, 32), (19, 0), (38, 0)]
     assert module._ratio((19, 32), (19, 0)) == pytest.approx(38 / 32)
+
+
+def test_other_laws_carry_their_distance_to_the_scenes_law() -> None:
+    paper = beamstops.Scene(t_end=0.2)
+    # before the first impact (t = 0.088 s) the law without stops is the same run as Signorini's
+    before = plan(paper, "tip", 1e-3, until=0.08, laws=["none", "signorini"], quiet=True, exhaustive=True)
+    nones = [c for c in before.candidates if c.model.law == "none"]
+    assert nones and all(c.parts["law"] == 0.0 for c in nones)
+    # through the first impacts it is not: its distance to Signorini alone exceeds the tolerance
+    after = plan(paper, "tip", 1e-3, until=0.15, laws=["none", "signorini"], quiet=True, finer=2, extend=0)
+    nones = [c for c in after.candidates if c.model.law == "none"]
+    assert nones and all(c.parts["law"] > 1e-3 and not c.qualifies for c in nones)
+    assert after.choice is None or after.choice.model.law == "signorini"
+
+
+def test_a_shock_log_larger_than_its_room_runs_again_to_the_same_result() -> None:
+    small = beamstops.run(PAPER_SHORT, shock_capacity=1)
+    roomy = beamstops.run(PAPER_SHORT, shock_capacity=10_000)
+    assert small.shocks == roomy.shocks > 1
+    assert np.array_equal(small.impacts["impulse"], roomy.impacts["impulse"])
+    assert np.array_equal(small.statistics["power"].value, roomy.statistics["power"].value)
