@@ -123,21 +123,21 @@ def test_cli_bad_input_is_one_line_and_exit_1(tmp_path: Path, capsys: pytest.Cap
 
 
 def test_mesh_ladder_with_and_without_the_reduced_model(monkeypatch: pytest.MonkeyPatch) -> None:
-    from beamstops import plan as module
+    from beamstops import plan_runs as module
 
-    ladder = module._mesh_ladder(PAPER_SHORT)
+    ladder = module.mesh_ladder(PAPER_SHORT)
     assert ladder.rungs == [(5, 0), (10, 0), (19, 0), (38, 0)]
     assert ladder.chain((5, 0), 3) == [(5, 0), (10, 0), (19, 0)] and ladder.refinable() == [(5, 0), (10, 0), (19, 0)]
     ladder.extend()
     assert ladder.chain((19, 0), 3) == [(19, 0), (38, 0), (76, 0)]
     # stops along the span keep their nodes: no J/4 or J/2 that would move them off the nodes
-    spans = module._mesh_ladder(beamstops.Scene(nodes=(10, 19), lower=-0.1, upper=0.1, elements=19))
+    spans = module.mesh_ladder(beamstops.Scene(nodes=(10, 19), lower=-0.1, upper=0.1, elements=19))
     assert spans.rungs == [(19, 0), (38, 0)]
     # with the reduced model's key (&mesh modes, 0 = full): modes 4, 8, ... refine towards the full model
     monkeypatch.setattr(module, "reduced_available", lambda: True)
-    reduced = module._mesh_ladder(PAPER_SHORT)
+    reduced = module.mesh_ladder(PAPER_SHORT)
     assert reduced.chain((19, 4), 7) == [(19, 4), (19, 8), (19, 16), (19, 32), (19, 0), (38, 0)]
-    assert module._ratio((19, 32), (19, 0)) == pytest.approx(38 / 32)
+    assert module.ratio((19, 32), (19, 0)) == pytest.approx(38 / 32)
 
 
 def test_other_laws_carry_their_distance_to_the_scenes_law() -> None:
