@@ -8,6 +8,7 @@
 #   docs/work_precision_statistics/  the same two studies with --qoi: statistics under impacts
 #   docs/bifurcation/  scripts/bifurcation.py       bifurcation diagram (sweep)
 #   docs/stops/        input/tube_supports.nml, scripts/bench_stops.py   stops along the span
+#   docs/plan/         scripts/plan_chart.py        which model do I need (plan, stop power to 2 %)
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export PATH="$PWD/.venv/bin:$PATH" MPLBACKEND=Agg
@@ -25,5 +26,6 @@ mkdir -p out docs/stops
 beamstops run input/tube_supports.nml -o out/tube_supports.h5 >/dev/null
 python -m beamstops plot out/tube_supports.h5 --kind stops -o docs/stops/tube_supports_stops.png >/dev/null
 python scripts/bench_stops.py --out docs/stops/bench_stops.md
+python scripts/plan_chart.py -o docs/plan --quiet
 # keep the images and tables, not the HDF5 files of the runs
 find docs -name '*.h5' -delete

@@ -89,6 +89,10 @@ from .studies.cli import STUDIES  # noqa: E402  (issue 6: converge, work-precisi
 
 COMMANDS += STUDIES
 
+from .plan_cli import register_plan  # noqa: E402  (issue 14 item 3: plan)
+
+COMMANDS.append(register_plan)
+
 
 def build_parser(prog: str = "python -m beamstops") -> argparse.ArgumentParser:
     from . import version

@@ -170,18 +170,19 @@ def _observations(scene: Scene, fields: list[str], shocks: np.ndarray, value: np
             "ensemble": tables["ensemble"]}
 
 
-def run(scene: Scene, *, allow_incomplete: bool = False) -> Result:
+def run(scene: Scene, *, allow_incomplete: bool = False, shock_capacity: int = 4096) -> Result:
     """Run a scene in memory and return its :class:`Result` (no file is written).
 
     Same engine loop as ``beamstops run``: for the same scene, every array and every
     attribute but ``cpu_seconds`` equals the program's HDF5 output bit for bit.
     A run that does not complete (it diverged) raises :class:`IncompleteRunError`
-    (a ValueError holding the partial result) unless ``allow_incomplete``.
+    (a ValueError holding the partial result) unless ``allow_incomplete``. ``shock_capacity``: rows
+    of the shock log to make room for (a run with more shocks runs again, with room for every one).
     """
     text = _scene_text(scene)
     records, snapshots, nodes, stops = sizes(scene)
     width = max(stops, 1, scene.bins + 1)
-    capacity = 4096
+    capacity = max(int(shock_capacity), 1)
     while True:
         (t, tip_u, tip_v, reaction, energy, work, dissipated, damped, snapshot_t, snapshot_x, snapshot_u, stops_x,
          stops_u, stops_reaction, filled, snaps, shocks, shock_count, shock_labels, stat_value, stat_half, stat_entries,

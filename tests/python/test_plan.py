@@ -1,0 +1,161 @@
+"""``plan``: the cheapest model under a tolerance, checked against runs much finer than the search's."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import beamstops
+from beamstops import cli
+from beamstops.plan import Plan, Quantity, parse_tolerance, plan
+
+FREE = beamstops.Scene(law="none", t_end=0.1)
+PAPER_SHORT = beamstops.Scene(t_end=4.0, transient=1.0)
+
+
+@pytest.fixture(scope="module")
+def free_plan() -> Plan:
+    return plan(FREE, "tip", 5e-4, until=0.08, quiet=True)
+
+
+def test_trajectory_choice_is_within_tolerance_of_a_much_finer_run(free_plan: Plan) -> None:
+    chosen = free_plan.scene
+    assert chosen is not None and free_plan.choice is not None and free_plan.choice.qualifies
+    # the choice is cheaper than the finest rungs of the search: the tolerance is loose enough to coarsen
+    assert chosen.dt > FREE.dt / 8
+    grid = chosen.dt
+    mine = beamstops.run(chosen.replace(t_end=0.08))
+    fine_dt = chosen.dt / 16
+    reference = beamstops.run(FREE.replace(elements=4 * chosen.elements, dt=fine_dt, t_end=0.08,
+                                           record_every=round(grid / fine_dt)))
+    n = min(mine.t.size, reference.t.size)
+    assert np.allclose(mine.t[:n], reference.t[:n], rtol=0, atol=1e-12)
+    measured = float(np.abs(mine.tip_u[:n] - reference.tip_u[:n]).max())
+    assert 0 < measured < 5e-4
+    assert free_plan.check is not None and free_plan.check.passed
+    assert free_plan.check.difference < 5e-4
+
+
+def test_trajectory_estimates_are_not_below_the_measured_error(free_plan: Plan) -> None:
+    # every candidate that failed was estimated above the tolerance; the cheapest among the evaluated
+    # candidates that qualify is chosen, and the table lists it
+    assert all(c.error > 5e-4 for c in free_plan.candidates if not c.qualifies)
+    assert "**chosen**" in free_plan.table()
+    assert free_plan.choice is min((c for c in free_plan.candidates if c.qualifies), key=lambda c: c.cpu_per_second)
+
+
+def test_tighter_tolerance_costs_more() -> None:
+    loose = plan(FREE, "tip", 2e-3, until=0.08, quiet=True)
+    tight = plan(FREE, "tip", 2e-4, until=0.08, quiet=True)
+    assert loose.choice is not None and tight.choice is not None
+    assert tight.choice.cpu_per_second > loose.choice.cpu_per_second
+    assert tight.choice.error <= 2e-4 < loose.choice.error or tight.choice.error < loose.choice.error
+
+
+def test_statistic_choice_overlaps_a_finer_reference() -> None:
+    result = plan(PAPER_SHORT, "power", "20%", quiet=True)
+    assert result.choice is not None and result.choice.qualifies and result.scene is not None
+    assert result.window is not None and result.window > 0
+    assert result.scene.t_end == pytest.approx(PAPER_SHORT.transient + result.window)
+    chosen = beamstops.run(result.scene.replace(record_every=100)).statistics["power"]
+    # the same run as the plan's (the engine is deterministic)
+    assert float(chosen.value[0]) == result.choice.value
+    finer = result.scene.replace(elements=2 * result.scene.elements, dt=result.scene.dt / 4, record_every=400)
+    reference = beamstops.run(finer).statistics["power"]
+    v, h, vr, hr = float(chosen.value[0]), float(chosen.half_width[0]), float(reference.value[0]), float(reference.half_width[0])
+    assert abs(v - vr) <= h + hr, (v, h, vr, hr)
+    assert abs(v - vr) <= result.tolerance
+    assert result.check is not None and result.check.overlap
+
+
+def test_budget_stops_the_search_and_says_so() -> None:
+    result = plan(FREE, "tip", 1e-6, until=0.08, budget=0.003, quiet=True)
+    assert result.stopped is not None and "budget" in result.stopped
+    assert "stopped: budget" in result.summary()
+    assert result.choice is None or not result.choice.qualifies
+
+
+def test_relative_tolerance_and_bad_inputs() -> None:
+    assert parse_tolerance("2%") == (0.02, True)
+    assert parse_tolerance(0.01) == (0.01, False)
+    for bad in ("0", "-1", "0%", "abc", "nan"):
+        with pytest.raises(ValueError, match="tolerance"):
+            parse_tolerance(bad)
+    with pytest.raises(ValueError, match="unknown quantity 'energy'"):
+        plan(FREE, "energy", 1e-3)
+    with pytest.raises(ValueError, match="until"):
+        Quantity("tip")
+    with pytest.raises(ValueError, match="unknown law"):
+        plan(FREE, "tip", 1e-3, until=0.05, laws=["spring"])
+    with pytest.raises(ValueError, match="compliance' needs a stiffness"):
+        plan(FREE, "tip", 1e-3, until=0.05, laws=["compliance"], quiet=True)
+
+
+def test_cli_writes_the_chosen_scene(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    scene_file = tmp_path / "free.nml"
+    FREE.to_namelist(scene_file)
+    assert cli.main(["plan", str(scene_file), "--qoi", "tip", "--until", "0.08", "--tol", "1e-3", "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert "| law | J | Δt (s) |" in out and "PASS" in out and "**chosen**" in out
+    written = beamstops.Scene.from_namelist(tmp_path / "free_plan.nml")
+    expected = plan(FREE, "tip", 1e-3, until=0.08, quiet=True).scene
+    assert expected is not None
+    assert written.dt == expected.dt and written.elements == expected.elements and written.law == "none"
+    assert written.t_end == FREE.t_end
+
+
+@pytest.mark.parametrize("arguments, message", [
+    (["--qoi", "tip", "--until", "0.08", "--tol", "0"], "tolerance '0': must be > 0"),
+    (["--qoi", "tip", "--until", "0.08", "--tol", "-0.001"], "must be > 0"),
+    (["--qoi", "energy", "--tol", "1e-3"], "unknown quantity 'energy'"),
+    (["--qoi", "tip", "--tol", "1e-3"], "until"),
+])
+def test_cli_bad_input_is_one_line_and_exit_1(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                arguments: list[str], message: str) -> None:
+    scene_file = tmp_path / "free.nml"
+    FREE.to_namelist(scene_file)
+    assert cli.main(["plan", str(scene_file), *arguments, "--quiet"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("beamstops: error:") and message in err[0], err
+    assert not (tmp_path / "free_plan.nml").exists()
+
+
+def test_mesh_ladder_with_and_without_the_reduced_model(monkeypatch: pytest.MonkeyPatch) -> None:
+    from beamstops import plan_runs as module
+
+    ladder = module.mesh_ladder(PAPER_SHORT)
+    assert ladder.rungs == [(5, 0), (10, 0), (19, 0), (38, 0)]
+    assert ladder.chain((5, 0), 3) == [(5, 0), (10, 0), (19, 0)] and ladder.refinable() == [(5, 0), (10, 0), (19, 0)]
+    ladder.extend()
+    assert ladder.chain((19, 0), 3) == [(19, 0), (38, 0), (76, 0)]
+    # stops along the span keep their nodes: no J/4 or J/2 that would move them off the nodes
+    spans = module.mesh_ladder(beamstops.Scene(nodes=(10, 19), lower=-0.1, upper=0.1, elements=19))
+    assert spans.rungs == [(19, 0), (38, 0)]
+    # with the reduced model's key (&mesh modes, 0 = full): modes 4, 8, ... refine towards the full model
+    monkeypatch.setattr(module, "reduced_available", lambda: True)
+    reduced = module.mesh_ladder(PAPER_SHORT)
+    assert reduced.chain((19, 4), 7) == [(19, 4), (19, 8), (19, 16), (19, 32), (19, 0), (38, 0)]
+    assert module.ratio((19, 32), (19, 0)) == pytest.approx(38 / 32)
+
+
+def test_other_laws_carry_their_distance_to_the_scenes_law() -> None:
+    paper = beamstops.Scene(t_end=0.2)
+    # before the first impact (t = 0.088 s) the law without stops is the same run as Signorini's
+    before = plan(paper, "tip", 1e-3, until=0.08, laws=["none", "signorini"], quiet=True, exhaustive=True)
+    nones = [c for c in before.candidates if c.model.law == "none"]
+    assert nones and all(c.parts["law"] == 0.0 for c in nones)
+    # through the first impacts it is not: its distance to Signorini alone exceeds the tolerance
+    after = plan(paper, "tip", 1e-3, until=0.15, laws=["none", "signorini"], quiet=True, finer=2, extend=0)
+    nones = [c for c in after.candidates if c.model.law == "none"]
+    assert nones and all(c.parts["law"] > 1e-3 and not c.qualifies for c in nones)
+    assert after.choice is None or after.choice.model.law == "signorini"
+
+
+def test_a_shock_log_larger_than_its_room_runs_again_to_the_same_result() -> None:
+    small = beamstops.run(PAPER_SHORT, shock_capacity=1)
+    roomy = beamstops.run(PAPER_SHORT, shock_capacity=10_000)
+    assert small.shocks == roomy.shocks > 1
+    assert np.array_equal(small.impacts["impulse"], roomy.impacts["impulse"])
+    assert np.array_equal(small.statistics["power"].value, roomy.statistics["power"].value)

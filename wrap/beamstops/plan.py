@@ -1,0 +1,248 @@
+"""Which model do I need? The cheapest model whose estimated error on a quantity is under a tolerance.
+
+``plan(scene, qoi, tol)`` searches the contact law (among those allowed), the mesh (the number of
+elements J on a ladder J/4, J/2, J, 2J around the scene's; the reduced model's ``modes`` when the
+engine has that key) and the time step (the scene's Δt times 4, 2, 1, 1/2, 1/4, 1/8, refused ones
+skipped) for the cheapest candidate, by CPU per simulated second, whose estimated error is ≤ tol,
+then checks the choice against a finer run.
+
+Quantities (:data:`QUANTITIES`):
+
+- ``tip`` (deterministic): the tip trajectory on [0, until], distance max |u_tip − u'_tip| over a
+  common record grid. A candidate's error is a Richardson estimate in Δt plus one in the mesh,
+  each ``safety · |q_h − q_fine| / (r^p − 1)`` with r the refinement ratio and p the order
+  observed from three rungs (bounded to [1, 4]; the nominal order when a third rung is missing),
+  plus, for a law other than the scene's, the measured distance to the scene's law at the same
+  mesh and Δt.
+- ``power``, ``impulse_rate``, ``shocks_per_second``, ``contact_fraction``, ``tip_rms``
+  (statistical, the engine's batch-means statistics after the scene's ``transient``): a
+  candidate's error is ``safety · (|v − v_finer| + h)``, h its 95 % half-width and v_finer the
+  value of the finer run (next mesh, Δt/2, the scene's law). The window is first scaled so that
+  the half-width is about half the tolerance, W = W_scene · (h_scene / h*)² (batch means), and
+  reported.
+
+Every run, CPU time, statistic and interval comes from the engine (:func:`beamstops.run`);
+this module only chooses scenes, differences and sorts. The search is deterministic (no
+random numbers; the engine's runs are reproducible bit for bit).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any, Optional, Union
+
+from .plan_runs import RECORDS, STEP_WORK, Ladder, Runner, distance, dt_ladder, mesh_ladder, ratio, reduced_available, \
+    richardson
+from .plan_types import LAWS, QUANTITIES, STATISTICAL, Candidate, Check, Model, Plan, Quantity, parse_tolerance
+from .scene import Scene
+from .studies.common import progress
+
+__all__ = ["QUANTITIES", "STATISTICAL", "LAWS", "Quantity", "Model", "Candidate", "Check", "Plan", "plan",
+           "parse_tolerance", "reduced_available"]
+
+
+# ----------------------------------------------------------------------------------- search
+
+def plan(scene: Scene, qoi: Union[str, Quantity], tol: Union[str, float], *, until: Optional[float] = None,
+         budget: Optional[float] = None, laws: Optional[Sequence[str]] = None, safety: Optional[float] = None,
+         coarser: int = 2, finer: int = 3, extend: int = 2, exhaustive: bool = False, max_window: Optional[float] = None,
+         quiet: bool = False) -> Plan:
+    """The cheapest model of ``scene`` whose estimated error on ``qoi`` is ≤ ``tol``, and its check.
+
+    ``qoi``: 'tip' (with ``until``, s) or a statistic of :data:`STATISTICAL`; ``tol``: absolute in the
+    quantity's unit, or a percentage string ('2%') of the scene's own value. ``laws``: contact models
+    the search may use (keys of :data:`LAWS`; default the scene's own). ``budget``: engine CPU seconds
+    for the search (stops refining once the next runs would exceed it). ``safety``: factor on the
+    estimates (default 2 for the tip, 1 for statistics, whose difference already carries both runs'
+    noise). ``coarser``/``finer``: Δt ladder from dt·2^coarser down to dt/2^finer. ``exhaustive``:
+    estimate every candidate (within the budget) instead of stopping at the first, in order of
+    predicted cost, that qualifies. ``extend``: when nothing qualifies, add up to this many finer rungs
+    (Δt/2 and 2J each) and go on. Raises ValueError on bad input.
+    """
+    quantity = qoi if isinstance(qoi, Quantity) else Quantity(qoi, until=until)
+    fraction, relative = parse_tolerance(tol)
+    if budget is not None and not budget > 0:
+        raise ValueError(f"budget {budget!r}: CPU seconds > 0")
+    if coarser < 0 or finer < 2 or extend < 0:
+        raise ValueError("the Δt ladder needs coarser >= 0, finer >= 2 and extend >= 0")
+    reference_law = "redistributed" if (scene.law == "signorini" and scene.mass == "redistributed") else scene.law
+    chosen_laws = list(dict.fromkeys(laws)) if laws else [reference_law]
+    unknown = [law for law in chosen_laws if law not in LAWS]
+    if unknown:
+        raise ValueError(f"unknown law(s) {', '.join(unknown)}; choose among {', '.join(LAWS)}")
+    if "compliance" in chosen_laws and not scene.stiffness_per_mass > 0:
+        raise ValueError("law 'compliance' needs a stiffness in the scene (&stops stiffness or stiffness_per_mass)")
+    if reference_law not in chosen_laws:
+        chosen_laws.append(reference_law)  # the finer runs use the scene's law
+    factor = safety if safety is not None else (2.0 if quantity.deterministic else 1.0)
+    if not factor > 0:
+        raise ValueError(f"safety {safety!r}: > 0")
+
+    base = scene.replace(snapshot_every=0, checkpoint_every=0, members=1)
+    dts = dt_ladder(base, coarser, finer)
+    grid = None
+    if quantity.deterministic:
+        assert quantity.until is not None
+        grid = max(dts)
+        base = base.replace(t_end=max(quantity.until, grid), enabled=False)
+    elif not base.enabled:
+        base = base.replace(enabled=True)
+    if not quantity.deterministic and not base.t_end > base.transient:
+        raise ValueError(f"the scene's window after its transient is empty (t_end {base.t_end} ≤ transient "
+                         f"{base.transient})")
+    meshes = mesh_ladder(base)
+    runner = pilot_runner = Runner(base, quantity, grid, budget)
+    own = Model(reference_law, base.elements, int(getattr(base, "modes")) if reduced_available() else 0, base.dt)
+    pilot = runner.get(own)
+    if pilot is None:
+        raise ValueError(f"the scene itself cannot run: {runner.refused.get(own, 'refused')}")
+    unit = pilot.unit
+    tolerance = fraction * abs(pilot.value) if relative else fraction
+    if relative and not tolerance > 0:
+        raise ValueError(f"a relative tolerance of a quantity whose value is {pilot.value}: give it absolute")
+    out = Plan(quantity=quantity, tolerance=tolerance, relative=fraction if relative else None, unit=unit)
+
+    if not quantity.deterministic:  # scale the window to a half-width of about half the tolerance
+        window = base.t_end - base.transient
+        out.pilot_window, out.pilot_half_width = window, pilot.half_width
+        target = 0.5 * tolerance
+        needed = window * (pilot.half_width / target) ** 2 if math.isfinite(pilot.half_width) else window
+        needed = max(needed, 0.25 * window)
+        if max_window is not None:
+            needed = min(needed, max_window)
+        needed = float(f"{needed:.3g}")
+        out.window = needed
+        if needed != window:
+            t_end = base.transient + needed
+            base = base.replace(t_end=t_end, record_every=max(1, math.ceil(t_end / min(dts) / RECORDS)))
+            pilot_runner, runner = runner, Runner(base, quantity, grid, budget)
+            runner.cpu, runner.rate, runner.shock_rate = pilot_runner.cpu, pilot_runner.rate, pilot_runner.shock_rate
+    done: set[Model] = set()
+    for round_ in range(extend + 1):
+        if round_:  # nothing qualified: one rung finer in Δt and in the mesh
+            dts.append(dts[-1] / 2)
+            meshes.extend()
+        models = [Model(law, j, r, dt) for law in chosen_laws for (j, r) in meshes.refinable() for dt in dts[:-1]]
+        models = sorted((m for m in models if m not in done), key=_cost)
+        for model in progress(models, f"plan (round {round_ + 1})", total=len(models), quiet=quiet):
+            needs = _needs(model, meshes, dts, reference_law, quantity)
+            if not runner.affordable(needs):
+                runs = len(runner.cache) + (runner is not pilot_runner)
+                out.stopped = (f"budget of {budget:g} CPU s reached after {runs} runs "
+                               f"({runner.cpu:.3g} s); finer candidates were not estimated")
+                break
+            done.add(model)
+            candidate = _estimate(model, runner, meshes, dts, reference_law, quantity, factor, tolerance)
+            if candidate is None:
+                continue
+            out.candidates.append(candidate)
+            if candidate.qualifies and not exhaustive:
+                break
+        if out.stopped or any(c.qualifies for c in out.candidates):
+            break
+        if not quantity.deterministic and out.candidates and \
+                min(c.half_width for c in out.candidates) > 0.5 * tolerance:
+            out.notes.append("no candidate qualifies and the half-widths exceed half the tolerance: a longer window "
+                             "(max_window), not a finer model, is what is missing")
+            break
+    qualified = [c for c in out.candidates if c.qualifies]
+    if qualified:
+        out.choice = min(qualified, key=lambda c: c.cpu_per_second)
+    elif out.candidates:
+        out.choice = min(out.candidates, key=lambda c: c.error)
+    if out.choice is not None:
+        steps = (scene.t_end if quantity.deterministic else base.t_end) / out.choice.model.dt
+        every = max(scene.record_every, math.ceil(steps / 1e6))
+        if every != scene.record_every:
+            out.notes.append(f"the chosen scene records every {every} steps (at most a million records)")
+        keep: dict[str, Any] = {"file": scene.file, "record_every": every, "checkpoint_every": scene.checkpoint_every,
+                "members": scene.members, "enabled": scene.enabled,
+                "t_end": scene.t_end if quantity.deterministic else base.t_end}
+        chosen = runner.scene(out.choice.model)
+        try:
+            out.scene = chosen.replace(snapshot_every=scene.snapshot_every, **keep)
+        except ValueError as exc:  # the scene's snapshots would not fit at the chosen Δt
+            out.scene = chosen.replace(snapshot_every=0, **keep)
+            out.notes.append(f"the chosen scene has no snapshots ({exc})")
+        out.check = _check(out.choice, runner, meshes, reference_law, tolerance)
+    if out.choice is not None and out.choice.qualifies and out.choice.model.dt == dts[0]:
+        out.notes.append("the choice is on the coarsest Δt rung: a coarser Δt may qualify too (coarser=, --coarser)")
+    if out.choice is not None and out.choice.qualifies and (out.choice.model.elements, out.choice.model.modes) == meshes.rungs[0]:
+        out.notes.append("the choice is on the coarsest mesh rung")
+    refused = {**pilot_runner.refused, **runner.refused}
+    if refused:
+        first = next(iter(refused.items()))
+        out.notes.append(f"{len(refused)} model(s) refused by the engine and skipped (e.g. {first[0].describe()}: "
+                         f"{first[1]})")
+    out.cpu_seconds, out.runs = runner.cpu, len(runner.cache) + (runner is not pilot_runner)
+    return out
+
+
+def _cost(model: Model) -> float:
+    """Predicted cost per simulated second, up to a factor: (unknowns' work + fixed work) / Δt."""
+    return ((model.modes or model.elements) + STEP_WORK) / model.dt
+
+
+def _needs(model: Model, meshes: Ladder, dts: Sequence[float], reference_law: str,
+           quantity: Quantity) -> list[Model]:
+    """The runs the estimate of ``model`` uses."""
+    rungs, k = meshes.chain((model.elements, model.modes), 3), dts.index(model.dt)
+    if not quantity.deterministic:
+        j, r = rungs[1]
+        return [model, Model(reference_law, j, r, dts[k + 1])]
+    out = [model] + [Model(model.law, model.elements, model.modes, dt) for dt in dts[k + 1:k + 3]]
+    out += [Model(model.law, j, r, model.dt) for (j, r) in rungs[1:]]
+    if model.law != reference_law:
+        out.append(Model(reference_law, model.elements, model.modes, model.dt))
+    return out
+
+
+def _estimate(model: Model, runner: Runner, meshes: Ladder, dts: Sequence[float],
+              reference_law: str, quantity: Quantity, safety: float, tolerance: float) -> Optional[Candidate]:
+    own = runner.get(model)
+    if own is None:
+        return None  # refused by the engine (stability): not a candidate
+    cpu_rate = own.cpu / own.simulated
+    rungs, k = meshes.chain((model.elements, model.modes), 3), dts.index(model.dt)
+    if quantity.deterministic:
+        in_dt = [runner.get(Model(model.law, model.elements, model.modes, dt)) for dt in dts[k:k + 3]]
+        in_mesh = [runner.get(Model(model.law, j, r, model.dt)) for (j, r) in rungs]
+        nominal_dt = 1.0 if runner.base.load_rule == "paper" else 2.0
+        e_dt = richardson(in_dt, [2.0, 2.0], nominal_dt, safety)
+        ratios = [ratio(rungs[n], rungs[n + 1]) for n in range(len(rungs) - 1)]
+        e_mesh = richardson(in_mesh, ratios, 2.0, safety)
+        parts = {"dt": e_dt, "mesh": e_mesh}
+        if model.law != reference_law:
+            ref = runner.get(Model(reference_law, model.elements, model.modes, model.dt))
+            parts["law"] = distance(own, ref) if ref is not None else math.inf
+        error = sum(parts.values())
+        half = math.nan
+    else:
+        j, r = rungs[1]
+        finer = runner.get(Model(reference_law, j, r, dts[k + 1]))
+        difference = abs(own.value - finer.value) if finer is not None else math.inf
+        parts = {"difference": difference, "half_width": own.half_width}
+        error = safety * (difference + own.half_width) if math.isfinite(own.half_width) else math.inf
+        half = own.half_width
+    if not math.isfinite(error):
+        verdict = "no estimate"
+    else:
+        verdict = "qualifies" if error <= tolerance else "too coarse"
+    return Candidate(model=model, value=own.value, half_width=half, error=error, parts=parts,
+                     cpu_per_second=cpu_rate, verdict=verdict)
+
+
+def _check(choice: Candidate, runner: Runner, meshes: Ladder, reference_law: str,
+           tolerance: float) -> Optional[Check]:
+    model = choice.model
+    rung = (model.elements, model.modes)
+    j, r = meshes.finer.get(rung, (2 * model.elements, 0))
+    finer = Model(reference_law, j, r, model.dt / 2)
+    a, b = runner.get(model), runner.get(finer)
+    if a is None or b is None:
+        return None
+    difference = distance(a, b)
+    overlap = None if runner.quantity.deterministic else bool(difference <= a.half_width + b.half_width)
+    return Check(finer=finer, value=a.value, half_width=a.half_width, finer_value=b.value,
+                 finer_half_width=b.half_width, difference=difference, tolerance=tolerance, overlap=overlap)

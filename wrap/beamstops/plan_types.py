@@ -1,0 +1,190 @@
+"""The plan's types: the quantity, the tolerance, a model of the search, the candidates, the check
+and the plan itself with its table and summary (see :mod:`beamstops.plan`)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Optional, Union
+
+from .scene import Scene
+
+__all__ = ["QUANTITIES", "STATISTICAL", "LAWS", "Quantity", "Model", "Candidate", "Check", "Plan",
+           "parse_tolerance"]
+
+#: Statistical quantities: the engine's statistic of that name (entry ``stop``).
+STATISTICAL: tuple[str, ...] = ("power", "impulse_rate", "shocks_per_second", "contact_fraction", "tip_rms")
+#: Every quantity ``plan`` accepts.
+QUANTITIES: tuple[str, ...] = ("tip",) + STATISTICAL
+#: Contact models the search may use: scene changes of each.
+LAWS: dict[str, dict[str, str]] = {
+    "signorini": {"law": "signorini", "mass": "consistent"},
+    "redistributed": {"law": "signorini", "mass": "redistributed"},
+    "compliance": {"law": "compliance", "mass": "consistent"},
+    "none": {"law": "none", "mass": "consistent"},
+}
+
+
+def parse_tolerance(text: Union[str, float]) -> tuple[float, bool]:
+    """``'2%'`` → (0.02, True) (relative); ``'0.01'`` or 0.01 → (0.01, False) (absolute). Must be > 0."""
+    relative = isinstance(text, str) and text.strip().endswith("%")
+    body = text.strip()[:-1] if relative and isinstance(text, str) else text
+    try:
+        value = float(body)
+    except ValueError:
+        raise ValueError(f"tolerance {text!r}: a number > 0, or a percentage such as 2%") from None
+    if not (value > 0 and math.isfinite(value)):
+        raise ValueError(f"tolerance {text!r}: must be > 0")
+    return (value / 100.0 if relative else value), relative
+
+
+@dataclass(frozen=True)
+class Quantity:
+    """What the plan must get right: the tip trajectory on [0, until] or a statistic of the engine."""
+
+    name: str
+    until: Optional[float] = None
+    """``tip``: end of the window [0, until] (s)."""
+    stop: int = 0
+    """Statistical: which entry of a per-stop statistic (0: the tip's stops, or the first stop)."""
+
+    def __post_init__(self) -> None:
+        if self.name not in QUANTITIES:
+            raise ValueError(f"unknown quantity {self.name!r}; choose one of {', '.join(QUANTITIES)}")
+        if self.deterministic and not (self.until is not None and self.until > 0):
+            raise ValueError("quantity 'tip' needs a window end until > 0 (s), e.g. --until 0.08")
+
+    @property
+    def deterministic(self) -> bool:
+        return self.name == "tip"
+
+    def label(self) -> str:
+        return f"max |u_tip| error on [0, {self.until:g}] s" if self.deterministic else self.name
+
+
+@dataclass(frozen=True, order=True)
+class Model:
+    """A point of the search: contact model, mesh (J, reduced modes: 0 = full) and Δt."""
+
+    law: str
+    elements: int
+    modes: int
+    dt: float
+
+    def describe(self) -> str:
+        return f"{self.law} J={self.elements}" + (f" r={self.modes}" if self.modes else "") + f" dt={self.dt:g}"
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One row of the plan's table."""
+
+    model: Model
+    value: float
+    """QoI value: max |u_tip| on the window (tip), or the statistic's value."""
+    half_width: float
+    """95 % half-width of the statistic (nan for the tip)."""
+    error: float
+    """Estimated error (inf when it could not be estimated)."""
+    parts: dict[str, float]
+    """The estimate's terms: 'dt', 'mesh', 'law' (tip); 'difference', 'half_width' (statistics)."""
+    cpu_per_second: float
+    """The engine's CPU seconds per simulated second."""
+    verdict: str
+    """'qualifies', 'too coarse', 'no estimate' or 'refused: ...'."""
+
+    @property
+    def qualifies(self) -> bool:
+        return self.verdict == "qualifies"
+
+
+@dataclass(frozen=True)
+class Check:
+    """The choice against a finer run (next mesh, Δt/2, the scene's law)."""
+
+    finer: Model
+    value: float
+    half_width: float
+    finer_value: float
+    finer_half_width: float
+    difference: float
+    """Measured: max |u − u'| on the window (tip) or |v − v'| (statistics)."""
+    tolerance: float
+    overlap: Optional[bool]
+    """Statistics: whether the two 95 % intervals overlap."""
+
+    @property
+    def passed(self) -> bool:
+        return self.difference <= self.tolerance
+
+
+@dataclass
+class Plan:
+    """The search's outcome: candidates in the order run, the choice, its scene and its check."""
+
+    quantity: Quantity
+    tolerance: float
+    """Absolute tolerance (the QoI's unit)."""
+    relative: Optional[float]
+    """The relative tolerance asked for (0.02 for 2 %), or None."""
+    unit: str
+    candidates: list[Candidate] = field(default_factory=list)
+    choice: Optional[Candidate] = None
+    scene: Optional[Scene] = None
+    check: Optional[Check] = None
+    window: Optional[float] = None
+    """Statistics: the window after the transient used by every candidate (s)."""
+    pilot_window: Optional[float] = None
+    pilot_half_width: Optional[float] = None
+    cpu_seconds: float = 0.0
+    """The engine's CPU time of every run of the search and the check."""
+    runs: int = 0
+    stopped: Optional[str] = None
+    """Why the search stopped before finding a qualifying candidate (budget), or None."""
+    notes: list[str] = field(default_factory=list)
+
+    def table(self) -> str:
+        """The candidates as a markdown table."""
+        unit = f" ({self.unit})" if self.unit else ""
+        lines = [f"| law | J | {'modes | ' if any(c.model.modes for c in self.candidates) else ''}Δt (s) | "
+                 f"value{unit} | ± 95 %{unit} | error estimate{unit} | CPU s per simulated s | verdict |",
+                 "|---|---|" + ("---|" if any(c.model.modes for c in self.candidates) else "") + "---|---|---|---|---|---|"]
+        with_modes = any(c.model.modes for c in self.candidates)
+        for c in self.candidates:
+            mark = " **chosen**" if c is self.choice else ""
+            modes = (f"{c.model.modes or 'all'} | " if with_modes else "")
+            lines.append(f"| {c.model.law} | {c.model.elements} | {modes}{c.model.dt:.4g} | {_g(c.value)} | "
+                         f"{_g(c.half_width)} | {_g(c.error)} | {_g(c.cpu_per_second)} | {c.verdict}{mark} |")
+        return "\n".join(lines) + "\n"
+
+    def summary(self) -> str:
+        """What the plan found, in a few lines of text."""
+        tol = f"{self.tolerance:.4g} {self.unit}".rstrip()
+        if self.relative is not None:
+            tol += f" ({100 * self.relative:g} % of the scene's value)"
+        out = [f"quantity: {self.quantity.label()}; tolerance {tol}"]
+        if self.window is not None:
+            out.append(f"window after the transient: {self.window:.4g} s (the scene's {self.pilot_window:.4g} s gave "
+                       f"± {self.pilot_half_width:.3g}; half-widths scale as 1/sqrt(window))")
+        out.append(f"search: {self.runs} runs, {self.cpu_seconds:.3g} s of engine CPU")
+        if self.stopped:
+            out.append(f"stopped: {self.stopped}")
+        if self.choice is None:
+            out.append("no candidate could be estimated")
+        else:
+            c = self.choice
+            state = "qualifies" if c.qualifies else "does NOT qualify (best estimate found)"
+            out.append(f"choice: {c.model.describe()}: value {_g(c.value)}, estimated error {_g(c.error)} "
+                       f"{self.unit}, {_g(c.cpu_per_second)} CPU s per simulated s; {state}")
+        out += [f"note: {note}" for note in self.notes]
+        if self.check is not None:
+            k = self.check
+            overlap = "" if k.overlap is None else f"; intervals {'overlap' if k.overlap else 'do NOT overlap'}"
+            out.append(f"check against {k.finer.describe()}: measured difference {_g(k.difference)} {self.unit} "
+                       f"{'≤' if k.passed else '>'} tolerance {_g(k.tolerance)}: {'PASS' if k.passed else 'FAIL'}"
+                       f"{overlap}")
+        return "\n".join(out)
+
+
+def _g(x: float) -> str:
+    return "–" if x is None or (isinstance(x, float) and math.isnan(x)) else ("inf" if x == math.inf else f"{x:.3g}")
