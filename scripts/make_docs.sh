@@ -4,8 +4,9 @@
 #   docs/paper/        scripts/paper_figures.py     the paper's Figures 2-8, report.md
 #   docs/bench.md      scripts/bench.py             speed tables
 #   docs/convergence/  scripts/convergence.py       convergence tables (markdown, CSV)
-#   docs/work_precision/, docs/stability_map/, docs/compliance/   the studies
-#   docs/bifurcation/  scripts/bifurcation.py       bifurcation diagram (sweep)
+#   docs/work_precision/, docs/stability_map/, docs/compliance/, docs/contact_laws/   the studies
+#   docs/bifurcation/  scripts/bifurcation.py       bifurcation diagram (sweep), and its periods table
+#   docs/bifurcation_damped/  the same for the damped beam (input/sweeps/bifurcation_damped.toml)
 #   docs/stops/        input/tube_supports.nml, scripts/bench_stops.py   stops along the span
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -15,7 +16,10 @@ python scripts/convergence.py -o docs/convergence --quiet
 python scripts/study_workprecision.py -o docs/work_precision --quiet
 python scripts/study_stability.py -o docs/stability_map --quiet
 python scripts/study_compliance.py -o docs/compliance --quiet
+python scripts/study_contact_laws.py -o docs/contact_laws --quiet
 python scripts/bifurcation.py -o out/bifurcation --png docs/bifurcation/bifurcation.png -q
+python scripts/bifurcation.py --spec input/sweeps/bifurcation_damped.toml -o out/bifurcation_damped \
+    --png docs/bifurcation_damped/bifurcation.png -q
 python scripts/bench.py --out docs/bench.md
 mkdir -p out docs/stops
 beamstops run input/tube_supports.nml -o out/tube_supports.h5 >/dev/null

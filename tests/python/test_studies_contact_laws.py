@@ -69,3 +69,18 @@ def test_command(tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch
     assert cli.main(["contact-laws", "--quick", "--quiet", "-o", str(tmp_path)]) == 0
     assert calls == [(tmp_path, True)]
     assert str(tmp_path / "contact_laws.png") in capsys.readouterr().out
+
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_readme_quotes_the_committed_runs() -> None:
+    """The README's numbers on contact laws and the damped diagram are the lines the runs wrote."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    laws = (ROOT / "docs" / "contact_laws" / "contact_laws.md").read_text(encoding="utf-8")
+    for prefix in ("**Answer (measured):**", "**Energy over"):
+        line = next(line for line in laws.splitlines() if line.startswith(prefix))
+        assert f"> {line}" in readme, prefix
+    damped = (ROOT / "docs" / "bifurcation_damped" / "bifurcation.md").read_text(encoding="utf-8")
+    line = next(line for line in damped.splitlines() if line.startswith("Periodic (any p):"))
+    assert line in readme.replace("\n", " ")

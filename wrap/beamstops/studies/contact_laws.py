@@ -37,8 +37,8 @@ from ..scene import Scene
 from .cli import StudyCommand
 from .common import Table, observed_orders, out_dir, progress, run_tip, tip_error
 
-__all__ = ["LAWS", "Plan", "PLANS", "chatter", "energy_table", "convergence_table", "headline", "study", "main",
-           "register"]
+__all__ = ["LAWS", "Plan", "PLANS", "chatter", "energy_table", "energy_sentence", "convergence_table", "headline",
+           "study", "main", "register"]
 
 #: The contact laws compared: label and the scene keys that make it.
 LAWS: tuple[tuple[str, dict[str, Any]], ...] = (
@@ -199,7 +199,7 @@ def _sentence(summary: Table, verdict: dict[str, list[bool]], plan: Plan) -> str
 
     winners = [label for label, ok in verdict.items() if ok[1] and label != paper]
     lines = [f"**Answer (measured):** on {w}, between Δt = {plan.span[0]:g} and {plan.span[1]:g} s, "
-             f"the paper's projection ({paper}) gives {numbers(paper)}: it "
+             f"the paper's projection, {paper}, gives {numbers(paper)}: it "
              + ("converges" if verdict[paper][1] else "does not converge") + f" (target order ≥ {TARGET:g})."]
     if winners and not verdict[paper][1]:
         lines.append("Laws that converge where the paper's does not: "
@@ -215,6 +215,22 @@ def _sentence(summary: Table, verdict: dict[str, list[bool]], plan: Plan) -> str
                  + (("order ≥ " + f"{TARGET:g} for " + ", ".join(whole)) if whole else "no law reaches that order")
                  + ".")
     return " ".join(lines)
+
+
+def energy_sentence(energy: Table) -> str:
+    """What the energy runs measured, law by law: the stops' share of the support's work, the
+    contact phases and the largest violation."""
+    col = {name: energy.columns.index(name) for name in energy.columns}
+    parts = []
+    for r in energy.rows:
+        work, stops, damped = (float(r[col[k]]) for k in ("support work (J)", "stops (J)", "damping (J)"))  # type: ignore
+        part = (f"{r[0]}: stops {stops:.3g} J of the support's {work:.3g} J ({100 * stops / work:.2g} %), "
+                f"{r[col['contact phases']]} contact phases, violation {float(r[col['max violation (m)']]):.2g} m")  # type: ignore
+        if damped:
+            part += f", damping {damped:.3g} J"
+        parts.append(part)
+    t, dt = energy.rows[0][col["T (s)"]], energy.rows[0][col["Δt (s)"]]
+    return f"**Energy over {float(t):g} s at Δt = {float(dt):g} s (measured):** " + "; ".join(parts) + "."  # type: ignore
 
 
 def study(folder: Optional[Path] = None, *, quick: bool = False, quiet: bool = False) -> dict[str, Table]:
@@ -233,6 +249,7 @@ def study(folder: Optional[Path] = None, *, quick: bool = False, quiet: bool = F
         table.write_csv(folder / f"contact_laws_{name}.csv")
     draw(runs, convergence, plan, folder / "contact_laws.png")
     text = [f"# Contact laws on the paper's scene{' (quick)' if quick else ''}", "", sentence, "",
+            energy_sentence(energy), "",
             "![contact laws](contact_laws.png)", "", summary.markdown(), energy.markdown(), convergence.markdown()]
     (folder / "contact_laws.md").write_text("\n".join(text), encoding="utf-8")
     return tables

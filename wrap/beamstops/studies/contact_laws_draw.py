@@ -72,8 +72,8 @@ def draw(runs: dict[str, Result], convergence: Table, plan: "Plan", path: Path) 
         a.axvspan(min(plan.span), max(plan.span), color="0.9", zorder=0)
     for a in ax[2:]:
         a.set_xlabel("Δt (s)")
-    for a in ax:
+    for k, a in enumerate(ax):
         a.grid(True, which="both", alpha=0.3)
-        a.legend(fontsize=7)
+        a.legend(fontsize=7, loc="upper left" if k < 2 else "best")
     fig.savefig(path, dpi=110)
     return path
