@@ -84,3 +84,6 @@ def test_readme_quotes_the_committed_runs() -> None:
     damped = (ROOT / "docs" / "bifurcation_damped" / "bifurcation.md").read_text(encoding="utf-8")
     line = next(line for line in damped.splitlines() if line.startswith("Periodic (any p):"))
     assert line in readme.replace("\n", " ")
+    # the undamped diagram: the README says no value of ω settles on a periodic motion
+    undamped = (ROOT / "docs" / "bifurcation" / "bifurcation.md").read_text(encoding="utf-8")
+    assert "Periodic (any p): 0 of" in undamped and "No value of ω settles on a periodic motion" in readme

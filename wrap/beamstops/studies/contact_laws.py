@@ -266,7 +266,7 @@ def _run(folder: Path, args: argparse.Namespace) -> Path:
 
 #: ``contact-laws [-o DIR] [--quick]``; ``main`` is scripts/study_contact_laws.py.
 COMMAND = StudyCommand("contact_laws", _options, _run, name="contact-laws",
-                       help="contact laws: energy, violation, chatter, convergence in Δt",
+                       help="contact laws: energy, violation, chatter, convergence in dt",
                        description="Contact laws compared on the paper's scene (PNG, md, CSV).",
                        prog="study_contact_laws", script_description="Contact-laws study.")
 register = COMMAND.register
