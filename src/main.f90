@@ -376,13 +376,48 @@ contains
       type(run_summary), intent(in) :: summary
       character(len=:), allocatable :: line
       character(len=768) :: buf
-      write (buf, '(a,": ",i0," steps, ",f0.3," s CPU (",f0.3," us/step), ",i0," impacts, largest violation ",' // &
+      write (buf, '(a,": ",i0," steps, ",f0.3," s CPU (",f0.3," us/step), ",i0," impacts (",i0,' // &
+         & '" contact phases), largest violation ",' // &
          & 'es9.3," m; energy (J): support work ",es10.3,", stops ",es10.3,", damping ",es10.3,' // &
          & '", balance residual ",es9.2,"; status ",a)') scene%output_file, summary%steps, summary%cpu_seconds, &
-         & 1.0e6_wp*summary%cpu_seconds/max(1_ik, summary%steps), summary%impacts, summary%max_violation, &
-         & summary%work, summary%dissipated, summary%damped, summary%energy_residual, summary%status
-      line = trim(buf)
+         & 1.0e6_wp*summary%cpu_seconds/max(1_ik, summary%steps), summary%impacts, summary%contact_phases, &
+         & summary%max_violation, summary%work, summary%dissipated, summary%damped, summary%energy_residual, &
+         & summary%status
+      line = trim(buf)//headline(summary)
    end function summary_line
+
+   !> The headline statistics after the transient, with their 95 % intervals: shocks per second,
+   !> power the stops take, impulse rate, RMS tip displacement (first stop).
+   function headline(summary) result(text)
+      type(run_summary), intent(in) :: summary
+      character(len=:), allocatable :: text
+      character(len=*), parameter :: names(4) = [character(len=17) :: 'shocks_per_second', 'power', &
+         & 'impulse_rate', 'tip_rms']
+      character(len=96) :: buf
+      integer :: i, k
+      text = ''
+      if (.not. allocated(summary%statistics%quantity)) return
+      text = new_line('a')//'statistics (95 % intervals):'
+      do i = 1, size(names)
+         k = summary%statistics%find(trim(names(i)))
+         if (k == 0) cycle
+         associate (q => summary%statistics%quantity(k))
+            write (buf, '(1x,a,1x,es10.4," +- ",es8.2,1x,a)') trim(names(i)), q%value(1), q%half_width(1), q%unit
+         end associate
+         text = text//trim(buf)//';'
+      end do
+      if (summary%ensemble_members < 2 .or. .not. allocated(summary%ensemble%quantity)) return
+      write (buf, '(i0)') summary%ensemble_members
+      text = text//new_line('a')//'across '//trim(buf)//' members (95 %):'
+      do i = 1, size(names)
+         k = summary%ensemble%find(trim(names(i)))
+         if (k == 0) cycle
+         associate (q => summary%ensemble%quantity(k))
+            write (buf, '(1x,a,1x,es10.4," +- ",es8.2,1x,a)') trim(names(i)), q%value(1), q%half_width(1), q%unit
+         end associate
+         text = text//trim(buf)//';'
+      end do
+   end function headline
 
    subroutine print_info(scene, model)
       type(scene_type), intent(in) :: scene

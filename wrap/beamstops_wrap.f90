@@ -142,24 +142,41 @@ end subroutine bs_stability
 !> output file's root attributes as lines `name = value` (the same list the HDF5 writer writes,
 !> status last; the quoted `scene` text spans lines); status/message report errors that
 !> prevent the run.
-subroutine bs_run(text, source, records, snapshots, nodes, stops, t, tip_u, tip_v, reaction, energy, work, &
-   & dissipated, damped, snapshot_t, snapshot_x, snapshot_u, stops_x, stops_u, stops_reaction, filled, snaps, &
+subroutine bs_run(text, source, records, snapshots, nodes, stops, shock_capacity, stat_width, t, tip_u, tip_v, &
+   & reaction, energy, work, dissipated, damped, snapshot_t, snapshot_x, snapshot_u, stops_x, stops_u, &
+   & stops_reaction, filled, snaps, shocks, shock_count, shock_labels, stat_value, stat_half, stat_entries, stat_labels, &
    & attributes, status, message)
    use beamstops, only: error_type, fatal_error, scene_type, record_count, snapshot_count, stop_count, &
       & model_type, prepare_run, simulate, array_recorder, n_columns, run_summary
    use beamstops_recorder, only: col_t, col_u, col_v, col_reaction, col_energy, col_work, col_dissipated, col_damped
    use beamstops_attributes, only: attribute_list, attribute_lines
    use beamstops_output_attributes, only: run_attributes, summary_attributes
+   use beamstops_observe_shocks, only: n_shock_columns, shock_column_names
+   use beamstops_observe_statistics, only: statistics_table
    use beamstops_wrap_support, only: scene_of, report
    implicit none
    !f2py threadsafe
    character(len=*), intent(in) :: text, source
    integer(8), intent(in) :: records, snapshots, nodes, stops
+   !> Columns of `shocks` (shock_count may exceed it: then call again with shock_count) and entries
+   !> per quantity of the statistics (max(stops, bins + 1) from bs_sizes).
+   integer(8), intent(in) :: shock_capacity, stat_width
    real(8), intent(out) :: t(records), tip_u(records), tip_v(records), reaction(records)
    real(8), intent(out) :: energy(records), work(records), dissipated(records), damped(records)
    real(8), intent(out) :: snapshot_t(snapshots), snapshot_x(nodes), snapshot_u(nodes, snapshots)
    real(8), intent(out) :: stops_x(stops), stops_u(stops, records), stops_reaction(stops, records)
    integer(8), intent(out) :: filled, snaps
+   !> The shocks (13 fields each, the order of /impacts: shock_column_names) and their number.
+   real(8), intent(out) :: shocks(13, shock_capacity)
+   integer(8), intent(out) :: shock_count
+   !> The names of the 13 fields, separated by blanks.
+   character(len=1024), intent(out) :: shock_labels
+   !> The statistics and (members > 1) the ensemble's: up to 128 quantities, value and half-width of
+   !> each entry, entries per quantity, and a line `name unit axis table` per quantity (table:
+   !> statistics or ensemble).
+   real(8), intent(out) :: stat_value(stat_width, 128), stat_half(stat_width, 128)
+   integer(8), intent(out) :: stat_entries(128)
+   character(len=8192), intent(out) :: stat_labels
    character(len=262144), intent(out) :: attributes
    integer, intent(out) :: status
    character(len=1024), intent(out) :: message
@@ -169,13 +186,18 @@ subroutine bs_run(text, source, records, snapshots, nodes, stops, t, tip_u, tip_
    type(run_summary) :: summary
    type(attribute_list) :: list
    type(error_type), allocatable :: error
-   integer :: stat
+   integer :: stat, i, n, j
    integer(8) :: k
 
    t = 0; tip_u = 0; tip_v = 0; reaction = 0; energy = 0; work = 0; dissipated = 0; damped = 0
    snapshot_t = 0; snapshot_x = 0; snapshot_u = 0
    stops_x = 0; stops_u = 0; stops_reaction = 0
    filled = 0; snaps = 0
+   shock_labels = ''
+   do i = 1, n_shock_columns
+      shock_labels = trim(shock_labels)//' '//trim(shock_column_names(i))
+   end do
+   shocks = 0; shock_count = 0; stat_value = 0; stat_half = 0; stat_entries = 0; stat_labels = ''
    attributes = ''
 
    call scene_of(text, source, scene, error)
@@ -218,12 +240,40 @@ subroutine bs_run(text, source, records, snapshots, nodes, stops, t, tip_u, tip_
    snapshot_u(:, :snaps) = recorder%snap_u(:, :snaps)
    snapshot_x = model%x
    if (stops > 0) stops_x = model%x(scene%stop_nodes + 1)
+   if (allocated(summary%shocks)) then
+      shock_count = size(summary%shocks, 2)
+      k = min(shock_count, shock_capacity)
+      shocks(:, :k) = summary%shocks(:, :k)
+   end if
+   j = 0
+   if (allocated(summary%statistics%quantity)) call hand_table(summary%statistics, 'statistics')
+   if (summary%ensemble_members > 1 .and. allocated(summary%ensemble%quantity)) &
+      & call hand_table(summary%ensemble, 'ensemble')
    list = run_attributes(scene, model)
    call list%extend(summary_attributes(summary))
    call list%add_text('', 'status', summary%status)
    attributes = attribute_lines(list)
    status = 0
    message = ''
+
+contains
+
+   !> The quantities of a table into the statistics' arrays, after the j already there.
+   subroutine hand_table(table, label)
+      type(statistics_table), intent(in) :: table
+      character(len=*), intent(in) :: label
+      do i = 1, size(table%quantity)
+         if (j == size(stat_entries)) return
+         j = j + 1
+         associate (q => table%quantity(i))
+            n = int(min(size(q%value, kind=8), stat_width))
+            stat_entries(j) = n
+            stat_value(:n, j) = q%value(:n)
+            stat_half(:n, j) = q%half_width(:n)
+            stat_labels = trim(stat_labels)//q%name//' '//q%unit//' '//q%axis//' '//label//new_line('a')
+         end associate
+      end do
+   end subroutine hand_table
 end subroutine bs_run
 
 !> Studies: a scene without stops run in the paper's three-level form (module

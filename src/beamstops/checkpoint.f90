@@ -86,6 +86,7 @@ contains
       !> Set when the file cannot be written.
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: temporary
+      real(wp), allocatable :: observer(:)
       integer(hid_t) :: file
       integer :: hdferr
       logical :: ok(6), moved
@@ -106,6 +107,11 @@ contains
       if (allocated(state%stop_reaction)) call write_vector(file, 'stop_reaction', state%stop_reaction, ok(6))
       ! The energy the damping took (its other terms are rebuilt from d on resume).
       if (ok(6) .and. allocated(state%cd)) call write_vector(file, 'damped', [state%damped], ok(6))
+      if (ok(6) .and. state%observer%active) then
+         call state%observer%pack(observer)
+         call write_vector(file, 'observer_length', [real(size(observer), wp)], ok(6))
+         if (ok(6)) call write_vector(file, 'observer', observer, ok(6))
+      end if
       call h5fclose_f(file, hdferr)
       if (.not. all(ok) .or. hdferr /= 0) then
          call remove_file(temporary)
@@ -131,7 +137,8 @@ contains
       integer(ik), intent(out) :: records, snapshots
       !> Set when the file is unreadable or belongs to another scene.
       type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: signature(:)
+      real(wp), allocatable :: signature(:), observer(:)
+      type(error_type), allocatable :: failure
       real(wp) :: scalars(n_scalars), damped(1)
       integer(hid_t) :: file
       integer :: hdferr, n
@@ -159,6 +166,17 @@ contains
       if (ok(6) .and. model%damped) then
          call read_vector(file, 'damped', damped, ok(6))
          state%damped = damped(1)
+      end if
+      if (ok(6) .and. scene%statistics) then
+         call read_vector(file, 'observer_length', damped, ok(6))
+         if (ok(6)) then
+            allocate (observer(nint(damped(1))))
+            call read_vector(file, 'observer', observer, ok(6))
+         end if
+         if (ok(6)) then
+            call state%observer%unpack(observer, failure)
+            ok(6) = .not. allocated(failure)
+         end if
       end if
       call h5fclose_f(file, hdferr)
       if (.not. all(ok)) then

@@ -5,24 +5,27 @@
 !> source, the group and the key.
 module beamstops_namelist
    use, intrinsic :: iso_fortran_env, only: iostat_end
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
    use beamstops_scene, only: scene_type, validate_scene, tube_beam, law_code, law_compliance, max_stops
    use beamstops_strings, only: fmt_real, itoa, lower, squeeze
    use beamstops_physics_checks, only: validate_physics
+   use beamstops_observe_statistics, only: validate_statistics, validate_ensemble
    implicit none
    private
    public :: read_scene, scene_from_text, read_text_file, default_output, group_names, group_keys
 
    !> Groups a scene file may hold, each at most once.
-   character(len=*), parameter :: group_names(7) = [character(len=7) :: 'beam', 'support', 'stops', 'damping', &
-      & 'mesh', 'time', 'output']
+   character(len=*), parameter :: group_names(9) = [character(len=10) :: 'beam', 'support', 'stops', 'damping', &
+      & 'mesh', 'time', 'output', 'statistics', 'ensemble']
    !> Keys of each group, for messages.
-   character(len=*), parameter :: group_keys(7) = [character(len=140) :: &
+   character(len=*), parameter :: group_keys(9) = [character(len=140) :: &
       & 'length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness', &
       & 'amplitude, omega', 'lower, upper, nodes, x, law, stiffness, stiffness_per_mass, restitution, mass', &
       & 'mass_coefficient, stiffness_coefficient, ratio, modes', 'elements', &
-      & 'dt, t_end, beta, load_rule, start, allow_unstable', 'file, record_every, snapshot_every, checkpoint_every, max_output_gb']
+      & 'dt, t_end, beta, load_rule, start, allow_unstable', 'file, record_every, snapshot_every, checkpoint_every, max_output_gb', &
+      & 'enabled, transient, batches, bins, rest_time, histogram_lower, histogram_upper', 'members, perturbation, seed']
    real(wp), parameter :: unset = -huge(1.0_wp)
    integer, parameter :: unset_node = -huge(1)
    integer, parameter :: text_len = 4096
@@ -113,6 +116,10 @@ contains
       ! &damping: Rayleigh coefficients, or ratios at two modes
       real(wp) :: mass_coefficient, stiffness_coefficient, ratio(2)
       integer :: modes(2)
+      ! &statistics, &ensemble
+      logical :: enabled
+      real(wp) :: transient, rest_time, histogram_lower, histogram_upper, perturbation
+      integer :: batches, bins, members, seed
       ! &mesh
       integer :: elements
       ! &time
@@ -128,6 +135,8 @@ contains
       namelist /support/ amplitude, omega
       namelist /stops/ lower, upper, nodes, x, law, stiffness, stiffness_per_mass, restitution, mass
       namelist /damping/ mass_coefficient, stiffness_coefficient, ratio, modes
+      namelist /statistics/ enabled, transient, batches, bins, rest_time, histogram_lower, histogram_upper
+      namelist /ensemble/ members, perturbation, seed
       namelist /mesh/ elements
       namelist /time/ dt, t_end, beta, load_rule, start, allow_unstable
       namelist /output/ file, record_every, snapshot_every, checkpoint_every, max_output_gb
@@ -148,6 +157,9 @@ contains
       law = 'signorini'; stiffness = unset; stiffness_per_mass = unset
       restitution = scene%restitution; mass = 'consistent'
       mass_coefficient = unset; stiffness_coefficient = unset; ratio = unset; modes = scene%damping_modes
+      enabled = scene%statistics; transient = scene%transient; batches = scene%batches; bins = scene%bins
+      rest_time = scene%rest_time; histogram_lower = unset; histogram_upper = unset
+      members = scene%members; perturbation = scene%perturbation; seed = scene%seed
       elements = scene%elements
       dt = scene%dt; t_end = scene%t_end; beta = scene%beta; load_rule = 'centered'; start = 'taylor'
       allow_unstable = .false.
@@ -237,11 +249,50 @@ contains
          return
       end select
       call damping_forms(); if (allocated(error)) return
+      call statistics_keys()
       call validate_scene(scene, source, error)
       if (allocated(error)) return
       call validate_physics(scene, source, error)
+      if (allocated(error)) return
+      call validate_statistics(scene%transient, scene%t_end, scene%batches, scene%bins, scene%rest_time, &
+         & scene%histogram_lower, scene%histogram_upper, source, error)
+      if (allocated(error)) return
+      call validate_ensemble(scene%members, source, error)
+      if (allocated(error)) return
+      if (.not. (ieee_is_finite(scene%perturbation) .and. scene%perturbation >= 0 .and. &
+         & scene%perturbation <= 1.0e-3_wp*min(-scene%lower, scene%upper))) then
+         call fatal_error(error, source//': &ensemble perturbation = '//fmt_real(scene%perturbation)// &
+            & ' is out of range; allowed: 0 <= perturbation <= 1e-3 times the smallest gap to a stop = '// &
+            & fmt_real(1.0e-3_wp*min(-scene%lower, scene%upper))//' m')
+         return
+      end if
 
    contains
+
+      !> &statistics and &ensemble into the scene; the histogram's range defaults to the stops'.
+      subroutine statistics_keys()
+         scene%statistics = enabled
+         scene%transient = transient
+         scene%batches = batches
+         scene%bins = bins
+         scene%rest_time = rest_time
+         if (allocated(scene%stop_lower)) then
+            scene%histogram_lower = minval(scene%stop_lower)
+            scene%histogram_upper = maxval(scene%stop_upper)
+            if (any(scene%stop_nodes == scene%elements)) then
+               scene%histogram_lower = scene%stop_lower(findloc(scene%stop_nodes, scene%elements, dim=1))
+               scene%histogram_upper = scene%stop_upper(findloc(scene%stop_nodes, scene%elements, dim=1))
+            end if
+         else
+            scene%histogram_lower = scene%lower
+            scene%histogram_upper = scene%upper
+         end if
+         if (histogram_lower /= unset) scene%histogram_lower = histogram_lower
+         if (histogram_upper /= unset) scene%histogram_upper = histogram_upper
+         scene%members = members
+         scene%perturbation = perturbation
+         scene%seed = seed
+      end subroutine statistics_keys
 
       !> &damping: the coefficients a and b, or the ratios (one value: both) at `modes`; not both.
       subroutine damping_forms()
@@ -283,6 +334,8 @@ contains
          case (5); read (text, nml=mesh, iostat=stat, iomsg=msg)
          case (6); read (text, nml=time, iostat=stat, iomsg=msg)
          case (7); read (text, nml=output, iostat=stat, iomsg=msg)
+         case (8); read (text, nml=statistics, iostat=stat, iomsg=msg)
+         case (9); read (text, nml=ensemble, iostat=stat, iomsg=msg)
          end select
       end subroutine read_group
 
@@ -351,7 +404,7 @@ contains
       character(len=*), intent(in) :: key
       character(len=:), allocatable :: kind
       select case (key)
-      case ('elements', 'record_every', 'snapshot_every', 'checkpoint_every')
+      case ('elements', 'record_every', 'snapshot_every', 'checkpoint_every', 'batches', 'bins', 'members', 'seed')
          kind = 'a whole number'
       case ('nodes', 'modes')
          kind = 'whole numbers separated by commas'
@@ -361,7 +414,7 @@ contains
          kind = 'real numbers separated by commas (one per stop)'
       case ('law', 'load_rule', 'start', 'file', 'mass')
          kind = "a quoted text, e.g. 'name'"
-      case ('allow_unstable')
+      case ('allow_unstable', 'enabled')
          kind = '.true. or .false.'
       case default
          kind = 'a real number, e.g. 1e-5'

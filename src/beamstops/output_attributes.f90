@@ -46,6 +46,7 @@ contains
       call list%add_real('', 't_final', summary%t_final)
       call list%add_real('', 'cpu_seconds', summary%cpu_seconds)
       call list%add_int('', 'impacts', summary%impacts)
+      call list%add_int('', 'contact_phases', summary%contact_phases)
       call list%add_real('', 'max_violation', summary%max_violation)
       call list%add_real('', 'work', summary%work)
       call list%add_real('', 'dissipated', summary%dissipated)

@@ -12,7 +12,8 @@ module beamstops_run
    use beamstops_scheme, only: state_type, start_state, run_scheme
    use beamstops_recorder, only: recorder_type
    use beamstops_checkpoint, only: write_checkpoint
-   use beamstops_summary, only: run_summary, status_running, status_failed
+   use beamstops_summary, only: run_summary, status_running, status_failed, status_complete
+   use beamstops_ensemble, only: run_members
    implicit none
    private
    public :: prepare_run, simulate, continue_run
@@ -91,6 +92,11 @@ contains
             return
          end if
       end do
+      if (summary%status == status_complete .and. scene%members > 1 .and. scene%statistics .and. &
+         & .not. recorder%failed) then
+         call run_members(scene, model, summary, error)
+         if (allocated(error)) return
+      end if
       if (recorder%failed) then
          if (allocated(recorder%message)) then
             call fatal_error(error, recorder%message)

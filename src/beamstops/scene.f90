@@ -91,6 +91,23 @@ module beamstops_scene
       !> &stops: .true. to give the constrained displacement unknowns no mass (SPEC 10; beta > 0).
       logical :: redistributed_mass = .false.
       ! ---- end of issue 12 ----
+      ! ---- shocks and statistics (issue 13, SPEC 12), ensembles ----
+      !> &statistics enabled: keep the shock log and the running statistics.
+      logical :: statistics = .true.
+      !> &statistics: start of the statistics' window (s), 0 <= transient < t_end.
+      real(wp) :: transient = 0
+      !> &statistics: batches of the batch-means intervals (>= 2) and bins of the tip histogram.
+      integer :: batches = 20, bins = 40
+      !> &statistics: contact phases closer than this are one shock (s; code_aster's DUREE_REPOS).
+      real(wp) :: rest_time = 1.0e-2_wp
+      !> &statistics: range of the tip histogram (m); the reader fills in the stops' range.
+      real(wp) :: histogram_lower = -0.1_wp, histogram_upper = 0.1_wp
+      !> &ensemble: members (1: the scene alone), the size of their initial perturbation (m) and the
+      !> seed of its random numbers.
+      integer :: members = 1
+      real(wp) :: perturbation = 0
+      integer :: seed = 1
+      ! ---- end of issue 13 ----
    end type scene_type
 
 contains
@@ -237,6 +254,16 @@ contains
          call list%add_real('damping', 'stiffness_coefficient', scene%damping_stiffness)
       end if
       call list%add_int('damping', 'modes', 0_ik, values=int(scene%damping_modes, ik), attribute=.false.)
+      call list%add_logical('statistics', 'enabled', scene%statistics)
+      call list%add_real('statistics', 'transient', scene%transient)
+      call list%add_int('statistics', 'batches', int(scene%batches, ik))
+      call list%add_int('statistics', 'bins', int(scene%bins, ik))
+      call list%add_real('statistics', 'rest_time', scene%rest_time)
+      call list%add_real('statistics', 'histogram_lower', scene%histogram_lower)
+      call list%add_real('statistics', 'histogram_upper', scene%histogram_upper)
+      call list%add_int('ensemble', 'members', int(scene%members, ik))
+      call list%add_real('ensemble', 'perturbation', scene%perturbation)
+      call list%add_int('ensemble', 'seed', int(scene%seed, ik))
       call list%add_int('mesh', 'elements', int(scene%elements, ik))
       call list%add_real('time', 'dt', scene%dt)
       call list%add_real('time', 't_end', scene%t_end)

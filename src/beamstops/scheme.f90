@@ -1,8 +1,12 @@
-!> The time loop of the paper's scheme in increment form (SPEC 4):
-!>   A (d^n - d^{n-1}) = dt^2 (G^n - S u^n),  u^{n+1} = u^n + d^n,
-!> followed by the contact law at the tip (or at the stops along the span, SPEC 7), with the
-!> energy bookkeeping of SPEC 6. The law is chosen once per call of advance.
-!> The loop allocates nothing and writes nothing: records go to a recorder.
+!> The time loop of the paper's scheme in increment form (SPEC 4), with Rayleigh damping (SPEC 8):
+!>   A (d^n - d^{n-1}) = dt^2 (G^n - S u^n) - dt C d^{n-1},  u^{n+1} = u^n + d^n,
+!> A = M + dt/2 C + dt^2 beta S, followed by the contact law at the tip (or at the stops along
+!> the span, SPEC 7; with restitution, SPEC 9), the rows of massless unknowns stepped as
+!> equilibria (mass redistribution, SPEC 10), and the energy bookkeeping of SPEC 6 (beamstops_ledger).
+!> The path is chosen once per call of advance: the paper's scheme (advance_fused, as before),
+!> with damping or massless unknowns (advance_fused_general), the reference (LAPACK) path, or the
+!> stops along the span. The start is beamstops_start's; the tip's contact law is in
+!> contact/tip_contact.f90. The loop allocates nothing and writes nothing: records go to a recorder.
 module beamstops_scheme
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_kinds, only: wp, ik
@@ -81,6 +85,7 @@ contains
                & 'before t = '//trim(real_text(real(state%step - 1, wp)*model%dt))//' s'
             exit
          end if
+         if (state%observer%active) call state%observer%drain()
          call recorder%progress(state%step - 1, steps)
       end do
       summary%cpu_seconds = state%cpu_seconds
@@ -88,8 +93,13 @@ contains
       summary%t_final = real(summary%steps, wp)*model%dt
       summary%impacts = state%impacts
       summary%max_violation = state%max_violation
+      summary%contact_phases = state%impacts
       call close_ledger(scene, model, state, summary)
       if (summary%status == status_running .and. state%step > steps) summary%status = status_complete
+      if (state%observer%active .and. summary%status /= status_running) then
+         call state%observer%finish(summary%shocks, summary%statistics)
+         summary%impacts = state%observer%shocks%shock_count()
+      end if
    end subroutine run_scheme
 
    !> The energy ledger of the summary (J): work, stops' and damping's losses, and the balance
@@ -183,6 +193,8 @@ contains
          else
             call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
          end if
+         if (state%observer%active) call state%observer%tip(real(step + 1, wp)*model%dt, state%u(tip), &
+            & state%reaction, state%dissipated)
          if (model%damped) call damping_loss(model, state)
          if (step == next_record) u_old_su = dot_product(state%u, state%su) - dot_product(state%d, state%su)
          call band_matvec(model%stiffness, state%u, state%su)
@@ -244,6 +256,8 @@ contains
          u_old_su = usu
          call back_substitution(model%solver, state%rhs)
          call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
+         if (state%observer%active) call state%observer%tip(real(step + 1, wp)*model%dt, state%u(tip), &
+            & state%reaction, state%dissipated)
          if (step == next_record) then
             next_record = next_record + scene%record_every
             call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_prev, row)
@@ -309,6 +323,8 @@ contains
          else
             call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
          end if
+         if (state%observer%active) call state%observer%tip(real(step + 1, wp)*model%dt, state%u(tip), &
+            & state%reaction, state%dissipated)
          if (model%damped) call damping_loss(model, state)
          if (step == next_record) then
             next_record = next_record + scene%record_every
@@ -433,6 +449,9 @@ contains
          else
             state%stop_reaction = state%span%lambda/model%dt2
          end if
+         if (state%observer%active) call state%observer%span(real(step + 1, wp)*model%dt, &
+            & state%u(model%stops%unknown) + model%stops%lift*phi_next, state%stop_reaction, state%u(tip), &
+            & state%dissipated)
          if (step == next_snapshot) then
             next_snapshot = next_snapshot + scene%snapshot_every
             call take_snapshot(scene, model, state, step, recorder)

@@ -16,6 +16,7 @@ module beamstops_start
    use beamstops_contact_box_qp, only: qp_solved, qp_message
    use beamstops_recorder, only: recorder_type, n_columns, col_u, col_v, col_energy
    use beamstops_ledger, only: energy, physical_shape
+   use beamstops_observe_observer, only: new_observer
    implicit none
    private
    public :: start_state
@@ -111,7 +112,33 @@ contains
          call recorder%snapshot(0.0_wp, state%shape)
       end if
       state%step = 1
+      if (scene%statistics) call start_observer(scene, model, state, error)
    end subroutine start_state
+
+   !> The shock log and the statistics from t = 0, with the start's u^1 as their first sample.
+   subroutine start_observer(scene, model, state, error)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: phi0, phi1
+      phi0 = support_position(0.0_wp, scene%amplitude, scene%omega)
+      phi1 = support_position(model%dt, scene%amplitude, scene%omega)
+      if (model%stops%m > 0) then
+         call new_observer(state%observer, model%stops%m, model%u0(model%stops%unknown) + model%stops%lift*phi0, &
+            & scene%mass_per_length, model%dt, scene%rest_time, scene%transient, scene%t_end, scene%batches, &
+            & scene%bins, scene%histogram_lower, scene%histogram_upper, 0.0_wp, error)
+         if (allocated(error)) return
+         call state%observer%span(model%dt, state%u(model%stops%unknown) + model%stops%lift*phi1, &
+            & state%stop_reaction, state%u(model%tip), state%dissipated)
+      else
+         call new_observer(state%observer, 1, [model%u0(model%tip)], scene%mass_per_length, model%dt, &
+            & scene%rest_time, scene%transient, scene%t_end, scene%batches, scene%bins, scene%histogram_lower, &
+            & scene%histogram_upper, 0.0_wp, error)
+         if (allocated(error)) return
+         call state%observer%tip(model%dt, state%u(model%tip), state%reaction, state%dissipated)
+      end if
+   end subroutine start_observer
 
    !> The stops along the span at the start: their work, and u^1 projected on the bounds of t_1
    !> (the QP on the trial values u^1 at the stops; with one stop at the tip, the tip's projection).

@@ -3,6 +3,7 @@
 module beamstops_state
    use beamstops_kinds, only: wp, ik
    use beamstops_contact_span_stops, only: span_work_type
+   use beamstops_observe_observer, only: observer_type
    implicit none
    private
    public :: state_type
@@ -50,6 +51,8 @@ module beamstops_state
       real(wp) :: cpu_seconds = 0
       !> Largest violation of the stops so far (m).
       real(wp) :: max_violation = 0
+      !> The shock log and the running statistics, fed every step (when &statistics enabled).
+      type(observer_type) :: observer
       !> Solve with LAPACK's dpbtrs and separate updates: the reference path of the tests.
       logical :: lapack_solve = .false.
    end type state_type

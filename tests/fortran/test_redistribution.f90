@@ -12,7 +12,8 @@ module test_redistribution
    use beamstops_band, only: kd, band_matvec, cholesky_factor
    use beamstops_hermite, only: element_mass
    use beamstops_contact_mass_redistribution, only: redistributed_element
-   use beamstops_recorder, only: col_t, col_u, col_energy, col_work, col_dissipated
+   use beamstops_recorder, only: col_t, col_u, col_energy, col_work, col_dissipated, col_damped
+   use beamstops_scheme, only: advance
    implicit none
    private
    public :: collect_redistribution
@@ -33,7 +34,8 @@ contains
          & new_unittest('the stops'' energy -> 0 as dt -> 0', test_stop_energy), &
          & new_unittest('tip converges on [0.08, 0.125] s (order >= 1.2), the consistent mass does not', &
          &              test_convergence), &
-         & new_unittest('stops along the span (tube, interior nodes): balance and no violation', test_span) &
+         & new_unittest('stops along the span (tube, interior nodes): balance and no violation', test_span), &
+         & new_unittest('fused and reference paths agree (massless tip, with mass damping)', test_paths) &
          & ]
    end subroutine collect_redistribution
 
@@ -340,4 +342,30 @@ contains
       if (allocated(error)) return
       call check(error, summary%max_violation < 1.0e-14_wp, 'no violation beyond round-off')
    end subroutine test_span
+
+   subroutine test_paths(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(model_type) :: model
+      type(state_type) :: fused, reference
+      type(array_recorder) :: a, b
+      real(wp) :: gap
+      scene = first_period(1.0e-6_wp, .true.)
+      scene%t_end = 0.1_wp
+      scene%record_every = 1
+      scene%damping_mass = 1.0_wp
+      call open_run(scene, model, fused, a, error)
+      if (allocated(error)) return
+      call advance(scene, model, fused, a, steps_of(scene))
+      call open_run(scene, model, reference, b, error)
+      if (allocated(error)) return
+      reference%lapack_solve = .true.
+      call advance(scene, model, reference, b, steps_of(scene))
+      gap = maxval(abs(a%rows(col_u, 1:a%filled) - b%rows(col_u, 1:b%filled)))
+      call note('tip: fused vs reference '//real_text(gap)//' m through '//int_text(fused%impacts)// &
+         & ' contact phases; damped '//real_text(a%rows(col_damped, a%filled))//' J')
+      call check(error, fused%impacts > 0, 'the tip reaches a stop')
+      if (allocated(error)) return
+      call check(error, gap < 1.0e-12_wp, 'the two paths agree to round-off')
+   end subroutine test_paths
 end module test_redistribution

@@ -26,7 +26,9 @@ contains
          & new_unittest('tip, e = 0.5 and 1: KKT of the combination every step; violation of u^{n+1} shrinks with dt', &
          &              test_tip_kkt), &
          & new_unittest('stops along the span, e = 0.5: KKT of the combination every step', test_span_kkt), &
-         & new_unittest('free mass on a stop (J = 1): rebound velocity ratio -> e as dt -> 0', test_rebound) &
+         & new_unittest('free mass on a stop (J = 1): rebound velocity ratio -> e as dt -> 0', test_rebound), &
+         & new_unittest('one stop along the span at the tip is the tip path to the bit (e = 0.5; also massless)', &
+         &              test_one_stop) &
          & ]
    end subroutine collect_restitution
 
@@ -233,4 +235,30 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_rebound
+
+   subroutine test_one_stop(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: tip, span
+      type(array_recorder) :: a, b
+      type(run_summary) :: summary
+      integer :: c, k
+      do k = 1, 2
+         tip = paper(1.0e-5_wp, 0.5_wp, 0.5_wp)
+         tip%redistributed_mass = k == 2
+         span = tip
+         span%stop_nodes = [19]
+         span%stop_lower = [tip%lower]
+         span%stop_upper = [tip%upper]
+         call run_recorded(tip, a, summary, error)
+         if (allocated(error)) return
+         call run_recorded(span, b, summary, error)
+         if (allocated(error)) return
+         do c = 1, n_columns
+            if (any(a%rows(c, 1:a%filled) /= b%rows(c, 1:b%filled))) then
+               call test_failed(error, merge('massless  ', 'consistent', k == 2)//': column '//int_text(c)//' differs')
+               return
+            end if
+         end do
+      end do
+   end subroutine test_one_stop
 end module test_restitution

@@ -8,7 +8,7 @@ module test_shocks
       & shock_column_names, side_lower, side_upper
    implicit none
    private
-   public :: collect_shocks, lecuyer, uniform
+   public :: collect_shocks, lecuyer, uniform, same_bits
 
    !> Time step of the synthetic sequences (s).
    real(wp), parameter :: dt = 1.0e-3_wp
@@ -31,7 +31,9 @@ contains
          & new_unittest('random sequences, 2 stops: rows as the offline detector, sums', test_random_against_offline), &
          & new_unittest('a full ring drops rows and counts them', test_ring_overflow), &
          & new_unittest('bad inputs: stops, rest_time, u0, capacity', test_bad_inputs), &
-         & new_unittest('row values: columns in the order of the names', test_row_values) &
+         & new_unittest('row values: columns in the order of the names', test_row_values), &
+         & new_unittest('pack at a random midpoint, unpack, continue: the same rows bit for bit', test_pack_resume), &
+         & new_unittest('unpack of a truncated, padded, foreign or corrupted vector: an error', test_unpack_bad) &
          & ]
    end subroutine collect_shocks
 
@@ -542,6 +544,205 @@ contains
       if (allocated(error)) return
       call check(error, trim(shock_column_names(7)) == 'impulse', 'column 7 is impulse')
    end subroutine test_row_values
+
+   !> Whether a and b hold the same bits (any two NaNs count as the same).
+   elemental logical function same_bits(a, b)
+      real(wp), intent(in) :: a, b
+      same_bits = transfer(a, 0_ik) == transfer(b, 0_ik) .or. (ieee_is_nan(a) .and. ieee_is_nan(b))
+   end function same_bits
+
+   !> A synthetic sequence of m stops: contact bursts (chatter) of either sign, energies.
+   subroutine synthetic(m, n, seed, u, r, e)
+      integer, intent(in) :: m, n
+      integer(ik), intent(in) :: seed
+      real(wp), allocatable, intent(out) :: u(:, :), r(:, :), e(:, :)
+      integer(ik) :: s1, s2
+      integer :: i, k
+      logical :: contact
+      allocate (u(m, n), r(m, n), e(m, n))
+      s1 = seed
+      s2 = 2*seed + 1
+      do i = 1, m
+         contact = .false.
+         do k = 1, n
+            if (contact) then
+               contact = uniform(s1, s2) < 0.6_wp
+            else
+               contact = uniform(s1, s2) < 0.08_wp
+            end if
+            u(i, k) = 0.05_wp*sin(0.01_wp*k + i) + 1.0e-3_wp*uniform(s1, s2)
+            if (contact) then
+               r(i, k) = (0.5_wp + uniform(s1, s2))*merge(1, -1, mod(k/300 + i, 2) == 0)
+               e(i, k) = uniform(s1, s2)
+            else
+               r(i, k) = 0
+               e(i, k) = 0
+            end if
+         end do
+      end do
+   end subroutine synthetic
+
+   !> pack at random midpoints, unpack into a fresh log, continue both with the same steps: the
+   !> same rows, counts and packed state, bit for bit (rings of several sizes, some overflowing).
+   subroutine test_pack_resume(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: n = 3000, m = 3
+      integer, parameter :: capacities(4) = [64, 3, 1, 4096]
+      real(wp), parameter :: rests(4) = [3.5_wp*dt, 0.0_wp, 12*dt, dt]
+      real(wp), allocatable :: u(:, :), r(:, :), e(:, :), va(:), vb(:)
+      type(shock_log) :: a, b
+      type(shock_row) :: ra, rb
+      logical :: fa, fb
+      integer(ik) :: s1, s2
+      integer :: trial, k, mid, i, rows
+      s1 = 777
+      s2 = 4242
+      do trial = 1, 8
+         call synthetic(m, n, int(trial, ik), u, r, e)
+         mid = 1 + int(uniform(s1, s2)*(n - 2))
+         call new_shock_log(a, m, rests(mod(trial - 1, 4) + 1), [0.0_wp, 1.0e-3_wp, -2.0e-3_wp], error, &
+            & capacity=capacities(mod(trial - 1, 4) + 1))
+         if (allocated(error)) return
+         do k = 1, mid
+            call a%step(k*dt, dt, u(:, k), r(:, k), e(:, k))
+            if (mod(k, 97) == 0) then
+               do while (a%ready())
+                  call a%pop(ra)
+               end do
+            end if
+         end do
+         call a%pack(va)
+         call b%unpack(va, error)
+         if (allocated(error)) return
+         call b%pack(vb)
+         call check(error, size(va) == size(vb), 'trial '//int_text(trial)//': repacked size'); if (allocated(error)) return
+         call check(error, all(same_bits(va, vb)), 'trial '//int_text(trial)//': repacked values')
+         if (allocated(error)) return
+         rows = 0
+         do k = mid + 1, n + 1
+            if (k <= n) then
+               call a%step(k*dt, dt, u(:, k), r(:, k), e(:, k))
+               call b%step(k*dt, dt, u(:, k), r(:, k), e(:, k))
+            else
+               call a%finish()
+               call b%finish()
+            end if
+            if (mod(k, 97) == 0 .or. k > n) then
+               do
+                  call a%pop(ra, fa)
+                  call b%pop(rb, fb)
+                  call check(error, fa .eqv. fb, 'trial '//int_text(trial)//': a row in both'); if (allocated(error)) return
+                  if (.not. fa) exit
+                  rows = rows + 1
+                  call check(error, all(same_bits(shock_row_values(ra), shock_row_values(rb))), &
+                     & 'trial '//int_text(trial)//': row '//int_text(rows)//' bit for bit'); if (allocated(error)) return
+               end do
+            end if
+         end do
+         call check(error, rows > 0, 'trial '//int_text(trial)//': rows after the midpoint'); if (allocated(error)) return
+         do i = 1, m
+            call check(error, int(a%shock_count(i)), int(b%shock_count(i)), 'shock_count'); if (allocated(error)) return
+            call check(error, int(a%phase_count(i)), int(b%phase_count(i)), 'phase_count'); if (allocated(error)) return
+         end do
+         call check(error, int(a%lost_count()), int(b%lost_count()), 'lost_count'); if (allocated(error)) return
+         call a%pack(va)
+         call b%pack(vb)
+         call check(error, size(va) == size(vb) .and. all(same_bits(va, vb)), 'trial '//int_text(trial)// &
+            & ': final states'); if (allocated(error)) return
+      end do
+      ! The tip-only path and a log never constructed.
+      call new_shock_log(a, 1, 2*dt, [0.0_wp], error)
+      if (allocated(error)) return
+      do k = 1, 500
+         call a%step_tip(k*dt, dt, u(1, k), r(1, k), e(1, k))
+      end do
+      call a%pack(va)
+      call b%unpack(va, error)
+      if (allocated(error)) return
+      do k = 501, 1000
+         call a%step_tip(k*dt, dt, u(1, k), r(1, k), e(1, k))
+         call b%step_tip(k*dt, dt, u(1, k), r(1, k), e(1, k))
+      end do
+      call a%finish()
+      call b%finish()
+      call a%pack(va)
+      call b%pack(vb)
+      call check(error, size(va) == size(vb) .and. all(same_bits(va, vb)), 'step_tip: final states')
+      if (allocated(error)) return
+      call check(error, a%ready() .and. size(va) > 10 + 24, 'step_tip: rows held at the end'); if (allocated(error)) return
+      a = shock_log()
+      call a%pack(va)
+      call b%unpack(va, error)
+      if (allocated(error)) return
+      call check(error, b%stop_count(), 0, 'a log never constructed: restored as such')
+   end subroutine test_pack_resume
+
+   !> unpack of a truncated, padded, foreign or corrupted vector: an error, the log unchanged.
+   subroutine test_unpack_bad(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(shock_log) :: a, b
+      real(wp), allocatable :: u(:, :), r(:, :), e(:, :), va(:), vb(:), vc(:)
+      integer :: k, n
+      call synthetic(2, 400, 5_ik, u, r, e)
+      call new_shock_log(a, 2, 3*dt, [0.0_wp, 0.0_wp], error)
+      if (allocated(error)) return
+      do k = 1, 400
+         call a%step(k*dt, dt, u(:, k), r(:, k), e(:, k))
+      end do
+      call a%pack(va)
+      n = size(va)
+      call check(error, n, 10 + 24*2 + 13*int(a%shock_count()), 'length 10 + 24 m + 13 H'); if (allocated(error)) return
+      call new_shock_log(b, 1, 0.0_wp, [0.5_wp], error)
+      if (allocated(error)) return
+      call b%pack(vb)
+      call b%unpack(va(1:n - 1), error)
+      call expect('shock log: unpack: '//int_text(n - 1)//' values, header length '//int_text(n)// &
+         & '; the header (m = 2, held = '//int_text(int(a%shock_count()))//') needs '//int_text(n))
+      if (allocated(error)) return
+      call b%unpack(va(1:5), error)
+      call expect('shock log: unpack: 5 values, too short for the header (6)'); if (allocated(error)) return
+      call b%unpack([va, 0.0_wp], error)
+      call expect('shock log: unpack: '//int_text(n + 1)//' values, header length '//int_text(n)// &
+         & '; the header (m = 2, held = '//int_text(int(a%shock_count()))//') needs '//int_text(n))
+      if (allocated(error)) return
+      vc = va
+      vc(1) = 7302
+      call b%unpack(vc, error)
+      call expect('shock log: unpack: tag 7302, version 1; expected tag 7301, version 1'); if (allocated(error)) return
+      vc = va
+      vc(4) = 2.5_wp
+      call b%unpack(vc, error)
+      call expect('shock log: unpack: header value 4 = 2.5 is not an integer'); if (allocated(error)) return
+      vc = va
+      vc(10 + 5*2 + 1) = 0.5_wp
+      call b%unpack(vc, error)
+      if (.not. allocated(error)) then
+         call test_failed(error, 'a logical 0.5: no error')
+         return
+      end if
+      deallocate (error)
+      vc = va
+      vc(9) = 0
+      call b%unpack(vc, error)
+      if (.not. allocated(error)) then
+         call test_failed(error, 'head 0: no error')
+         return
+      end if
+      deallocate (error)
+      call b%pack(vc)
+      call check(error, size(vb) == size(vc) .and. all(same_bits(vb, vc)), 'unchanged after the errors')
+   contains
+      subroutine expect(message)
+         character(len=*), intent(in) :: message
+         if (.not. allocated(error)) then
+            call test_failed(error, 'no error; expected "'//message//'"')
+         else if (error%message /= message) then
+            call test_failed(error, 'message "'//error%message//'", expected "'//message//'"')
+         else
+            deallocate (error)
+         end if
+      end subroutine expect
+   end subroutine test_unpack_bad
 
    !> L'Ecuyer's combined generator (1988): deterministic, portable (int64, no overflow).
    function lecuyer(s1, s2) result(z)

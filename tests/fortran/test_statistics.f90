@@ -7,10 +7,10 @@ module test_statistics
    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_value, ieee_quiet_nan
    use testing
    use beamstops, only: ik
-   use beamstops_observe_shocks, only: shock_log, shock_row, new_shock_log
+   use beamstops_observe_shocks, only: shock_log, shock_row, new_shock_log, shock_row_values
    use beamstops_observe_statistics, only: statistics_type, new_statistics, validate_statistics, validate_ensemble, &
       & statistics_table, quantity_type, ensemble_table, student_t_quantile, student_t_cdf
-   use test_shocks, only: uniform
+   use test_shocks, only: uniform, same_bits
    implicit none
    private
    public :: collect_statistics
@@ -34,6 +34,8 @@ contains
          & new_unittest('samples and shocks before the transient are left out', test_transient), &
          & new_unittest('step_tip and step give the same table', test_step_tip), &
          & new_unittest('ensemble: mean and t s/sqrt(K) across members; bad members', test_ensemble), &
+         & new_unittest('pack at a random midpoint, unpack, continue: the same tables bit for bit', test_pack_resume), &
+         & new_unittest('unpack of a truncated, padded, foreign or corrupted vector: an error', test_unpack_bad), &
          & new_unittest('per-step cost of the shock log and the statistics (printed)', test_cost) &
          & ]
    end subroutine collect_statistics
@@ -103,7 +105,7 @@ contains
       call expect('in.nml: &statistics histogram_upper = 0.1 is out of range; allowed: histogram_upper > histogram_lower = 0.1 m')
       if (allocated(error)) return
       call validate_ensemble(0, 'in.nml', error)
-      call expect('in.nml: &statistics members = 0 is out of range; allowed: members >= 1'); if (allocated(error)) return
+      call expect('in.nml: &ensemble members = 0 is out of range; allowed: members >= 1'); if (allocated(error)) return
       call validate_statistics(1.0_wp, 10.0_wp, 2, 1, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
       call check(error, .not. allocated(error), 'batches = 2, bins = 1 accepted'); if (allocated(error)) return
       call validate_ensemble(1, 'in.nml', error)
@@ -506,6 +508,203 @@ contains
       end do
    end subroutine test_step_tip
 
+   !> Whether two tables hold the same quantities with the same bits (any two NaNs the same).
+   logical function same_tables(ta, tb)
+      type(statistics_table), intent(in) :: ta, tb
+      integer :: q
+      same_tables = size(ta%quantity) == size(tb%quantity)
+      if (.not. same_tables) return
+      do q = 1, size(ta%quantity)
+         same_tables = ta%quantity(q)%name == tb%quantity(q)%name .and. &
+            & size(ta%quantity(q)%value) == size(tb%quantity(q)%value)
+         if (.not. same_tables) return
+         same_tables = all(same_bits(ta%quantity(q)%value, tb%quantity(q)%value)) .and. &
+            & all(same_bits(ta%quantity(q)%half_width, tb%quantity(q)%half_width))
+         if (.not. same_tables) return
+      end do
+   end function same_tables
+
+   !> A shock log and statistics of 2 stops packed at a random midpoint (in the transient, in a
+   !> batch, with rows waiting), unpacked into fresh objects, then both pairs continued with the
+   !> same steps: the same rows and results tables, bit for bit (NaN-aware), during and after.
+   subroutine test_pack_resume(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: n = 4000, m = 2
+      real(wp), allocatable :: u(:, :), r(:, :), e(:, :), vl(:), vs(:), wl(:), ws(:)
+      type(shock_log) :: la, lb
+      type(statistics_type) :: sa, sb
+      type(shock_row) :: ra, rb
+      type(statistics_table) :: table
+      logical :: fa, fb
+      integer(ik) :: s1, s2
+      integer :: trial, k, mid, c
+      s1 = 99
+      s2 = 1234
+      allocate (u(m, n), r(m, n), e(m, n))
+      do trial = 1, 6
+         ! Contact bursts (chatter) at both stops, the tip swinging across the histogram range.
+         do c = 1, m
+            do k = 1, n
+               u(c, k) = 0.12_wp*sin(0.013_wp*k + c) + 0.01_wp*uniform(s1, s2)
+               r(c, k) = 0
+               if (merge(u(c, k) > 0.1_wp, u(c, k) < -0.1_wp, c == 1) .and. uniform(s1, s2) < 0.7_wp) &
+                  & r(c, k) = merge(-1, 1, c == 1)*(0.5_wp + uniform(s1, s2))
+               e(c, k) = 0.1_wp*abs(r(c, k))
+            end do
+         end do
+         mid = 1 + int(uniform(s1, s2)*(n - 2))
+         if (trial == 1) mid = 150
+         call new_shock_log(la, m, 3*dt, [0.0_wp, 0.0_wp], error, capacity=16)
+         if (allocated(error)) return
+         call new_statistics(sa, m, 0.5_wp, n*dt, 5, 9, -0.1_wp, 0.1_wp, error)
+         if (allocated(error)) return
+         do k = 1, mid
+            call advance(la, sa, k)
+         end do
+         call la%pack(vl)
+         call sa%pack(vs)
+         call lb%unpack(vl, error)
+         if (allocated(error)) return
+         call sb%unpack(vs, error)
+         if (allocated(error)) return
+         call lb%pack(wl)
+         call check(error, size(vl) == size(wl) .and. all(same_bits(vl, wl)), 'trial '//int_text(trial)// &
+            & ': repacked log'); if (allocated(error)) return
+         call sb%pack(ws)
+         call check(error, size(vs) == size(ws), 'trial '//int_text(trial)//': repacked size'); if (allocated(error)) return
+         call check(error, all(same_bits(vs, ws)), 'trial '//int_text(trial)//': repacked values')
+         if (allocated(error)) return
+         call check(error, same_tables(sa%results(), sb%results()), 'trial '//int_text(trial)//': tables at the midpoint')
+         if (allocated(error)) return
+         do k = mid + 1, n
+            call advance(la, sa, k)
+            call advance(lb, sb, k)
+            if (allocated(error)) return
+            if (mod(k, 1000) == 0) then
+               call check(error, same_tables(sa%results(), sb%results()), 'trial '//int_text(trial)//': tables at '// &
+                  & int_text(k)); if (allocated(error)) return
+            end if
+         end do
+         call la%finish()
+         call lb%finish()
+         call drain(la, sa, lb, sb)
+         if (allocated(error)) return
+         call sa%finish()
+         call sb%finish()
+         call check(error, same_tables(sa%results(), sb%results()), 'trial '//int_text(trial)//': final tables')
+         if (allocated(error)) return
+         table = sa%results()
+         call check(error, sum(table%quantity(table%find('shocks'))%value) > 0, 'trial '//int_text(trial)// &
+            & ': shocks counted')
+         if (allocated(error)) return
+         call sa%pack(vs)
+         call sb%pack(ws)
+         call check(error, size(vs) == size(ws) .and. all(same_bits(vs, ws)), 'trial '//int_text(trial)//': final states')
+         if (allocated(error)) return
+      end do
+      ! Statistics never constructed.
+      sa = statistics_type()
+      call sa%pack(vs)
+      call sb%unpack(vs, error)
+      if (allocated(error)) return
+      call sb%pack(ws)
+      call check(error, size(ws), 6, 'statistics never constructed: the header alone')
+   contains
+      !> Step k of a log and its statistics, rows drained every 50 steps.
+      subroutine advance(log, stats, k)
+         type(shock_log), intent(inout) :: log
+         type(statistics_type), intent(inout) :: stats
+         integer, intent(in) :: k
+         type(shock_row) :: row
+         call log%step(k*dt, dt, u(:, k), r(:, k), e(:, k))
+         call stats%step(k*dt, dt, u(1, k), r(:, k), e(:, k))
+         if (mod(k, 50) == 0) then
+            do while (log%ready())
+               call log%pop(row)
+               call stats%add_shock(row)
+            end do
+         end if
+      end subroutine advance
+      !> Drain both logs into their statistics, comparing the rows.
+      subroutine drain(log_a, stats_a, log_b, stats_b)
+         type(shock_log), intent(inout) :: log_a, log_b
+         type(statistics_type), intent(inout) :: stats_a, stats_b
+         do
+            call log_a%pop(ra, fa)
+            call log_b%pop(rb, fb)
+            call check(error, fa .eqv. fb, 'a row in both'); if (allocated(error)) return
+            if (.not. fa) exit
+            call check(error, all(same_bits(shock_row_values(ra), shock_row_values(rb))), 'rows bit for bit')
+            if (allocated(error)) return
+            call stats_a%add_shock(ra)
+            call stats_b%add_shock(rb)
+         end do
+      end subroutine drain
+   end subroutine test_pack_resume
+
+   !> unpack of a truncated, padded, foreign or corrupted vector: an error, the statistics unchanged.
+   subroutine test_unpack_bad(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(statistics_type) :: a, b
+      type(shock_log) :: log
+      real(wp), allocatable :: va(:), vb(:), vc(:)
+      integer :: k, n
+      call new_statistics(a, 2, 0.1_wp, 1.0_wp, 4, 7, -0.1_wp, 0.1_wp, error)
+      if (allocated(error)) return
+      do k = 1, 600
+         call a%step(k*dt, dt, 0.1_wp*sin(0.02_wp*k), [merge(1.0_wp, 0.0_wp, mod(k, 9) == 0), 0.0_wp], [0.0_wp, 0.0_wp])
+      end do
+      call a%pack(va)
+      n = size(va)
+      call check(error, n, 21 + 6*4 + 7 + 5*2 + 7*4 + 11*2*4, 'length 21 + 6 B + K + 5 m + K B + 11 m B')
+      if (allocated(error)) return
+      call new_statistics(b, 1, 0.0_wp, 1.0_wp, 2, 1, 0.0_wp, 1.0_wp, error)
+      if (allocated(error)) return
+      call b%pack(vb)
+      call b%unpack(va(1:n - 1), error)
+      call expect('statistics: unpack: '//int_text(n - 1)//' values, header length '//int_text(n)// &
+         & '; the header (m = 2, batches = 4, bins = 7) needs '//int_text(n))
+      if (allocated(error)) return
+      call b%unpack(va(1:3), error)
+      call expect('statistics: unpack: 3 values, too short for the header (6)'); if (allocated(error)) return
+      call b%unpack([va, 1.0_wp], error)
+      call expect('statistics: unpack: '//int_text(n + 1)//' values, header length '//int_text(n)// &
+         & '; the header (m = 2, batches = 4, bins = 7) needs '//int_text(n))
+      if (allocated(error)) return
+      call new_shock_log(log, 1, 0.0_wp, [0.0_wp], error)
+      if (allocated(error)) return
+      call log%pack(vc)
+      call b%unpack(vc, error)
+      call expect('statistics: unpack: tag 7301, version 1; expected tag 7302, version 1'); if (allocated(error)) return
+      vc = va
+      vc(5) = 1
+      call b%unpack(vc, error)
+      call expect('statistics: unpack: header m = 2, batches = 1, bins = 7 is inconsistent'); if (allocated(error)) return
+      vc = va
+      vc(6 + 7) = 5
+      call b%unpack(vc, error)
+      call expect('statistics: unpack: value 13 = 5 is out of range (expected an integer, or a batch or bin index '// &
+         & 'in range)'); if (allocated(error)) return
+      vc = va
+      vc(6 + 9) = 0.5_wp
+      call b%unpack(vc, error)
+      call expect('statistics: unpack: value 15 = 0.5 is out of range (expected an integer, or a batch or bin index '// &
+         & 'in range)'); if (allocated(error)) return
+      call b%pack(vc)
+      call check(error, size(vb) == size(vc) .and. all(same_bits(vb, vc)), 'unchanged after the errors')
+   contains
+      subroutine expect(message)
+         character(len=*), intent(in) :: message
+         if (.not. allocated(error)) then
+            call test_failed(error, 'no error; expected "'//message//'"')
+         else if (error%message /= message) then
+            call test_failed(error, 'message "'//error%message//'", expected "'//message//'"')
+         else
+            deallocate (error)
+         end if
+      end subroutine expect
+   end subroutine test_unpack_bad
+
    subroutine test_ensemble(error)
       type(error_type), allocatable, intent(out) :: error
       type(statistics_table) :: members(3), ensemble
@@ -539,7 +738,7 @@ contains
          call test_failed(error, 'no members accepted')
          return
       end if
-      if (error%message /= 'ensemble: &statistics members = 0 is out of range; allowed: members >= 1') then
+      if (error%message /= 'ensemble: &ensemble members = 0 is out of range; allowed: members >= 1') then
          call test_failed(error, 'message: '//error%message)
          return
       end if

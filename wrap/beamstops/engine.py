@@ -150,6 +150,26 @@ def attributes_of(lines: str) -> dict[str, Any]:
     return {match.group(1): parse_value(match.group(2)) for match in _ATTRIBUTE.finditer(lines)}
 
 
+def _observations(scene: Scene, fields: list[str], shocks: np.ndarray, value: np.ndarray, half: np.ndarray, entries: np.ndarray,
+                  labels: str) -> dict[str, Any]:
+    """The engine's shock log and statistics as Result fields (the layout of /impacts and /statistics)."""
+    from .observations import Statistic
+
+    if not scene.enabled:
+        return {}
+    impacts = {name: np.ascontiguousarray(shocks[i]) for i, name in enumerate(fields)}
+    tables: dict[str, dict[str, Statistic]] = {"statistics": {}, "ensemble": {}}
+    for k, line in enumerate(labels.splitlines()):
+        name, unit, axis, table = line.split()
+        n = int(entries[k])
+        tables[table][name] = Statistic(value=value[:n, k].copy(), half_width=half[:n, k].copy(), unit=unit,
+                                        axis=axis)
+    settings = {"transient": scene.transient, "batches": scene.batches, "bins": scene.bins,
+                "rest_time": scene.rest_time}
+    return {"impacts": impacts, "statistics": tables["statistics"], "statistics_attrs": settings,
+            "ensemble": tables["ensemble"]}
+
+
 def run(scene: Scene, *, allow_incomplete: bool = False) -> Result:
     """Run a scene in memory and return its :class:`Result` (no file is written).
 
@@ -160,10 +180,17 @@ def run(scene: Scene, *, allow_incomplete: bool = False) -> Result:
     """
     text = _scene_text(scene)
     records, snapshots, nodes, stops = sizes(scene)
-    (t, tip_u, tip_v, reaction, energy, work, dissipated, damped, snapshot_t, snapshot_x, snapshot_u, stops_x, stops_u,
-     stops_reaction, filled, snaps, attribute_text, status, message) = _engine.bs_run(
-        text, b"scene", records, snapshots, nodes, stops)
-    _check(status, message)
+    width = max(stops, 1, scene.bins + 1)
+    capacity = 4096
+    while True:
+        (t, tip_u, tip_v, reaction, energy, work, dissipated, damped, snapshot_t, snapshot_x, snapshot_u, stops_x,
+         stops_u, stops_reaction, filled, snaps, shocks, shock_count, shock_labels, stat_value, stat_half, stat_entries,
+         stat_labels, attribute_text, status, message) = _engine.bs_run(
+            text, b"scene", records, snapshots, nodes, stops, capacity, width)
+        _check(status, message)
+        if int(shock_count) <= capacity:
+            break
+        capacity = int(shock_count)  # the same deterministic run again, with room for every shock
     filled, snaps = int(filled), int(snaps)
     attrs = attributes_of(_text(attribute_text))
     cut: Callable[[np.ndarray], np.ndarray] = (lambda a: a) if filled == records else (lambda a: a[:filled].copy())
@@ -178,7 +205,8 @@ def run(scene: Scene, *, allow_incomplete: bool = False) -> Result:
         stops_lower=np.array(scene.lower if scene.nodes else (), dtype=np.float64),
         stops_upper=np.array(scene.upper if scene.nodes else (), dtype=np.float64),
         stops_u=np.ascontiguousarray(stops_u.T[:filled]), stops_reaction=np.ascontiguousarray(stops_reaction.T[:filled]),
-        attrs=attrs, source="memory")
+        attrs=attrs, source="memory", **_observations(scene, _text(shock_labels).split(), shocks[:, :int(shock_count)], stat_value, stat_half,
+                                                     stat_entries, _text(stat_labels)))
     if attrs.get("status") != "complete" and not allow_incomplete:
         raise IncompleteRunError(f"scene: run {attrs.get('status')}: {attrs.get('message', '')}", result)
     return result

@@ -144,11 +144,12 @@ def read_impacts(file: h5py.File, source: str = "") -> dict[str, np.ndarray]:
     return impacts
 
 
-def read_statistics(file: h5py.File, source: str = "") -> tuple[dict[str, Statistic], dict[str, Any]]:
-    """The /statistics group: {name: Statistic} and the group's attributes ({} and {} when absent)."""
-    if "statistics" not in file:
+def read_statistics(file: h5py.File, source: str = "", group_name: str = "statistics"
+                    ) -> tuple[dict[str, Statistic], dict[str, Any]]:
+    """The /statistics group (or /ensemble): {name: Statistic} and the group's attributes ({} and {} when absent)."""
+    if group_name not in file:
         return {}, {}
-    group = file["statistics"]
+    group = file[group_name]
     statistics: dict[str, Statistic] = {}
     for name in group:
         dataset = group[name]
@@ -156,7 +157,7 @@ def read_statistics(file: h5py.File, source: str = "") -> tuple[dict[str, Statis
             continue
         statistics[name] = Statistic.from_table(
             dataset[()], unit=_text(dataset.attrs.get("units", "")), axis=_text(dataset.attrs.get("axis", "")),
-            name=f"{source}: /statistics/{name}")
+            name=f"{source}: /{group_name}/{name}")
     attrs = {name: _plain(value) for name, value in group.attrs.items()}
     return statistics, attrs
 

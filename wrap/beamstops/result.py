@@ -106,6 +106,8 @@ class Result:
     """The engine's statistics by name ({} when none were computed)."""
     statistics_attrs: dict[str, Any] = field(default_factory=dict)
     """Attributes of the statistics: transient (s), batches, bins, rest_time (s)."""
+    ensemble: dict[str, Statistic] = field(default_factory=dict)
+    """With &ensemble members > 1: each statistic across the members, mean and t s/sqrt(K) (/ensemble)."""
     attrs: dict[str, Any] = field(default_factory=dict)
     source: str = "memory"
     """'memory' for :func:`beamstops.run`, the file name for :func:`load`."""
@@ -188,6 +190,7 @@ def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result
                 arrays[name] = np.asarray(f[dataset][()], dtype=np.float64)
         impacts = read_impacts(f, path)
         statistics, statistics_attrs = read_statistics(f, path)
+        ensemble, _ = read_statistics(f, path, "ensemble")
     nodes = arrays["snapshot_x"].size if "snapshot_x" in arrays else 0
     arrays.setdefault("snapshot_t", np.empty(0))
     arrays.setdefault("snapshot_x", np.empty(0))
@@ -197,7 +200,7 @@ def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result
     arrays.setdefault("stops_reaction", np.empty((records, 0)))
     for name in ARRAYS:
         arrays.setdefault(name, np.empty(0))
-    result = Result(**arrays, impacts=impacts, statistics=statistics, statistics_attrs=statistics_attrs,
+    result = Result(**arrays, impacts=impacts, statistics=statistics, statistics_attrs=statistics_attrs, ensemble=ensemble,
                     attrs=attrs, source=path)
     if result.status != "complete" and not allow_incomplete:
         raise IncompleteRunError(f"{path}: run {result.status}: {attrs.get('message', 'not complete')}; "

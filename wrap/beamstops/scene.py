@@ -126,6 +126,28 @@ class Scene:
     """Save a checkpoint every this many steps, for ``beamstops run --restart`` (0: never)."""
     max_output_gb: float = 4.0
     """Refuse a run whose recorded data would exceed this many gigabytes (1e9 bytes)."""
+    # &statistics
+    enabled: bool = True
+    """Keep the shock log (/impacts) and the statistics (/statistics)."""
+    transient: float = 0.0
+    """Start of the statistics' window (s)."""
+    batches: int = 20
+    """Batches of the batch-means 95 % intervals (>= 2)."""
+    bins: int = 40
+    """Bins of the tip-displacement histogram."""
+    rest_time: float = 0.01
+    """Contact phases closer than this are one shock (s)."""
+    histogram_lower: float = -0.1
+    """Lower end of the tip histogram (m; default: the lower stop)."""
+    histogram_upper: float = 0.1
+    """Upper end of the tip histogram (m; default: the upper stop)."""
+    # &ensemble
+    members: int = 1
+    """Members of the ensemble (1: the scene alone)."""
+    perturbation: float = 0.0
+    """Size of the members' random initial perturbation (m)."""
+    seed: int = 1
+    """Seed of the perturbation's random numbers."""
 
     def __post_init__(self) -> None:
         values = {field.name: getattr(self, field.name) for field in dataclasses.fields(self)}

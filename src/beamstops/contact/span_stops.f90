@@ -359,8 +359,13 @@ contains
          k = stops%unknown(a)
          r = work%reaction(a)
          if (r == 0) cycle
-         dissipated = dissipated - 0.5_wp*r*((d(k) + work%d_prev(a)) + stops%lift(a)*dphi)
-         support_work = support_work - 0.5_wp*r*stops%lift(a)*dphi
+         if (stops%lift(a) == 0) then
+            ! the tip path's expression, so that a stop at the tip gives its bits
+            dissipated = dissipated - 0.5_wp*r*(d(k) + work%d_prev(a))
+         else
+            dissipated = dissipated - 0.5_wp*r*((d(k) + work%d_prev(a)) + stops%lift(a)*dphi)
+            support_work = support_work - 0.5_wp*r*stops%lift(a)*dphi
+         end if
       end do
    end subroutine span_energy_massless
 end module beamstops_contact_span_stops

@@ -38,7 +38,7 @@
 !> happens on contact samples and at the few samples after a phase, in procedures kept out of
 !> line so that the common path stays a leaf without register saves.
 module beamstops_observe_shocks
-   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_positive_inf
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
    use beamstops_scene, only: fmt_real, fmt_int
@@ -144,6 +144,10 @@ module beamstops_observe_shocks
       procedure :: lost_count
       !> Number of stops.
       procedure :: stop_count
+      !> The complete state as a vector of reals (checkpoints).
+      procedure :: pack => pack_log
+      !> Restore the state from a vector of pack.
+      procedure :: unpack => unpack_log
       ! The rare paths, bound so that calls go through the type's table and stay out of line:
       ! the common path of step is then a leaf without register saves.
       procedure, private :: contact_sample
@@ -155,6 +159,13 @@ module beamstops_observe_shocks
 
    !> Ring size when none is given.
    integer, parameter :: default_capacity = 4096
+
+   !> First two values of a packed shock log: its tag and the version of the layout.
+   real(wp), parameter :: pack_tag = 7301, pack_version = 1
+   !> Values of the header, of the scalars, per stop (u1, u2, deadline, shocks, phases and the
+   !> track), per row.
+   integer, parameter :: pack_header = 6, pack_scalars = 4, pack_per_stop = 5 + 6 + n_shock_columns, &
+      & pack_per_row = n_shock_columns
 
 contains
 
@@ -487,6 +498,269 @@ contains
          & row%impulse, row%peak_reaction, row%energy_taken, real(row%rebounds, wp), real(row%contact_steps, wp), &
          & row%contact_time, merge(1.0_wp, 0.0_wp, row%truncated)]
    end function shock_row_values
+
+   !> The complete state of the log as reals, for a checkpoint (unpack restores it; a log never
+   !> constructed packs as its header alone, with m = 0). Integers are stored exactly as reals
+   !> (counters stay far below 2**53; huge(1_ik), "no deadline", as +Infinity), logicals as 1 or
+   !> 0, reals bit for bit (NaN included). Layout, version 1 (m stops, ring capacity C, H rows
+   !> held):
+   !> - header (6): 7301 (tag), 1 (version), total length, m, C, H;
+   !> - scalars (4): rest_time, k (samples seen), head (ring slot of the oldest row), lost;
+   !> - per stop, five arrays of m: u1, u2, deadline, shocks, phases;
+   !> - per stop i = 1..m, its track (19): open, in_phase, last, rest_steps, t_last, dt_last, then
+   !>   its open row (13);
+   !> - the H rows held, oldest first (13 each).
+   !> A row is its 13 values in the order of shock_column_names (shock_row_values).
+   !> Total: 10 + 24 m + 13 H (6 when m = 0).
+   subroutine pack_log(self, values)
+      !> Log.
+      class(shock_log), intent(in) :: self
+      !> The state, in the layout above.
+      real(wp), allocatable, intent(out) :: values(:)
+      integer :: i, j, p, cap, n
+      if (self%m == 0) then
+         values = [pack_tag, pack_version, real(pack_header, wp), 0.0_wp, 0.0_wp, 0.0_wp]
+         return
+      end if
+      cap = size(self%ring)
+      n = pack_header + pack_scalars + pack_per_stop*self%m + pack_per_row*self%held
+      allocate (values(n))
+      p = 0
+      call put(values, p, [pack_tag, pack_version, real(n, wp), real(self%m, wp), real(cap, wp), real(self%held, wp)])
+      call put(values, p, [self%rest_time, ik_value(self%k), real(self%head, wp), ik_value(self%lost)])
+      call put(values, p, self%u1)
+      call put(values, p, self%u2)
+      call put(values, p, ik_value(self%deadline))
+      call put(values, p, ik_value(self%shocks))
+      call put(values, p, ik_value(self%phases))
+      do i = 1, self%m
+         associate (tr => self%track(i))
+            call put(values, p, [logical_value(tr%open), logical_value(tr%in_phase), ik_value(tr%last), &
+               & ik_value(tr%rest_steps), tr%t_last, tr%dt_last])
+            call put(values, p, shock_row_values(tr%row))
+         end associate
+      end do
+      do j = 0, self%held - 1
+         call put(values, p, shock_row_values(self%ring(mod(self%head - 1 + j, cap) + 1)))
+      end do
+   end subroutine pack_log
+
+   !> Restore the log from a vector of pack (the layout of pack_log): afterwards it takes the
+   !> same samples and gives the same rows and counts, bit for bit, as the log that was packed.
+   !> On an error (a vector too short or too long for its header, another tag or version, a value
+   !> that is not an integer or a logical where one is due, an index out of range) the log is
+   !> left unchanged.
+   subroutine unpack_log(self, values, error)
+      !> Log (any state: it is replaced).
+      class(shock_log), intent(inout) :: self
+      !> The state, from pack.
+      real(wp), intent(in) :: values(:)
+      !> Set when the vector is not a packed shock log.
+      type(error_type), allocatable, intent(out) :: error
+      type(shock_log) :: new
+      integer :: i, j, p, m, cap, held, head, n, bad
+      integer(ik) :: want
+      if (size(values) < pack_header) then
+         call fatal_error(error, 'shock log: unpack: '//fmt_int(int(size(values), ik))// &
+            & ' values, too short for the header ('//fmt_int(int(pack_header, ik))//')')
+         return
+      end if
+      if (.not. (values(1) == pack_tag .and. values(2) == pack_version)) then
+         call fatal_error(error, 'shock log: unpack: tag '//fmt_real(values(1))//', version '//fmt_real(values(2))// &
+            & '; expected tag '//fmt_real(pack_tag)//', version '//fmt_real(pack_version))
+         return
+      end if
+      bad = 0
+      p = 2
+      call take_int(values, p, n, bad)
+      call take_int(values, p, m, bad)
+      call take_int(values, p, cap, bad)
+      call take_int(values, p, held, bad)
+      if (bad /= 0) then
+         call fatal_error(error, 'shock log: unpack: header value '//fmt_int(int(bad, ik))//' = '// &
+            & fmt_real(values(bad))//' is not an integer')
+         return
+      end if
+      if (m < 0 .or. cap < 0 .or. held < 0 .or. held > cap .or. ((m == 0) .neqv. (cap == 0))) then
+         call fatal_error(error, 'shock log: unpack: header m = '//fmt_int(int(m, ik))//', capacity = '// &
+            & fmt_int(int(cap, ik))//', held = '//fmt_int(int(held, ik))//' is inconsistent')
+         return
+      end if
+      want = pack_header
+      if (m > 0) want = pack_header + pack_scalars + pack_per_stop*int(m, ik) + pack_per_row*int(held, ik)
+      if (n /= want .or. size(values) /= want) then
+         call fatal_error(error, 'shock log: unpack: '//fmt_int(int(size(values), ik))//' values, header length '// &
+            & fmt_int(int(n, ik))//'; the header (m = '//fmt_int(int(m, ik))//', held = '// &
+            & fmt_int(int(held, ik))//') needs '//fmt_int(want))
+         return
+      end if
+      if (m > 0) then
+         new%m = m
+         allocate (new%u1(m), new%u2(m), new%deadline(m), new%track(m), new%shocks(m), new%phases(m), new%ring(cap))
+         p = pack_header
+         call take_real(values, p, new%rest_time)
+         call take_ik(values, p, new%k, bad)
+         call take_int(values, p, head, bad)
+         call take_ik(values, p, new%lost, bad)
+         if (bad == 0 .and. .not. new%rest_time >= 0) bad = pack_header + 1
+         if (bad == 0 .and. (head < 1 .or. head > cap)) bad = pack_header + 3
+         do i = 1, m
+            call take_real(values, p, new%u1(i))
+         end do
+         do i = 1, m
+            call take_real(values, p, new%u2(i))
+         end do
+         do i = 1, m
+            call take_ik(values, p, new%deadline(i), bad)
+         end do
+         do i = 1, m
+            call take_ik(values, p, new%shocks(i), bad)
+         end do
+         do i = 1, m
+            call take_ik(values, p, new%phases(i), bad)
+         end do
+         do i = 1, m
+            call take_logical(values, p, new%track(i)%open, bad)
+            call take_logical(values, p, new%track(i)%in_phase, bad)
+            call take_ik(values, p, new%track(i)%last, bad)
+            call take_ik(values, p, new%track(i)%rest_steps, bad)
+            call take_real(values, p, new%track(i)%t_last)
+            call take_real(values, p, new%track(i)%dt_last)
+            call take_row(values, p, new%track(i)%row, bad)
+         end do
+         if (bad == 0) then
+            new%head = head
+            new%held = held
+            do j = 0, held - 1
+               call take_row(values, p, new%ring(mod(head - 1 + j, cap) + 1), bad)
+            end do
+         end if
+         if (bad /= 0) then
+            call fatal_error(error, 'shock log: unpack: value '//fmt_int(int(bad, ik))//' = '// &
+               & fmt_real(values(bad))//' is out of range (expected an integer, a logical 0 or 1, an index '// &
+               & 'in range, or rest_time >= 0)')
+            return
+         end if
+      end if
+      self%m = new%m
+      self%rest_time = new%rest_time
+      self%k = new%k
+      self%head = new%head
+      self%held = new%held
+      self%lost = new%lost
+      call move_alloc(new%u1, self%u1)
+      call move_alloc(new%u2, self%u2)
+      call move_alloc(new%deadline, self%deadline)
+      call move_alloc(new%track, self%track)
+      call move_alloc(new%shocks, self%shocks)
+      call move_alloc(new%phases, self%phases)
+      call move_alloc(new%ring, self%ring)
+   end subroutine unpack_log
+
+   !> Read a row stored as shock_row_values at values(p+1:), advance p.
+   pure subroutine take_row(values, p, row, bad)
+      real(wp), intent(in) :: values(:)
+      integer, intent(inout) :: p
+      type(shock_row), intent(out) :: row
+      integer, intent(inout) :: bad
+      call take_real(values, p, row%t_start)
+      call take_real(values, p, row%t_end)
+      call take_int(values, p, row%stop, bad)
+      call take_int(values, p, row%side, bad)
+      call take_real(values, p, row%velocity_in)
+      call take_real(values, p, row%velocity_out)
+      call take_real(values, p, row%impulse)
+      call take_real(values, p, row%peak_reaction)
+      call take_real(values, p, row%energy_taken)
+      call take_int(values, p, row%rebounds, bad)
+      call take_ik(values, p, row%contact_steps, bad)
+      call take_real(values, p, row%contact_time)
+      call take_logical(values, p, row%truncated, bad)
+   end subroutine take_row
+
+   !> Store x at values(p+1:), advance p.
+   pure subroutine put(values, p, x)
+      real(wp), intent(inout) :: values(:)
+      integer, intent(inout) :: p
+      real(wp), intent(in) :: x(:)
+      values(p + 1:p + size(x)) = x
+      p = p + size(x)
+   end subroutine put
+
+   !> An integer(ik) as a real: exact below 2**53; huge(1_ik) as +Infinity.
+   elemental function ik_value(x) result(v)
+      integer(ik), intent(in) :: x
+      real(wp) :: v
+      if (x == huge(1_ik)) then
+         v = ieee_value(v, ieee_positive_inf)
+      else
+         v = real(x, wp)
+      end if
+   end function ik_value
+
+   !> A logical as 1 or 0.
+   elemental function logical_value(x) result(v)
+      logical, intent(in) :: x
+      real(wp) :: v
+      v = merge(1.0_wp, 0.0_wp, x)
+   end function logical_value
+
+   !> Read values(p+1) as a real, advance p.
+   pure subroutine take_real(values, p, x)
+      real(wp), intent(in) :: values(:)
+      integer, intent(inout) :: p
+      real(wp), intent(out) :: x
+      p = p + 1
+      x = values(p)
+   end subroutine take_real
+
+   !> Read values(p+1) as an integer(ik) (+Infinity: huge(1_ik)), advance p; bad = p when it is
+   !> not one (and bad was 0).
+   pure subroutine take_ik(values, p, x, bad)
+      real(wp), intent(in) :: values(:)
+      integer, intent(inout) :: p
+      integer(ik), intent(out) :: x
+      integer, intent(inout) :: bad
+      real(wp) :: v
+      p = p + 1
+      v = values(p)
+      x = 0
+      if (v > huge(v)) then
+         x = huge(1_ik)
+      else if (abs(v) <= 2.0_wp**62 .and. aint(v) == v) then
+         x = int(v, ik)
+      else if (bad == 0) then
+         bad = p
+      end if
+   end subroutine take_ik
+
+   !> Read values(p+1) as a default integer, advance p; bad = p when it is not one.
+   pure subroutine take_int(values, p, x, bad)
+      real(wp), intent(in) :: values(:)
+      integer, intent(inout) :: p
+      integer, intent(out) :: x
+      integer, intent(inout) :: bad
+      real(wp) :: v
+      p = p + 1
+      v = values(p)
+      x = 0
+      if (abs(v) <= real(huge(x), wp) .and. aint(v) == v) then
+         x = int(v)
+      else if (bad == 0) then
+         bad = p
+      end if
+   end subroutine take_int
+
+   !> Read values(p+1) as a logical (1 or 0), advance p; bad = p when it is neither.
+   pure subroutine take_logical(values, p, x, bad)
+      real(wp), intent(in) :: values(:)
+      integer, intent(inout) :: p
+      logical, intent(out) :: x
+      integer, intent(inout) :: bad
+      p = p + 1
+      x = values(p) == 1
+      if (.not. (values(p) == 1 .or. values(p) == 0) .and. bad == 0) bad = p
+   end subroutine take_logical
 
    !> A quiet NaN.
    function nan() result(x)

@@ -114,12 +114,21 @@ module beamstops_observe_statistics
       procedure :: finish
       !> The table of quantities.
       procedure :: results
+      !> The complete state as a vector of reals (checkpoints).
+      procedure :: pack => pack_statistics
+      !> Restore the state from a vector of pack.
+      procedure :: unpack => unpack_statistics
       ! The rare paths, bound so that calls go through the type's table and stay out of line:
       ! the common path of step is then a leaf without register saves.
       procedure, private :: contact_sample
       procedure, private :: turn
       procedure, private :: new_run
    end type statistics_type
+
+   !> First two values of packed statistics: their tag and the version of the layout.
+   real(wp), parameter :: pack_tag = 7302, pack_version = 1
+   !> Values of the header and of the scalars of packed statistics.
+   integer, parameter :: pack_header = 6, pack_scalars = 15
 
 contains
 
@@ -174,7 +183,7 @@ contains
       character(len=*), intent(in) :: source
       !> Set when out of range.
       type(error_type), allocatable, intent(out) :: error
-      if (members < 1) call fatal_error(error, source//': &statistics members = '//fmt_int(int(members, ik))// &
+      if (members < 1) call fatal_error(error, source//': &ensemble members = '//fmt_int(int(members, ik))// &
          & ' is out of range; allowed: members >= 1')
    end subroutine validate_ensemble
 
@@ -553,6 +562,293 @@ contains
          table%quantity(q)%half_width = half_width
       end subroutine put
    end function results
+
+   !> The complete state of the statistics as reals, for a checkpoint (unpack restores it;
+   !> statistics never constructed pack as their header alone, with m = 0). Integers are stored
+   !> exactly as reals (counts stay far below 2**53), reals bit for bit. Layout, version 1
+   !> (m stops, B batches, K bins; arrays of two indices column-major, the first index fastest):
+   !> - header (6): 7302 (tag), 1 (version), total length, m, B, K;
+   !> - scalars (15): transient, t_end, lower, upper, scale, dt, batch, next_edge, n, run_start,
+   !>   run_bin, su, suu, umin, umax;
+   !> - edge (B), hist (K, bins 0..K-1);
+   !> - the current batch per stop (m each): contact, sr, srr, rmax, se;
+   !> - per batch (B each): bn, bsu, bsuu, bumin, bumax; bhist (K x B);
+   !> - per stop and batch (m x B each): bcontact, bsr, bsrr, brmax, bse, bshocks, brebounds,
+   !>   bdur, bdurmin, bdurmax, bimp.
+   !> Total: 21 + 6 B + K + 5 m + K B + 11 m B (6 when m = 0).
+   subroutine pack_statistics(self, values)
+      !> Statistics.
+      class(statistics_type), intent(in) :: self
+      !> The state, in the layout above.
+      real(wp), allocatable, intent(out) :: values(:)
+      integer :: p, n, m, b, k
+      if (self%m == 0) then
+         values = [pack_tag, pack_version, real(pack_header, wp), 0.0_wp, 0.0_wp, 0.0_wp]
+         return
+      end if
+      m = self%m
+      b = self%batches
+      k = self%bins
+      n = pack_header + pack_scalars + 6*b + k + 5*m + k*b + 11*m*b
+      allocate (values(n))
+      p = 0
+      call put(values, p, [pack_tag, pack_version, real(n, wp), real(m, wp), real(b, wp), real(k, wp)])
+      call put(values, p, [self%transient, self%t_end, self%lower, self%upper, self%scale, self%dt, &
+         & real(self%batch, wp), self%next_edge, real(self%n, wp), real(self%run_start, wp), real(self%run_bin, wp), &
+         & self%su, self%suu, self%umin, self%umax])
+      call put(values, p, self%edge)
+      call put(values, p, real(self%hist, wp))
+      call put(values, p, real(self%contact, wp))
+      call put(values, p, self%sr)
+      call put(values, p, self%srr)
+      call put(values, p, self%rmax)
+      call put(values, p, self%se)
+      call put(values, p, real(self%bn, wp))
+      call put(values, p, self%bsu)
+      call put(values, p, self%bsuu)
+      call put(values, p, self%bumin)
+      call put(values, p, self%bumax)
+      call put(values, p, reshape(real(self%bhist, wp), [k*b]))
+      call put(values, p, reshape(real(self%bcontact, wp), [m*b]))
+      call put(values, p, reshape(self%bsr, [m*b]))
+      call put(values, p, reshape(self%bsrr, [m*b]))
+      call put(values, p, reshape(self%brmax, [m*b]))
+      call put(values, p, reshape(self%bse, [m*b]))
+      call put(values, p, reshape(real(self%bshocks, wp), [m*b]))
+      call put(values, p, reshape(real(self%brebounds, wp), [m*b]))
+      call put(values, p, reshape(self%bdur, [m*b]))
+      call put(values, p, reshape(self%bdurmin, [m*b]))
+      call put(values, p, reshape(self%bdurmax, [m*b]))
+      call put(values, p, reshape(self%bimp, [m*b]))
+   end subroutine pack_statistics
+
+   !> Restore the statistics from a vector of pack (the layout of pack_statistics): afterwards
+   !> they take the same samples and shocks and give the same results, bit for bit, as the
+   !> statistics that were packed. On an error (a vector too short or too long for its header,
+   !> another tag or version, a value that is not an integer where one is due, a batch or bin
+   !> index out of range) the statistics are left unchanged.
+   subroutine unpack_statistics(self, values, error)
+      !> Statistics (any state: they are replaced).
+      class(statistics_type), intent(inout) :: self
+      !> The state, from pack.
+      real(wp), intent(in) :: values(:)
+      !> Set when the vector is not packed statistics.
+      type(error_type), allocatable, intent(out) :: error
+      type(statistics_type) :: s
+      integer :: p, n, m, b, k, bad
+      real(wp) :: want
+      if (size(values) < pack_header) then
+         call fatal_error(error, 'statistics: unpack: '//fmt_int(int(size(values), ik))// &
+            & ' values, too short for the header ('//fmt_int(int(pack_header, ik))//')')
+         return
+      end if
+      if (.not. (values(1) == pack_tag .and. values(2) == pack_version)) then
+         call fatal_error(error, 'statistics: unpack: tag '//fmt_real(values(1))//', version '//fmt_real(values(2))// &
+            & '; expected tag '//fmt_real(pack_tag)//', version '//fmt_real(pack_version))
+         return
+      end if
+      bad = 0
+      p = 2
+      call take_int(values, p, n, bad)
+      call take_int(values, p, m, bad)
+      call take_int(values, p, b, bad)
+      call take_int(values, p, k, bad)
+      if (bad /= 0) then
+         call fatal_error(error, 'statistics: unpack: header value '//fmt_int(int(bad, ik))//' = '// &
+            & fmt_real(values(bad))//' is not an integer')
+         return
+      end if
+      if (.not. ((m >= 1 .and. b >= 2 .and. k >= 1) .or. (m == 0 .and. b == 0 .and. k == 0))) then
+         call fatal_error(error, 'statistics: unpack: header m = '//fmt_int(int(m, ik))//', batches = '// &
+            & fmt_int(int(b, ik))//', bins = '//fmt_int(int(k, ik))//' is inconsistent')
+         return
+      end if
+      ! In reals: exact for any length that can match the vector's, no overflow otherwise.
+      want = pack_header
+      if (m > 0) want = pack_header + pack_scalars + 6*real(b, wp) + k + 5*real(m, wp) + real(k, wp)*b + &
+         & 11*real(m, wp)*b
+      if (n /= want .or. size(values) /= want) then
+         call fatal_error(error, 'statistics: unpack: '//fmt_int(int(size(values), ik))//' values, header length '// &
+            & fmt_int(int(n, ik))//'; the header (m = '//fmt_int(int(m, ik))//', batches = '//fmt_int(int(b, ik))// &
+            & ', bins = '//fmt_int(int(k, ik))//') needs '//fmt_real(want))
+         return
+      end if
+      if (m > 0) then
+         s%m = m
+         s%batches = b
+         s%bins = k
+         allocate (s%edge(b), s%hist(0:k - 1), s%contact(m), s%sr(m), s%srr(m), s%rmax(m), s%se(m))
+         allocate (s%bn(b), s%bsu(b), s%bsuu(b), s%bumin(b), s%bumax(b), s%bhist(k, b))
+         allocate (s%bcontact(m, b), s%bsr(m, b), s%bsrr(m, b), s%brmax(m, b), s%bse(m, b))
+         allocate (s%bshocks(m, b), s%brebounds(m, b), s%bdur(m, b), s%bdurmin(m, b), s%bdurmax(m, b), s%bimp(m, b))
+         p = pack_header
+         call take_real(values, p, s%transient)
+         call take_real(values, p, s%t_end)
+         call take_real(values, p, s%lower)
+         call take_real(values, p, s%upper)
+         call take_real(values, p, s%scale)
+         call take_real(values, p, s%dt)
+         call take_int(values, p, s%batch, bad)
+         if (bad == 0 .and. (s%batch < 0 .or. s%batch > b)) bad = p
+         call take_real(values, p, s%next_edge)
+         call take_ik(values, p, s%n, bad)
+         call take_ik(values, p, s%run_start, bad)
+         call take_int(values, p, s%run_bin, bad)
+         if (bad == 0 .and. (s%run_bin < 0 .or. s%run_bin > k - 1)) bad = p
+         call take_real(values, p, s%su)
+         call take_real(values, p, s%suu)
+         call take_real(values, p, s%umin)
+         call take_real(values, p, s%umax)
+         call take_reals(values, p, size(s%edge), s%edge)
+         call take_iks(values, p, size(s%hist), s%hist, bad)
+         call take_iks(values, p, size(s%contact), s%contact, bad)
+         call take_reals(values, p, size(s%sr), s%sr)
+         call take_reals(values, p, size(s%srr), s%srr)
+         call take_reals(values, p, size(s%rmax), s%rmax)
+         call take_reals(values, p, size(s%se), s%se)
+         call take_iks(values, p, size(s%bn), s%bn, bad)
+         call take_reals(values, p, size(s%bsu), s%bsu)
+         call take_reals(values, p, size(s%bsuu), s%bsuu)
+         call take_reals(values, p, size(s%bumin), s%bumin)
+         call take_reals(values, p, size(s%bumax), s%bumax)
+         call take_iks(values, p, size(s%bhist), s%bhist, bad)
+         call take_iks(values, p, size(s%bcontact), s%bcontact, bad)
+         call take_reals(values, p, size(s%bsr), s%bsr)
+         call take_reals(values, p, size(s%bsrr), s%bsrr)
+         call take_reals(values, p, size(s%brmax), s%brmax)
+         call take_reals(values, p, size(s%bse), s%bse)
+         call take_iks(values, p, size(s%bshocks), s%bshocks, bad)
+         call take_iks(values, p, size(s%brebounds), s%brebounds, bad)
+         call take_reals(values, p, size(s%bdur), s%bdur)
+         call take_reals(values, p, size(s%bdurmin), s%bdurmin)
+         call take_reals(values, p, size(s%bdurmax), s%bdurmax)
+         call take_reals(values, p, size(s%bimp), s%bimp)
+         if (bad /= 0) then
+            call fatal_error(error, 'statistics: unpack: value '//fmt_int(int(bad, ik))//' = '// &
+               & fmt_real(values(bad))//' is out of range (expected an integer, or a batch or bin index in range)')
+            return
+         end if
+      end if
+      self%m = s%m
+      self%batches = s%batches
+      self%bins = s%bins
+      self%transient = s%transient
+      self%t_end = s%t_end
+      self%lower = s%lower
+      self%upper = s%upper
+      self%scale = s%scale
+      self%dt = s%dt
+      self%batch = s%batch
+      self%next_edge = s%next_edge
+      self%n = s%n
+      self%run_start = s%run_start
+      self%run_bin = s%run_bin
+      self%su = s%su
+      self%suu = s%suu
+      self%umin = s%umin
+      self%umax = s%umax
+      call move_alloc(s%edge, self%edge)
+      call move_alloc(s%hist, self%hist)
+      call move_alloc(s%contact, self%contact)
+      call move_alloc(s%sr, self%sr)
+      call move_alloc(s%srr, self%srr)
+      call move_alloc(s%rmax, self%rmax)
+      call move_alloc(s%se, self%se)
+      call move_alloc(s%bn, self%bn)
+      call move_alloc(s%bsu, self%bsu)
+      call move_alloc(s%bsuu, self%bsuu)
+      call move_alloc(s%bumin, self%bumin)
+      call move_alloc(s%bumax, self%bumax)
+      call move_alloc(s%bhist, self%bhist)
+      call move_alloc(s%bcontact, self%bcontact)
+      call move_alloc(s%bsr, self%bsr)
+      call move_alloc(s%bsrr, self%bsrr)
+      call move_alloc(s%brmax, self%brmax)
+      call move_alloc(s%bse, self%bse)
+      call move_alloc(s%bshocks, self%bshocks)
+      call move_alloc(s%brebounds, self%brebounds)
+      call move_alloc(s%bdur, self%bdur)
+      call move_alloc(s%bdurmin, self%bdurmin)
+      call move_alloc(s%bdurmax, self%bdurmax)
+      call move_alloc(s%bimp, self%bimp)
+   end subroutine unpack_statistics
+
+   !> Store x at values(p+1:), advance p.
+   pure subroutine put(values, p, x)
+      real(wp), intent(inout) :: values(:)
+      integer, intent(inout) :: p
+      real(wp), intent(in) :: x(:)
+      values(p + 1:p + size(x)) = x
+      p = p + size(x)
+   end subroutine put
+
+   !> Read values(p+1) as a real, advance p.
+   pure subroutine take_real(values, p, x)
+      real(wp), intent(in) :: values(:)
+      integer, intent(inout) :: p
+      real(wp), intent(out) :: x
+      p = p + 1
+      x = values(p)
+   end subroutine take_real
+
+   !> Read n reals into x (explicit shape: an array of any rank by sequence association, in
+   !> array element order), advance p.
+   pure subroutine take_reals(values, p, n, x)
+      real(wp), intent(in) :: values(:)
+      integer, intent(inout) :: p
+      integer, intent(in) :: n
+      real(wp), intent(out) :: x(n)
+      x = values(p + 1:p + n)
+      p = p + n
+   end subroutine take_reals
+
+   !> Read n integer(ik) into x as take_reals, advance p; bad = the index of the first value
+   !> that is not an integer below 2**62 (when bad was 0).
+   pure subroutine take_iks(values, p, n, x, bad)
+      real(wp), intent(in) :: values(:)
+      integer, intent(inout) :: p
+      integer, intent(in) :: n
+      integer(ik), intent(out) :: x(n)
+      integer, intent(inout) :: bad
+      integer :: i
+      do i = 1, n
+         call take_ik(values, p, x(i), bad)
+      end do
+   end subroutine take_iks
+
+   !> Read values(p+1) as an integer(ik), advance p; bad = p when it is not one (and bad was 0).
+   pure subroutine take_ik(values, p, x, bad)
+      real(wp), intent(in) :: values(:)
+      integer, intent(inout) :: p
+      integer(ik), intent(out) :: x
+      integer, intent(inout) :: bad
+      real(wp) :: v
+      p = p + 1
+      v = values(p)
+      x = 0
+      if (abs(v) <= 2.0_wp**62 .and. aint(v) == v) then
+         x = int(v, ik)
+      else if (bad == 0) then
+         bad = p
+      end if
+   end subroutine take_ik
+
+   !> Read values(p+1) as a default integer, advance p; bad = p when it is not one.
+   pure subroutine take_int(values, p, x, bad)
+      real(wp), intent(in) :: values(:)
+      integer, intent(inout) :: p
+      integer, intent(out) :: x
+      integer, intent(inout) :: bad
+      real(wp) :: v
+      p = p + 1
+      v = values(p)
+      x = 0
+      if (abs(v) <= real(huge(x), wp) .and. aint(v) == v) then
+         x = int(v)
+      else if (bad == 0) then
+         bad = p
+      end if
+   end subroutine take_int
 
    !> a / b, NaN when b = 0.
    elemental function ratio(a, b) result(r)

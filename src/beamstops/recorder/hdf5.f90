@@ -25,6 +25,7 @@ module beamstops_recorder_hdf5
       & col_work, col_dissipated, col_damped
    use beamstops_attributes, only: attribute_list, kind_real, kind_int, kind_logical, kind_text
    use beamstops_output_attributes, only: run_attributes, summary_attributes
+   use beamstops_recorder_hdf5_observations, only: write_observations
    implicit none
    private
    public :: hdf5_recorder, partial_path, check_output_path
@@ -214,6 +215,12 @@ contains
       logical :: ok
       if (self%file < 0) return
       call write_buffer(self)
+      if (allocated(summary%shocks) .and. .not. self%failed) then
+         call write_observations(self%file, summary%shocks, summary%statistics, self%scene%transient, &
+            & self%scene%batches, self%scene%bins, self%scene%rest_time, ok, summary%ensemble, &
+            & summary%ensemble_members)
+         if (.not. ok) call fail(self, 'cannot write /impacts or /statistics')
+      end if
       call write_attributes(self, summary_attributes(summary))
       if (.not. self%failed) then
          call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, hdferr)

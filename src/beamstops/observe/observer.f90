@@ -1,0 +1,224 @@
+!> The observers the time loop feeds every step: the shock log and the running statistics
+!> (beamstops_observe_shocks, beamstops_observe_statistics), in physical units. The loop hands
+!> each step's sample — t_{n+1}, the stops' physical displacement, their reactions of step n and
+!> the energy the stops took in step n, per unit mass — and, between blocks, the finished shocks
+!> are drained to the recorder and into the statistics.
+module beamstops_observe_observer
+   use beamstops_kinds, only: wp, ik
+   use beamstops_error, only: error_type, fatal_error
+   use beamstops_observe_shocks, only: shock_log, shock_row, new_shock_log, shock_row_values, n_shock_columns
+   use beamstops_observe_statistics, only: statistics_type, statistics_table, new_statistics
+   implicit none
+   private
+   public :: observer_type, new_observer
+
+   !> Shock log and statistics of a run, fed by the loop.
+   type :: observer_type
+      !> Whether the run observes (&statistics enabled).
+      logical :: active = .false.
+      !> Number of stops m (1 for the tip-only scene).
+      integer :: m = 0
+      !> Mass per length: reactions and energies per unit mass times it give N and J.
+      real(wp) :: rho = 1
+      !> Time step (s).
+      real(wp) :: dt = 0
+      !> Energy taken by the stops, per unit mass, up to the last sample.
+      real(wp) :: dissipated_seen = 0
+      !> The shock log.
+      type(shock_log) :: shocks
+      !> The running statistics.
+      type(statistics_type) :: stats
+      !> Samples of the stops (m): displacement, reaction, energy taken.
+      real(wp), allocatable :: u(:), r(:), e(:)
+      !> The finished shocks so far, one column each (n_shock_columns, shocks); `shocks_kept` used.
+      real(wp), allocatable :: rows(:, :)
+      !> Number of finished shocks kept in rows.
+      integer :: shocks_kept = 0
+   contains
+      !> The sample of a step of the tip-only scene.
+      procedure :: tip
+      !> The sample of a step with stops along the span.
+      procedure :: span
+      !> Take the finished shocks out (into the statistics and the kept rows).
+      procedure :: drain
+      !> Close the open shocks and the last batch at the end of the run; the table of statistics.
+      procedure :: finish
+      !> The whole observer as one vector of reals (checkpoints).
+      procedure :: pack => pack_observer
+      !> The observer from a vector of pack.
+      procedure :: unpack => unpack_observer
+   end type observer_type
+
+contains
+
+   !> An observer of m stops whose values are u0 at t = 0, over [transient, t_end] in `batches`
+   !> batches, the tip histogram with `bins` bins over [lower, upper].
+   subroutine new_observer(self, m, u0, rho, dt, rest_time, transient, t_end, batches, bins, lower, upper, &
+      & dissipated0, error)
+      !> The observer, active on return.
+      type(observer_type), intent(out) :: self
+      !> Number of stops.
+      integer, intent(in) :: m
+      !> Stops' physical displacement at t = 0 (m) (m).
+      real(wp), intent(in) :: u0(:)
+      !> Mass per length (kg/m), time step (s), rest time (s), window (s).
+      real(wp), intent(in) :: rho, dt, rest_time, transient, t_end
+      !> Batches and bins.
+      integer, intent(in) :: batches, bins
+      !> Histogram range of the tip (m).
+      real(wp), intent(in) :: lower, upper
+      !> Energy the stops took before the first sample, per unit mass (the start).
+      real(wp), intent(in) :: dissipated0
+      !> Set on a value out of range.
+      type(error_type), allocatable, intent(out) :: error
+      self%m = m
+      self%rho = rho
+      self%dt = dt
+      self%dissipated_seen = dissipated0
+      allocate (self%u(m), self%r(m), self%e(m))
+      ! Drained every block of 8192 steps: a capacity of m (4096 + 1) rows never drops one.
+      call new_shock_log(self%shocks, m, rest_time, u0, error, capacity=m*4097 + 16)
+      if (allocated(error)) return
+      call new_statistics(self%stats, m, transient, t_end, batches, bins, lower, upper, error)
+      if (allocated(error)) return
+      self%active = .true.
+   end subroutine new_observer
+
+   !> The sample of step n of the tip-only scene: t_{n+1}, u^{n+1}_tip (physical: the lifting is 0
+   !> at the tip), the reaction of step n and the stops' energy so far, both per unit mass.
+   subroutine tip(self, t, u_tip, reaction, dissipated)
+      !> Observer.
+      class(observer_type), intent(inout) :: self
+      !> t_{n+1} (s), u^{n+1}_tip (m), reaction per unit mass, energy taken so far per unit mass.
+      real(wp), intent(in) :: t, u_tip, reaction, dissipated
+      real(wp) :: r, e
+      r = self%rho*reaction
+      e = self%rho*(dissipated - self%dissipated_seen)
+      self%dissipated_seen = dissipated
+      call self%shocks%step_tip(t, self%dt, u_tip, r, e)
+      call self%stats%step_tip(t, self%dt, u_tip, r, e)
+   end subroutine tip
+
+   !> The sample of step n with stops along the span: t_{n+1}, the stops' physical displacement,
+   !> their reactions per unit mass, and the tip displacement. The energy the stops took in the
+   !> step is one total; it is shared among the stops acting in the step in proportion to |r|
+   !> (exact whenever one stop acts at a time).
+   subroutine span(self, t, u, reaction, u_tip, dissipated)
+      !> Observer.
+      class(observer_type), intent(inout) :: self
+      !> t_{n+1} (s).
+      real(wp), intent(in) :: t
+      !> Stops' physical displacement (m) and reactions per unit mass (m each).
+      real(wp), intent(in) :: u(:), reaction(:)
+      !> Tip displacement (m), energy taken so far per unit mass.
+      real(wp), intent(in) :: u_tip, dissipated
+      real(wp) :: total, weight
+      self%u = u
+      self%r = self%rho*reaction
+      total = self%rho*(dissipated - self%dissipated_seen)
+      self%dissipated_seen = dissipated
+      weight = sum(abs(self%r))
+      if (weight > 0) then
+         self%e = total*abs(self%r)/weight
+      else
+         self%e = 0
+      end if
+      call self%shocks%step(t, self%dt, self%u, self%r, self%e)
+      call self%stats%step(t, self%dt, u_tip, self%r, self%e)
+   end subroutine span
+
+   !> Take the finished shocks out of the log into the statistics and `rows` (grown as needed).
+   subroutine drain(self)
+      !> Observer.
+      class(observer_type), intent(inout) :: self
+      type(shock_row) :: row
+      real(wp), allocatable :: grown(:, :)
+      if (.not. allocated(self%rows)) allocate (self%rows(n_shock_columns, 256))
+      do while (self%shocks%ready())
+         call self%shocks%pop(row)
+         call self%stats%add_shock(row)
+         if (self%shocks_kept == size(self%rows, 2)) then
+            allocate (grown(n_shock_columns, 2*size(self%rows, 2)))
+            grown(:, :self%shocks_kept) = self%rows(:, :self%shocks_kept)
+            call move_alloc(grown, self%rows)
+         end if
+         self%shocks_kept = self%shocks_kept + 1
+         self%rows(:, self%shocks_kept) = shock_row_values(row)
+      end do
+   end subroutine drain
+
+   !> At the end of the run: close the open shocks, take them out, close the last batch; the
+   !> shocks (one column each) and the table of statistics.
+   subroutine finish(self, shocks, table)
+      !> Observer.
+      class(observer_type), intent(inout) :: self
+      !> Every shock of the run (n_shock_columns, shocks).
+      real(wp), allocatable, intent(out) :: shocks(:, :)
+      !> The statistics of the run.
+      type(statistics_table), intent(out) :: table
+      call self%shocks%finish()
+      call self%drain()
+      call self%stats%finish()
+      table = self%stats%results()
+      shocks = self%rows(:, :self%shocks_kept)
+   end subroutine finish
+   !> The whole observer as reals: [m, rho, dt, dissipated_seen, kept, size of the log's vector,
+   !> the log's vector (shock_log%pack), size of the statistics' vector, its vector
+   !> (statistics_type%pack), the kept rows (13 per shock)].
+   subroutine pack_observer(self, values)
+      !> Observer (active).
+      class(observer_type), intent(in) :: self
+      !> Its state.
+      real(wp), allocatable, intent(out) :: values(:)
+      real(wp), allocatable :: log(:), stats(:)
+      call self%shocks%pack(log)
+      call self%stats%pack(stats)
+      values = [real(self%m, wp), self%rho, self%dt, self%dissipated_seen, real(self%shocks_kept, wp), &
+         & real(size(log), wp), log, real(size(stats), wp), stats]
+      if (self%shocks_kept > 0) values = [values, reshape(self%rows(:, :self%shocks_kept), [n_shock_columns* &
+         & self%shocks_kept])]
+   end subroutine pack_observer
+
+   !> Restore an observer from the vector of pack_observer.
+   subroutine unpack_observer(self, values, error)
+      !> Observer, active on return.
+      class(observer_type), intent(inout) :: self
+      !> The vector of pack_observer.
+      real(wp), intent(in) :: values(:)
+      !> Set when the vector is not an observer's.
+      type(error_type), allocatable, intent(out) :: error
+      integer :: at, n_log, n_stats
+      if (size(values) < 7) then
+         call fatal_error(error, 'the checkpoint''s shock log is damaged')
+         return
+      end if
+      self%m = nint(values(1))
+      self%rho = values(2)
+      self%dt = values(3)
+      self%dissipated_seen = values(4)
+      self%shocks_kept = nint(values(5))
+      n_log = nint(values(6))
+      at = 7
+      if (at + n_log > size(values)) then
+         call fatal_error(error, 'the checkpoint''s shock log is damaged')
+         return
+      end if
+      call self%shocks%unpack(values(at:at + n_log - 1), error)
+      if (allocated(error)) return
+      at = at + n_log
+      n_stats = nint(values(at))
+      if (at + n_stats + n_shock_columns*self%shocks_kept /= size(values)) then
+         call fatal_error(error, 'the checkpoint''s statistics are damaged')
+         return
+      end if
+      call self%stats%unpack(values(at + 1:at + n_stats), error)
+      if (allocated(error)) return
+      at = at + n_stats + 1
+      allocate (self%rows(n_shock_columns, max(256, self%shocks_kept)))
+      if (self%shocks_kept > 0) self%rows(:, :self%shocks_kept) = reshape(values(at:), &
+         & [n_shock_columns, self%shocks_kept])
+      if (allocated(self%u)) deallocate (self%u, self%r, self%e)
+      allocate (self%u(self%m), self%r(self%m), self%e(self%m))
+      self%active = .true.
+   end subroutine unpack_observer
+end module beamstops_observe_observer

@@ -1,0 +1,137 @@
+"""Shocks and statistics (issue 13) against an independent computation from the records of the
+same run, and the intervals' behaviour (disjoint halves, ensembles)."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import beamstops
+from beamstops import Scene
+
+DT = 5e-5
+
+
+def shocks_from_records(result: beamstops.Result, rest_time: float) -> list[dict[str, float]]:
+    """The shock log recomputed from /tip/t, /tip/u, /tip/reaction and /energy/dissipated
+    (record_every = 1), with the rest-time rule of docs/statistics.md, written independently."""
+    t, u, r, dissipated = result.t, result.tip_u, result.reaction, result.dissipated
+    n = t.size - 1
+    e = np.zeros(n + 1)
+    e[2:] = dissipated[1:-1] - dissipated[:-2]
+    rest_steps = max(math.ceil(rest_time / DT - 1e-9), 2)
+    phases = []  # (first, last, sign) of each maximal run of contact samples of one sign
+    k = 1
+    while k <= n:
+        if r[k] != 0:
+            sign = np.sign(r[k])
+            first = k
+            while k + 1 <= n and r[k + 1] != 0 and np.sign(r[k + 1]) == sign:
+                k += 1
+            phases.append((first, k, sign))
+        k += 1
+    shocks: list[list[tuple[int, int, float]]] = []
+    for phase in phases:
+        if shocks and shocks[-1][-1][2] == phase[2] and (phase[0] - shocks[-1][-1][1] - 1) * DT < rest_time:
+            shocks[-1].append(phase)
+        else:
+            shocks.append([phase])
+    rows = []
+    for shock in shocks:
+        a, b = shock[0][0], shock[-1][1]
+        samples = [k for first, last, _ in shock for k in range(first, last + 1)]
+        u_before = u[a - 2] if a >= 2 else u[0]
+        rows.append({
+            "t_start": t[a], "side": shock[0][2], "rebounds": len(shock) - 1, "contact_steps": len(samples),
+            "impulse": float(np.sum(r[samples]) * DT), "energy_taken": float(np.sum(e[samples])),
+            "peak_reaction": float(r[samples][np.argmax(np.abs(r[samples]))]),
+            "velocity_in": (u[a] - u_before) / (2 * DT),
+            "t_end": t[b + 1] if b + 1 <= n else math.nan,
+            "velocity_out": (u[b + 2] - u[b]) / (2 * DT) if b + 2 <= n else math.nan,
+            "complete": b + rest_steps <= n,
+        })
+    return rows
+
+
+@pytest.fixture(scope="module")
+def run() -> beamstops.Result:
+    return beamstops.run(Scene(t_end=3.0, dt=DT, rest_time=0.01))
+
+
+def test_shock_log_equals_an_independent_one_from_the_records(run: beamstops.Result) -> None:
+    expected = shocks_from_records(run, 0.01)
+    got = run.impacts
+    assert len(expected) == got["t_start"].size > 10
+    assert run.attrs["impacts"] == len(expected)
+    for i, row in enumerate(expected):
+        assert got["t_start"][i] == row["t_start"] and got["side"][i] == row["side"]
+        assert got["rebounds"][i] == row["rebounds"] and got["contact_steps"][i] == row["contact_steps"]
+        assert got["stop"][i] == 1
+        for name in ("impulse", "energy_taken", "peak_reaction", "velocity_in"):
+            assert got[name][i] == pytest.approx(row[name], rel=1e-11, abs=1e-15), (i, name)
+        if row["complete"]:
+            assert got["t_end"][i] == row["t_end"] and got["truncated"][i] == 0
+            assert got["velocity_out"][i] == pytest.approx(row["velocity_out"], rel=1e-11, abs=1e-15), i
+
+
+def test_impulses_and_energies_add_up(run: beamstops.Result) -> None:
+    assert run.impacts["impulse"].sum() == pytest.approx(run.reaction.sum() * DT, rel=1e-12)
+    assert run.impacts["energy_taken"].sum() == pytest.approx(run.dissipated[-1], rel=1e-9)
+    # contact phases: the engine's count beside the shocks
+    assert run.attrs["contact_phases"] == run.impacts["rebounds"].sum() + run.impacts["rebounds"].size
+
+
+def test_program_and_memory_give_the_same_shocks(tmp_path: Path, program: str) -> None:
+    scene = Scene(t_end=1.0, file="out.h5")
+    scene.to_namelist(tmp_path / "s.nml")
+    subprocess.run([program, "run", "s.nml"], cwd=tmp_path, check=True, capture_output=True)
+    loaded, ran = beamstops.load(tmp_path / "out.h5"), beamstops.run(scene)
+    for name, column in ran.impacts.items():
+        assert np.array_equal(loaded.impacts[name], column, equal_nan=True), name
+    for name, stat in ran.statistics.items():
+        assert np.array_equal(loaded.statistics[name].value, stat.value, equal_nan=True), name
+
+
+def test_no_contact_no_shocks_and_one_forced_contact_one_shock() -> None:
+    free = beamstops.run(Scene(t_end=0.5, law="none"))
+    assert free.impacts["t_start"].size == 0 and float(free.statistics["power"]) == 0
+    # stops far away but for one excursion: the support's single push brings the tip to the upper
+    # stop once within 0.2 s (the first impact of the paper's scene is at t = 0.088 s)
+    one = beamstops.run(Scene(t_end=0.12, rest_time=0.02, upper=0.1, lower=-1.0))
+    assert one.impacts["t_start"].size == 1 and one.impacts["side"][0] == -1
+
+
+def test_disjoint_halves_agree_within_their_intervals() -> None:
+    first = beamstops.run(Scene(t_end=12.0, transient=2.0, batches=10, record_every=1000))
+    second = beamstops.run(Scene(t_end=22.0, transient=12.0, batches=10, record_every=1000))
+    for name in ("power", "shocks_per_second", "impulse_rate", "tip_rms", "tip_mean", "contact_fraction"):
+        a, b = first.statistics[name], second.statistics[name]
+        assert abs(float(a) - float(b)) <= a.half_width[0] + b.half_width[0], (name, str(a), str(b))
+
+
+def test_ensembles_identical_members_and_decorrelated_members() -> None:
+    scene = Scene(t_end=3.0, transient=1.0, batches=10, record_every=1000, members=3)
+    same = beamstops.run(scene)
+    assert same.ensemble["power"].half_width[0] == 0  # delta = 0: members identical bit for bit
+    assert float(same.ensemble["power"]) == float(same.statistics["power"])
+    spread = beamstops.run(scene.replace(perturbation=1e-6, members=4))
+    assert spread.ensemble["power"].half_width[0] > 0  # the members parted after the first impacts
+
+
+@pytest.mark.parametrize(("text", "needle"), [
+    ("&statistics batches = 1 /", "&statistics batches = 1 is out of range; allowed: batches >= 2"),
+    ("&statistics transient = 5 /", "&statistics transient = 5 is out of range"),
+    ("&statistics rest_time = -1 /", "&statistics rest_time = -1 is out of range"),
+    ("&ensemble members = 0 /", "&ensemble members = 0 is out of range"),
+    ("&statistics bins = 0 /", "&statistics bins = 0 is out of range"),
+])
+def test_bad_statistics_inputs(text: str, needle: str, tmp_path: Path) -> None:
+    path = tmp_path / "bad.nml"
+    path.write_text(text + "\n")
+    with pytest.raises(ValueError, match="allowed") as caught:
+        Scene.from_namelist(path)
+    assert needle in str(caught.value)
