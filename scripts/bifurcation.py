@@ -9,7 +9,7 @@ resumable: a second call only draws) and draws from its summary table:
   in the colour of its p (1, 2, 3, ≥ 4), the others in black;
 - bottom: the energy the stops take per forcing period over the whole run (and the
   Rayleigh damping's, when the sweep has a ``damped`` reduction), and the number of
-  impacts per period.
+  shocks (the engine's ``impacts``) per period.
 
 Beside the image, a markdown table (same name, ``.md``): how many values of ω settle on a
 period-p motion at the stroboscope (from ``strobe_period``), and the windows of ω where they do.
@@ -118,8 +118,8 @@ def draw(rows: list[dict[str, Any]], path: Path, title: str = "", stops: Sequenc
                 bottom.plot(omega, damped, color="tab:green", linewidth=0.8, label="energy taken by damping per period (J)")
             bottom.set_ylabel("J per period")
             twin = bottom.twinx()
-            twin.plot(omega, impacts, color="tab:orange", linewidth=0.8, label="impacts per period")
-            twin.set_ylabel("impacts per period", color="tab:orange")
+            twin.plot(omega, impacts, color="tab:orange", linewidth=0.8, label="shocks per period")
+            twin.set_ylabel("shocks per period", color="tab:orange")
             bottom.legend(loc="upper left", fontsize=7)
         bottom.set_xlabel("forcing frequency ω (rad/s)")
         path.parent.mkdir(parents=True, exist_ok=True)

@@ -36,6 +36,8 @@ def test_files_and_rows(quick: tuple[Path, dict[str, Table]]) -> None:
             assert math.isnan(orders[0]) and all(math.isfinite(o) for o in orders[1:]), (label, orders)
     assert [r[0] for r in tables["headline"].rows] == labels
     assert [r[0] for r in tables["energy"].rows] == labels + [contact_laws.DAMPED[0]]
+    per_shock = [float(r[tables["energy"].columns.index("phases per shock")]) for r in tables["energy"].rows]  # type: ignore
+    assert all(math.isnan(x) or x >= 1 for x in per_shock) and any(x >= 1 for x in per_shock)
     text = (folder / "contact_laws.md").read_text(encoding="utf-8")
     assert "**Answer (measured):**" in text and "contact_laws.png" in text
 

@@ -8,9 +8,9 @@ Every number comes from engine runs (J = 19, β = 1/4, centred load, Taylor star
 - energy (one run per law over ``t_end``, plus the paper's law with Rayleigh damping, whose
   ledger has a damping term): E(t) and the ledger /energy/work, /energy/dissipated (the stops),
   /energy/damped, and the run's ``energy_residual``, ``max_violation`` and ``impacts``;
-- chatter: ``impacts``, the engine's count of entries into contact (contact phases, every
-  step), and — when the run carries the engine's shock log (``result.impacts``) — its shocks
-  and contact phases per shock (1 + mean ``rebounds``);
+- chatter: the engine's count of entries into contact (``contact_phases``, every step), and
+  from its shock log (``result.impacts``: contact phases closer than ``rest_time`` merged) the
+  shocks and the contact phases per shock (1 + mean ``rebounds``);
 - convergence: the tip on a common record grid against a reference at ``dt_ref`` of the same
   law, largest error over [0, 0.2] s and over [0.08, 0.125] s, with observed orders
   (:func:`common.observed_orders`) and the order over a span of Δt (``span``, SPEC §10's
@@ -37,7 +37,7 @@ from ..scene import Scene
 from .cli import StudyCommand
 from .common import Table, observed_orders, out_dir, progress, run_tip, tip_error
 
-__all__ = ["LAWS", "Plan", "PLANS", "chatter", "energy_table", "energy_sentence", "convergence_table", "headline",
+__all__ = ["LAWS", "Plan", "PLANS", "chatter", "shock_log", "inconsistent", "energy_table", "energy_sentence", "convergence_table", "headline",
            "study", "main", "register"]
 
 #: The contact laws compared: label and the scene keys that make it.
@@ -81,15 +81,36 @@ def base_scene() -> Scene:
     return Scene(beta=0.25, elements=19)
 
 
-def chatter(result: Result) -> tuple[int, float, float]:
-    """(contact phases, shocks, contact phases per shock): the engine's ``impacts`` count, and the
-    engine's shock log when the run carries one (NaN otherwise)."""
-    phases = int(result.attrs["impacts"])
+def shock_log(result: Result) -> tuple[int, float]:
+    """(shocks, contact phases per shock = 1 + mean rebounds) of the engine's shock log; (0, NaN)
+    without one."""
     rebounds = result.impacts.get("rebounds") if result.impacts else None
-    if rebounds is None:
+    if rebounds is None or np.asarray(rebounds).size == 0:
+        return 0, math.nan
+    return int(np.asarray(rebounds).size), 1.0 + float(np.mean(rebounds))
+
+
+def chatter(result: Result) -> tuple[int, float, float]:
+    """(contact phases, shocks, contact phases per shock): the engine's ``contact_phases`` (its
+    ``impacts`` in runs written before the shock log), and its shock log — NaN without one, or
+    when the log holds more shocks than there were contact phases (a shock is one contact phase
+    or more: such a log counted something else, see :func:`inconsistent`)."""
+    phases = int(result.attrs.get("contact_phases", result.attrs["impacts"]))
+    shocks, per_shock = shock_log(result)
+    if not shocks or shocks > phases:
         return phases, math.nan, math.nan
-    shocks = int(np.asarray(rebounds).size)
-    return phases, float(shocks), (1.0 + float(np.mean(rebounds))) if shocks else math.nan
+    return phases, float(shocks), per_shock
+
+
+def inconsistent(result: Result) -> Optional[str]:
+    """Why the run's shock log is not used (more shocks than contact phases), or None."""
+    phases = int(result.attrs.get("contact_phases", result.attrs["impacts"]))
+    shocks, _ = shock_log(result)
+    if shocks <= phases:
+        return None
+    reaction = np.abs(result.reaction[result.reaction != 0])
+    smallest = f"; its smallest nonzero recorded reaction is {float(reaction.min()):.2g} N" if reaction.size else ""
+    return f"the shock log holds {shocks} shocks for {phases} contact phases{smallest}"
 
 
 def energy_runs(base: Scene, plan: Plan, quiet: bool = False) -> dict[str, Result]:
@@ -112,9 +133,14 @@ def energy_table(runs: dict[str, Result], plan: Plan) -> Table:
                   ["law", "Δt (s)", "T (s)", "E(T) (J)", "mean E (J)", "support work (J)", "stops (J)",
                    "damping (J)", "energy residual (J)", "max violation (m)", "contact phases", "shocks",
                    "phases per shock", "CPU (s)"], rows)
+    unused = [f"{label}: {why}" for label, r in runs.items() if (why := inconsistent(r)) is not None]
     table.note = ("E − E(0) = work − stops − damping; energy residual: the engine's round-off of that balance. "
-                  "Contact phases: the engine's `impacts` (entries into contact, every step); shocks and phases "
-                  "per shock: the engine's shock log (– when the run has none).")
+                  "Contact phases: the engine's `contact_phases` (entries into contact, every step); shocks and "
+                  "phases per shock (1 + mean rebounds): the engine's shock log (contact phases closer than "
+                  "its rest_time are one shock; – when the run has none).")
+    if unused:
+        table.note += (" Shock log not used (a shock is one contact phase or more) for " + "; ".join(unused) +
+                       " — it counts steps whose reaction is round-off as contact.")
     return table
 
 
@@ -224,8 +250,12 @@ def energy_sentence(energy: Table) -> str:
     parts = []
     for r in energy.rows:
         work, stops, damped = (float(r[col[k]]) for k in ("support work (J)", "stops (J)", "damping (J)"))  # type: ignore
+        shocks, per_shock = float(r[col["shocks"]]), float(r[col["phases per shock"]])  # type: ignore[arg-type]
+        phases = f"{r[col['contact phases']]} contact phases"
+        if math.isfinite(per_shock):
+            phases += f" in {shocks:.0f} shocks ({per_shock:.3g} per shock)"
         part = (f"{r[0]}: stops {stops:.3g} J of the support's {work:.3g} J ({100 * stops / work:.2g} %), "
-                f"{r[col['contact phases']]} contact phases, violation {float(r[col['max violation (m)']]):.2g} m")  # type: ignore
+                f"{phases}, violation {float(r[col['max violation (m)']]):.2g} m")  # type: ignore
         if damped:
             part += f", damping {damped:.3g} J"
         parts.append(part)

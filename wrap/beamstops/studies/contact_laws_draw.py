@@ -59,7 +59,7 @@ def draw(runs: dict[str, Result], convergence: Table, plan: "Plan", path: Path) 
             ax[4 + k].loglog(dt, err, "o-", color=c, markersize=3, label=label)
     ax[2].set_title("largest violation of the stops (0 drawn at 1e-16)")
     ax[2].set_ylabel("max violation (m)")
-    ax[3].set_title(f"chatter: contact phases for t ≤ {t_end:g} s (engine's impacts)")
+    ax[3].set_title(f"chatter: contact phases for t ≤ {t_end:g} s (engine's contact_phases)")
     ax[3].set_ylabel("contact phases")
     for k, (start, end) in enumerate(WINDOWS):
         a = ax[4 + k]
