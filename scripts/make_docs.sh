@@ -5,6 +5,7 @@
 #   docs/bench.md      scripts/bench.py             speed tables
 #   docs/convergence/  scripts/convergence.py       convergence tables (markdown, CSV)
 #   docs/work_precision/, docs/stability_map/, docs/compliance/, docs/contact_laws/   the studies
+#   docs/work_precision_statistics/  the same two studies with --qoi: statistics under impacts
 #   docs/bifurcation/  scripts/bifurcation.py       bifurcation diagram (sweep), and its periods table
 #   docs/bifurcation_damped/  the same for the damped beam (input/sweeps/bifurcation_damped.toml)
 #   docs/stops/        input/tube_supports.nml, scripts/bench_stops.py   stops along the span
@@ -14,6 +15,9 @@ export PATH="$PWD/.venv/bin:$PATH" MPLBACKEND=Agg
 python scripts/paper_figures.py --out docs/paper
 python scripts/convergence.py -o docs/convergence --quiet
 python scripts/study_workprecision.py -o docs/work_precision --quiet
+QOIS="stop_power impulse_rate shock_rate contact_fraction tip_rms"
+python scripts/study_workprecision.py --qoi $QOIS -o docs/work_precision_statistics --quiet
+python scripts/convergence.py --qoi $QOIS -o docs/work_precision_statistics --quiet
 python scripts/study_stability.py -o docs/stability_map --quiet
 python scripts/study_compliance.py -o docs/compliance --quiet
 python scripts/study_contact_laws.py -o docs/contact_laws --quiet

@@ -14,8 +14,12 @@ module beamstops
    use beamstops_recorder_hdf5, only: hdf5_recorder
    use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed
    use beamstops_run, only: prepare_run, simulate
+   use beamstops_lockstep, only: check_lockstep, prepare_lockstep, simulate_lockstep
    use beamstops_version, only: version
    use beamstops_three_level, only: run_three_level
+   use beamstops_reduced, only: reduced_model_type, prepare_reduced, build_reduced, validate_reduced, &
+      & check_stability_reduced, stop_unknowns
+   use beamstops_reduced_scheme, only: simulate_reduced
    implicit none
    private
    public :: wp, ik, error_type, fatal_error
@@ -28,4 +32,7 @@ module beamstops
    public :: run_summary, status_complete, status_diverged, status_failed
    public :: prepare_run, simulate, record_count, snapshot_count, output_bytes, version
    public :: run_three_level
+   public :: check_lockstep, prepare_lockstep, simulate_lockstep
+   public :: reduced_model_type, prepare_reduced, build_reduced, validate_reduced, check_stability_reduced
+   public :: stop_unknowns, simulate_reduced
 end module beamstops

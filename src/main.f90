@@ -340,11 +340,15 @@ contains
          call stop_on(error, exit_output)
       end if
       recorder%show_progress = c_isatty(2_c_int) == 1
-      if (.not. resume) call start_state(scene, model, state, recorder, error)
+      if (scene%modes > 0) then
+         call simulate(scene, model, recorder, summary, error)
+      else if (.not. resume) then
+         call start_state(scene, model, state, recorder, error)
+      end if
       if (allocated(error)) then
          summary%status = status_failed
          summary%message = error%message
-      else
+      else if (scene%modes == 0) then
          call continue_run(scene, model, state, recorder, summary, write_error, checkpoint)
       end if
       call recorder%finish(summary, finish_error)

@@ -5,7 +5,8 @@
 !> from (seed, member), and keep only their statistics. After a few impacts the members
 !> decorrelate and are independent samples of the same statistics: across them each quantity
 !> has mean +- t_{0.975, K-1} s / sqrt(K) (beamstops_observe_statistics' ensemble_table),
-!> beside the batch-means intervals of each run. The members run one after the other.
+!> beside the batch-means intervals of each run. The members run in lockstep (beamstops_lockstep)
+!> when they can share the loop, one after the other otherwise.
 module beamstops_ensemble
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type
@@ -16,6 +17,7 @@ module beamstops_ensemble
    use beamstops_scheme, only: run_scheme
    use beamstops_recorder, only: recorder_type, n_columns
    use beamstops_summary, only: run_summary, status_complete
+   use beamstops_lockstep, only: check_lockstep, simulate_lockstep
    use beamstops_observe_statistics, only: statistics_table, ensemble_table
    implicit none
    private
@@ -44,9 +46,14 @@ contains
       type(statistics_table), allocatable :: tables(:)
       type(model_type) :: member_model
       type(scene_type) :: member_scene
+      type(scene_type), allocatable :: scenes(:)
       type(state_type) :: state
       type(no_records) :: recorder
+      type(no_records), allocatable :: recorders(:)
       type(run_summary) :: member
+      type(run_summary), allocatable :: members(:)
+      type(error_type), allocatable :: refusal
+      real(wp), allocatable :: u0(:, :)
       integer :: k
       allocate (tables(scene%members))
       tables(1) = summary%statistics
@@ -55,17 +62,35 @@ contains
       member_scene%snapshot_every = 0
       member_scene%record_every = huge(1)
       summary%ensemble_members = 1
-      do k = 2, scene%members
-         member_model = model
-         member_model%u0 = model%u0 + perturbation_of(scene%perturbation, scene%seed, k, size(model%u0))
-         call start_state(member_scene, member_model, state, recorder, error)
+      ! Members 2..K in lockstep (beamstops_lockstep, each bit for bit its run alone) when they
+      ! can share the loop; one after the other otherwise.
+      allocate (scenes(scene%members - 1), source=member_scene)
+      call check_lockstep(scenes, model, refusal)
+      if (.not. allocated(refusal)) then
+         allocate (u0(size(model%u0), scene%members - 1), recorders(scene%members - 1), members(scene%members - 1))
+         do k = 2, scene%members
+            u0(:, k - 1) = model%u0 + perturbation_of(scene%perturbation, scene%seed, k, size(model%u0))
+         end do
+         call simulate_lockstep(scenes, model, recorders, members, error, initial_displacement=u0)
          if (allocated(error)) return
-         member = run_summary()
-         call run_scheme(member_scene, member_model, state, recorder, member)
-         if (member%status /= status_complete) cycle
-         summary%ensemble_members = summary%ensemble_members + 1
-         tables(summary%ensemble_members) = member%statistics
-      end do
+         do k = 1, size(members)
+            if (members(k)%status /= status_complete) cycle
+            summary%ensemble_members = summary%ensemble_members + 1
+            tables(summary%ensemble_members) = members(k)%statistics
+         end do
+      else
+         do k = 2, scene%members
+            member_model = model
+            member_model%u0 = model%u0 + perturbation_of(scene%perturbation, scene%seed, k, size(model%u0))
+            call start_state(member_scene, member_model, state, recorder, error)
+            if (allocated(error)) return
+            member = run_summary()
+            call run_scheme(member_scene, member_model, state, recorder, member)
+            if (member%status /= status_complete) cycle
+            summary%ensemble_members = summary%ensemble_members + 1
+            tables(summary%ensemble_members) = member%statistics
+         end do
+      end if
       call ensemble_table(tables(:summary%ensemble_members), summary%ensemble, error)
    end subroutine run_members
 

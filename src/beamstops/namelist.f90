@@ -12,6 +12,7 @@ module beamstops_namelist
    use beamstops_strings, only: fmt_real, itoa, lower, squeeze
    use beamstops_physics_checks, only: validate_physics
    use beamstops_observe_statistics, only: validate_statistics, validate_ensemble
+   use beamstops_reduced, only: validate_reduced, stop_unknowns
    implicit none
    private
    public :: read_scene, scene_from_text, read_text_file, default_output, group_names, group_keys
@@ -23,7 +24,7 @@ module beamstops_namelist
    character(len=*), parameter :: group_keys(9) = [character(len=140) :: &
       & 'length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness', &
       & 'amplitude, omega', 'lower, upper, nodes, x, law, stiffness, stiffness_per_mass, restitution, mass', &
-      & 'mass_coefficient, stiffness_coefficient, ratio, modes', 'elements', &
+      & 'mass_coefficient, stiffness_coefficient, ratio, modes', 'elements, modes', &
       & 'dt, t_end, beta, load_rule, start, allow_unstable', 'file, record_every, snapshot_every, checkpoint_every, max_output_gb', &
       & 'enabled, transient, batches, bins, rest_time, histogram_lower, histogram_upper', 'members, perturbation, seed']
    real(wp), parameter :: unset = -huge(1.0_wp)
@@ -121,7 +122,7 @@ contains
       real(wp) :: transient, rest_time, histogram_lower, histogram_upper, perturbation
       integer :: batches, bins, members, seed
       ! &mesh
-      integer :: elements
+      integer :: elements, mesh_modes
       ! &time
       real(wp) :: dt, t_end, beta
       character(len=64) :: load_rule, start
@@ -137,7 +138,6 @@ contains
       namelist /damping/ mass_coefficient, stiffness_coefficient, ratio, modes
       namelist /statistics/ enabled, transient, batches, bins, rest_time, histogram_lower, histogram_upper
       namelist /ensemble/ members, perturbation, seed
-      namelist /mesh/ elements
       namelist /time/ dt, t_end, beta, load_rule, start, allow_unstable
       namelist /output/ file, record_every, snapshot_every, checkpoint_every, max_output_gb
       character(len=text_len) :: groups_text(size(group_names))
@@ -160,7 +160,7 @@ contains
       enabled = scene%statistics; transient = scene%transient; batches = scene%batches; bins = scene%bins
       rest_time = scene%rest_time; histogram_lower = unset; histogram_upper = unset
       members = scene%members; perturbation = scene%perturbation; seed = scene%seed
-      elements = scene%elements
+      elements = scene%elements; mesh_modes = scene%modes
       dt = scene%dt; t_end = scene%t_end; beta = scene%beta; load_rule = 'centered'; start = 'taylor'
       allow_unstable = .false.
       file = no_file; record_every = scene%record_every; snapshot_every = scene%snapshot_every
@@ -205,6 +205,7 @@ contains
          end if
       end if
       scene%elements = elements
+      scene%modes = mesh_modes
       scene%dt = dt
       scene%t_end = t_end
       scene%beta = beta
@@ -259,6 +260,16 @@ contains
       if (allocated(error)) return
       call validate_ensemble(scene%members, source, error)
       if (allocated(error)) return
+      call validate_reduced(scene, 2*scene%elements, stop_unknowns(scene), source, error)
+      if (allocated(error)) return
+      if (scene%modes > 0 .and. (scene%damping_mass /= 0 .or. scene%damping_stiffness /= 0 .or. &
+         & scene%damping_by_ratio .or. scene%restitution /= 0 .or. scene%redistributed_mass .or. &
+         & scene%members > 1)) then
+         call fatal_error(error, source//': &mesh modes = '//itoa(scene%modes)//' with damping, restitution, '// &
+            & "mass = 'redistributed' or an ensemble is not supported; allowed: modes = 0 (the full model) "// &
+            & 'for those')
+         return
+      end if
       if (.not. (ieee_is_finite(scene%perturbation) .and. scene%perturbation >= 0 .and. &
          & scene%perturbation <= 1.0e-3_wp*min(-scene%lower, scene%upper))) then
          call fatal_error(error, source//': &ensemble perturbation = '//fmt_real(scene%perturbation)// &
@@ -331,7 +342,7 @@ contains
          case (2); read (text, nml=support, iostat=stat, iomsg=msg)
          case (3); read (text, nml=stops, iostat=stat, iomsg=msg)
          case (4); read (text, nml=damping, iostat=stat, iomsg=msg)
-         case (5); read (text, nml=mesh, iostat=stat, iomsg=msg)
+         case (5); call read_mesh(text, elements, mesh_modes, stat, msg)
          case (6); read (text, nml=time, iostat=stat, iomsg=msg)
          case (7); read (text, nml=output, iostat=stat, iomsg=msg)
          case (8); read (text, nml=statistics, iostat=stat, iomsg=msg)
@@ -381,6 +392,16 @@ contains
       key = lower(body(start:start - 2 + verify(body(start:)//'=', &
          & 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_')))
    end function key_at
+
+   !> &mesh: elements and modes (a scope of its own: &damping has a key `modes` too).
+   subroutine read_mesh(text, elements, modes, stat, msg)
+      character(len=*), intent(in) :: text
+      integer, intent(inout) :: elements, modes
+      integer, intent(out) :: stat
+      character(len=*), intent(inout) :: msg
+      namelist /mesh/ elements, modes
+      read (text, nml=mesh, iostat=stat, iomsg=msg)
+   end subroutine read_mesh
 
    !> The groups as `&beam, &support, ...`.
    function all_groups() result(text)

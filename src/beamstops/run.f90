@@ -14,6 +14,8 @@ module beamstops_run
    use beamstops_checkpoint, only: write_checkpoint
    use beamstops_summary, only: run_summary, status_running, status_failed, status_complete
    use beamstops_ensemble, only: run_members
+   use beamstops_reduced, only: reduced_model_type, build_reduced, check_stability_reduced
+   use beamstops_reduced_scheme, only: simulate_reduced
    implicit none
    private
    public :: prepare_run, simulate, continue_run
@@ -32,10 +34,12 @@ contains
       type(error_type), allocatable, intent(out) :: error
       call build_model(scene, model, error)
       if (allocated(error)) return
-      call check_stability(scene, model, source, error)
+      ! A reduced model (modes > 0) has its own spectrum: simulate checks it.
+      if (scene%modes == 0) call check_stability(scene, model, source, error)
    end subroutine prepare_run
 
-   !> Run a prepared scene from t = 0 to t_end, feeding `recorder` (no checkpoints). A recorder
+   !> Run a prepared scene from t = 0 to t_end, feeding `recorder` (no checkpoints); a scene with
+   !> &mesh modes > 0 runs its reduced (Craig-Bampton) model. A recorder
    !> that cannot write ends the run with status 'failed' and its message in the summary.
    subroutine simulate(scene, model, recorder, summary, error)
       !> Validated scene.
@@ -50,6 +54,15 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(state_type) :: state
       type(error_type), allocatable :: write_error
+      type(reduced_model_type) :: reduced
+      if (scene%modes > 0) then
+         call build_reduced(scene, model, reduced, error)
+         if (allocated(error)) return
+         call check_stability_reduced(scene, reduced, 'scene', error)
+         if (allocated(error)) return
+         call simulate_reduced(scene, reduced, recorder, summary, error)
+         return
+      end if
       call start_state(scene, model, state, recorder, error)
       if (allocated(error)) return
       call continue_run(scene, model, state, recorder, summary, write_error)

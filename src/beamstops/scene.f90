@@ -108,6 +108,10 @@ module beamstops_scene
       real(wp) :: perturbation = 0
       integer :: seed = 1
       ! ---- end of issue 13 ----
+      ! ---- reduced (modal) models (SPEC 11, issue 14; beamstops_reduced) ----
+      !> &mesh: fixed-interface modes r of a reduced (Craig-Bampton) model; 0: the full model.
+      integer :: modes = 0
+      ! ---- end reduced ----
    end type scene_type
 
 contains
@@ -265,6 +269,7 @@ contains
       call list%add_real('ensemble', 'perturbation', scene%perturbation)
       call list%add_int('ensemble', 'seed', int(scene%seed, ik))
       call list%add_int('mesh', 'elements', int(scene%elements, ik))
+      call list%add_int('mesh', 'modes', int(scene%modes, ik))
       call list%add_real('time', 'dt', scene%dt)
       call list%add_real('time', 't_end', scene%t_end)
       call list%add_real('time', 'beta', scene%beta)

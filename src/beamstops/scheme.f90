@@ -194,7 +194,7 @@ contains
             call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
          end if
          if (state%observer%active) call state%observer%tip(real(step + 1, wp)*model%dt, state%u(tip), &
-            & state%reaction, state%dissipated)
+            & merge(state%reaction, 0.0_wp, state%in_contact), state%dissipated)
          if (model%damped) call damping_loss(model, state)
          if (step == next_record) u_old_su = dot_product(state%u, state%su) - dot_product(state%d, state%su)
          call band_matvec(model%stiffness, state%u, state%su)
@@ -257,7 +257,7 @@ contains
          call back_substitution(model%solver, state%rhs)
          call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
          if (state%observer%active) call state%observer%tip(real(step + 1, wp)*model%dt, state%u(tip), &
-            & state%reaction, state%dissipated)
+            & merge(state%reaction, 0.0_wp, state%in_contact), state%dissipated)
          if (step == next_record) then
             next_record = next_record + scene%record_every
             call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_prev, row)
@@ -324,7 +324,7 @@ contains
             call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
          end if
          if (state%observer%active) call state%observer%tip(real(step + 1, wp)*model%dt, state%u(tip), &
-            & state%reaction, state%dissipated)
+            & merge(state%reaction, 0.0_wp, state%in_contact), state%dissipated)
          if (model%damped) call damping_loss(model, state)
          if (step == next_record) then
             next_record = next_record + scene%record_every
@@ -449,9 +449,10 @@ contains
          else
             state%stop_reaction = state%span%lambda/model%dt2
          end if
+         ! (with massless stops a free stop's row residual is not a contact: only the active ones count)
          if (state%observer%active) call state%observer%span(real(step + 1, wp)*model%dt, &
-            & state%u(model%stops%unknown) + model%stops%lift*phi_next, state%stop_reaction, state%u(tip), &
-            & state%dissipated)
+            & state%u(model%stops%unknown) + model%stops%lift*phi_next, &
+            & merge(state%stop_reaction, 0.0_wp, state%span%lambda /= 0), state%u(tip), state%dissipated)
          if (step == next_snapshot) then
             next_snapshot = next_snapshot + scene%snapshot_every
             call take_snapshot(scene, model, state, step, recorder)

@@ -24,6 +24,8 @@ program tester
    use test_restitution, only: collect_restitution
    use test_redistribution, only: collect_redistribution
    use test_physics_checks, only: collect_physics_checks
+   use test_lockstep, only: collect_lockstep
+   use test_reduced, only: collect_reduced
    implicit none
 
    abstract interface
@@ -65,7 +67,9 @@ program tester
       & new_testsuite('damping', collect_damping), &
       & new_testsuite('restitution', collect_restitution), &
       & new_testsuite('redistribution', collect_redistribution), &
-      & new_testsuite('physics_checks', collect_physics_checks) &
+      & new_testsuite('physics_checks', collect_physics_checks), &
+      & new_testsuite('reduced', collect_reduced), &
+      & new_testsuite('lockstep', collect_lockstep) &
       & ]
 
    if (command_argument_count() < 1) call usage()

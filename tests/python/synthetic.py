@@ -75,16 +75,20 @@ def statistics(stops: int = 1, bins: int = 20, lower: float = -0.1, upper: float
 def write(path: Path, impacts_rows: dict[str, np.ndarray] | None = None,
           statistics_tables: dict[str, np.ndarray] | None = None, statistics_attrs: dict[str, Any] | None = None
           ) -> Path:
-    """Add /impacts and /statistics groups to an HDF5 file (created when missing) in the engine's layout."""
+    """Add (or replace) /impacts and /statistics groups of an HDF5 file (created when missing) in the engine's layout."""
     with h5py.File(path, "a") as f:
         if "status" not in f.attrs:
             f.attrs["status"] = "complete"
         if impacts_rows is not None:
+            if "impacts" in f:  # the engine's own log, replaced by the synthetic one
+                del f["impacts"]
             group = f.create_group("impacts")
             for name, column in impacts_rows.items():
                 dataset = group.create_dataset(name, data=np.asarray(column, dtype=np.float64))
                 dataset.attrs["units"] = IMPACT_UNITS.get(name, "1")
         if statistics_tables is not None:
+            if "statistics" in f:
+                del f["statistics"]
             group = f.create_group("statistics")
             for key, value in (statistics_attrs or {"transient": 0.0, "batches": 8, "bins": 20,
                                                     "rest_time": 1e-3}).items():

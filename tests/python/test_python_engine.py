@@ -152,7 +152,12 @@ def test_load_refuses_an_incomplete_file_unless_asked(program: str, tmp_path: Pa
     loaded = beamstops.load(tmp_path / "bad.h5", allow_incomplete=True)
     ran = beamstops.run(scene, allow_incomplete=True)
     assert loaded.status == ran.status == "diverged"
-    assert all(same_bits(getattr(loaded, a), getattr(ran, a)) for a in ARRAYS)
+    # the same bits while the solution is finite; once it has blown up to NaN, the projection of a
+    # NaN (min/max with NaN) is whatever the two builds' instructions make of it
+    finite = np.isfinite(loaded.energy) & np.isfinite(ran.energy)
+    assert finite.sum() > 2 and not finite.all()
+    for a in ("t", "tip_u", "tip_v", "reaction", "energy", "work", "dissipated"):
+        assert same_bits(getattr(loaded, a)[finite], getattr(ran, a)[finite]), a
     with pytest.raises(FileNotFoundError):
         beamstops.load(tmp_path / "nowhere.h5")
     (tmp_path / "text.h5").write_text("not HDF5")

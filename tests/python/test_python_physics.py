@@ -18,7 +18,7 @@ SHORT = Scene(t_end=0.3, dt=1e-5, beta=0.25)
 
 def test_keys_read_back_exactly_and_reach_the_output() -> None:
     scene = SHORT.replace(ratio=0.02, restitution=0.5)
-    assert scene.ratio == (0.02, 0.02) and scene.modes == (1, 2) and scene.restitution == 0.5
+    assert scene.ratio == (0.02, 0.02) and scene.damping_modes == (1, 2) and scene.restitution == 0.5
     assert Scene.from_text(scene.to_text()) == scene
     assert "&damping\n  ratio = 0.02, 0.02\n  modes = 1, 2\n/" in scene.to_text()
     coefficients = SHORT.replace(mass_coefficient=0.5, stiffness_coefficient=1e-5)
@@ -29,7 +29,7 @@ def test_keys_read_back_exactly_and_reach_the_output() -> None:
 
 def test_ratio_form_gives_the_requested_damping_at_both_modes() -> None:
     # zeta(omega) = a/(2 omega) + b omega/2 with the engine's a and b, at the FE frequencies of modes 1 and 3
-    result = beamstops.run(SHORT.replace(law="none", ratio=(0.01, 0.03), modes=(1, 3), t_end=0.01))
+    result = beamstops.run(SHORT.replace(law="none", ratio=(0.01, 0.03), damping_modes=(1, 3), t_end=0.01))
     a, b = result.attrs["damping_a"], result.attrs["damping_b"]
     omegas = [26.2458, 460.5477]  # SPEC §3, the cantilever's (J = 19 agrees to 2e-5)
     zetas = [a / (2 * w) + b * w / 2 for w in omegas]

@@ -246,7 +246,7 @@ def test_kinds_without_snapshots_say_how_to_get_them(kind: str, tmp_path: Path) 
 
 def test_other_missing_data_messages(result: beamstops.Result, tmp_path: Path) -> None:
     with pytest.raises(ValueError, match=r"^no shock log: the run has no /impacts"):
-        plots.figure(result, "impacts")
+        plots.figure(beamstops.run(Scene(t_end=0.3, enabled=False)), "impacts")
     path = synthetic.write(tmp_path / "quiet.h5", synthetic.impacts(0))
     with pytest.raises(ValueError, match=r"^no shocks: the shock log /impacts is empty"):
         plots.figure(beamstops.load(path), "impacts")
@@ -281,7 +281,8 @@ def test_all_draws_what_the_run_has(result: beamstops.Result, logged_result: bea
     for expected in ("tip displacement PDF (engine", "tip displacement u(L, t)", "contact reaction at the tip",
                      "Poincaré section", "impulse: 60 shocks", "impact velocity: 60 shocks"):
         assert any(t.startswith(expected) for t in titles), (expected, titles)
-    assert not any(t.startswith("impulse") for t in (ax.get_title() for ax in plots.figure(result, "all").axes))
+    unlogged = beamstops.run(Scene(t_end=1.3, enabled=False))
+    assert not any(t.startswith("impulse") for t in (ax.get_title() for ax in plots.figure(unlogged, "all").axes))
     info = "\n".join(t.get_text() for ax in plots.figure(logged_result, "all").axes for t in ax.texts)
     assert "shocks logged: 60" in info and "power to the stops: 0.560 ± 0.031 W" in info
     with pytest.raises(ValueError, match="unknown plot kind"):
@@ -323,7 +324,10 @@ def test_command_line_animation(output: Path, tmp_path: Path) -> None:
         assert image.n_frames == 7
 
 
-def test_command_line_missing_data_is_one_line(output: Path, tmp_path: Path) -> None:
+def test_command_line_missing_data_is_one_line(program: str, tmp_path: Path) -> None:
+    Scene(t_end=0.3, enabled=False, file="bare.h5").to_namelist(tmp_path / "bare.nml")
+    subprocess.run([program, "run", "bare.nml"], cwd=tmp_path, check=True, capture_output=True, timeout=120)
+    output = tmp_path / "bare.h5"
     done = subprocess.run([sys.executable, "-m", "beamstops", "plot", str(output), "--kind", "impacts",
                            "-o", str(tmp_path / "x.png")], capture_output=True, text=True, timeout=120, env=headless())
     assert done.returncode == 1

@@ -48,7 +48,11 @@ def _engine_keys() -> dict[str, tuple[str, ...]]:
 
 #: Namelist groups and the keys each accepts (fields and routes), as the engine's reader lists them.
 GROUPS: dict[str, tuple[str, ...]] = _engine_keys()
-_GROUP_OF = {key: group for group, keys in GROUPS.items() for key in keys}
+#: Fields whose name is not their key: &damping modes (&mesh has its own `modes`).
+_KEY_OF: dict[str, tuple[str, str]] = {"damping_modes": ("damping", "modes")}
+_FIELD_OF = {group_key: field for field, group_key in _KEY_OF.items()}
+_GROUP_OF = {key: group for group, keys in GROUPS.items() for key in keys if (group, key) not in _FIELD_OF}
+_GROUP_OF.update({field: group for field, (group, _) in _KEY_OF.items()})
 #: Routes to fields, and the fields each one gives (a route in :meth:`Scene.replace` replaces them).
 ROUTES: dict[str, tuple[str, ...]] = {
     "youngs_modulus": ("k2", "mass_per_length"), "density": ("k2", "mass_per_length"),
@@ -96,12 +100,14 @@ class Scene:
     stiffness_coefficient: float = 0.0
     """Rayleigh damping: b (s)."""
     ratio: tuple[float, ...] = ()
-    """Damping ratios ζ at the two ``modes`` (one value: both); () for the coefficients' form."""
-    modes: tuple[int, ...] = (1, 2)
-    """The two cantilever modes (1-based) of the ratio form."""
+    """Damping ratios ζ at the two ``damping_modes`` (one value: both); () for the coefficients' form."""
+    damping_modes: tuple[int, ...] = (1, 2)
+    """&damping modes: the two cantilever modes (1-based) of the ratio form."""
     # &mesh
     elements: int = 19
     """Number of elements J."""
+    modes: int = 0
+    """Fixed-interface modes r of a reduced (Craig–Bampton) model; 0: the full finite-element model."""
     # &time
     dt: float = 5e-5
     """Time step (s)."""
@@ -209,7 +215,7 @@ class Scene:
         """The scene as namelist groups of values (what :meth:`to_namelist` writes)."""
         out: dict[str, dict[str, Any]] = {group: {} for group in GROUPS}
         for group, key, _ in _items(self.to_text()):
-            out[group][key] = getattr(self, key)
+            out[group][key] = getattr(self, _FIELD_OF.get((group, key), key))
         return out
 
     def to_namelist(self, path: PathLike) -> None:
@@ -268,7 +274,8 @@ def _namelist(values: Mapping[str, Any]) -> str:
             continue
         if key in defaults and type(value) is type(defaults[key]) and value == defaults[key]:
             continue
-        groups.setdefault(_GROUP_OF[key], []).append(f"  {key} = {namelist_value(value, key)}")
+        name = _KEY_OF[key][1] if key in _KEY_OF else key
+        groups.setdefault(_GROUP_OF[key], []).append(f"  {name} = {namelist_value(value, key)}")
     return "".join(f"&{group}\n" + "\n".join(lines) + "\n/\n" for group, lines in groups.items()) or "&time /\n"
 
 
@@ -309,8 +316,8 @@ def parse_value(text: str) -> Any:
 
 def _fields_of(text: str) -> dict[str, Any]:
     """Field values of canonical text; with stops along the span lower and upper are tuples."""
-    values = {key: parse_value(value) for _, key, value in _items(text)}
-    for key in ("ratio", "modes"):
+    values = {_FIELD_OF.get((group, key), key): parse_value(value) for group, key, value in _items(text)}
+    for key in ("ratio", "damping_modes"):
         if key in values and not isinstance(values[key], tuple):
             values[key] = (values[key],)
     if "nodes" in values:

@@ -10,7 +10,10 @@ Errors (all from engine runs, compared here):
   the coarse field is written exactly on the reference mesh (:func:`common.prolong`).
 
 ``python -m beamstops converge`` and ``scripts/convergence.py`` write the tables
-(markdown and CSV) of :func:`study` into out/convergence.
+(markdown and CSV) of :func:`study` into out/convergence. With ``--qoi NAME ...`` they run the
+convergence of statistics after a transient instead (:mod:`beamstops.studies.qoi_convergence`:
+value ± 95 % half-width against Δt and J with a fine reference's interval); ``--qoi tip`` (the
+default) keeps these pointwise tables.
 """
 
 from __future__ import annotations
@@ -218,16 +221,32 @@ def study(folder: Optional[Path] = None, *, quick: bool = False, three_level: bo
 
 
 def _options(parser: argparse.ArgumentParser) -> None:
+    from .workprecision import qoi_options
+
     parser.add_argument("--no-three-level", action="store_true",
                         help="skip the three-level form in the round-off comparison")
+    qoi_options(parser)
 
 
 def _run(folder: Path, args: argparse.Namespace) -> Path:
-    study(folder, quick=args.quick, three_level=not args.no_three_level, quiet=args.quiet)
-    return folder / "convergence.md"
+    from . import qoi_convergence
+    from .qoi import HalfWidth
+    from .workprecision import split_qois
+
+    pointwise, statistical = split_qois(args.qoi)
+    printed = folder / "convergence.md"
+    if statistical:
+        qoi_convergence.study(folder, qois=statistical, quick=args.quick, half_width=HalfWidth.parse(args.half_width),
+                              transient=args.transient, window=args.stat_window, reference_window=args.reference_window,
+                              members=args.members, quiet=args.quiet)
+        printed = folder / "qoi_convergence.md"
+    if pointwise:
+        study(folder, quick=args.quick, three_level=not args.no_three_level, quiet=args.quiet)
+        printed = folder / "convergence.md"
+    return printed
 
 
-#: ``converge [-o DIR] [--quick] [--no-three-level]``; ``main`` is scripts/convergence.py.
+#: ``converge [-o DIR] [--quick] [--no-three-level] [--qoi NAME ...] [--half-width H]``; ``main`` is scripts/convergence.py.
 COMMAND = StudyCommand("convergence", _options, _run, name="converge",
                        help="convergence tables in Δt and h (markdown and CSV)",
                        description="Convergence tables in Δt and h against finer reference runs.",

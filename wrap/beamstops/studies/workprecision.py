@@ -8,6 +8,12 @@ against one fine reference run of the Signorini scheme (β = 1/2, centred) over 
 the first contact period (w = 0.2 s, where the paper sees runs agree by eye); the cost
 is the engine's ``cpu_seconds`` (the time loop's CPU time). Read the chart horizontally:
 at a given error, the leftmost curve is the fastest method.
+
+With ``--qoi NAME ...`` (statistics of the engine: stop_power, impulse_rate, shock_rate,
+contact_fraction, tip_rms, ...) the chart is the statistical one of
+:mod:`beamstops.studies.qoi_workprecision` (CPU against the 95 % half-width after a transient, one
+curve per contact law, the cost to reach ``--half-width``); ``--qoi tip`` (the default) is the
+pointwise study above, and both can be asked for at once.
 """
 
 from __future__ import annotations
@@ -24,7 +30,7 @@ from ..scene import Scene
 from .cli import StudyCommand
 from .common import Table, out_dir, progress, run_tip, tip_error
 
-__all__ = ["Method", "methods", "study", "draw", "main", "register"]
+__all__ = ["Method", "methods", "study", "draw", "qoi_options", "split_qois", "main", "register"]
 
 
 @dataclass(frozen=True)
@@ -111,18 +117,75 @@ def draw(table: Table, path: Path, windows: Sequence[float]) -> Path:
     return path
 
 
+def qoi_options(parser: argparse.ArgumentParser) -> None:
+    """``--qoi`` and the statistical runs' options (shared with ``converge``)."""
+    from .qoi import POINTWISE, QOIS, HalfWidth, statistic_name
+
+    def name(text: str) -> str:
+        if text != POINTWISE:
+            try:
+                statistic_name(text)
+            except ValueError as exc:
+                raise argparse.ArgumentTypeError(str(exc)) from None
+        return text
+
+    def half_width(text: str) -> str:
+        try:
+            HalfWidth.parse(text)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+        return text
+
+    parser.add_argument("--qoi", nargs="+", type=name, default=[POINTWISE], metavar="NAME",
+                        help=f"quantities of interest: {POINTWISE!r} (default: the tip against a reference over "
+                             f"[0, W], today's study) or statistics of the engine after a transient: "
+                             f"{', '.join(QOIS)} (or an engine statistic's own name)")
+    parser.add_argument("--half-width", type=half_width, default="2%", metavar="H",
+                        help="requested 95 %% half-width h* of each QoI: a percentage of the reference's value "
+                             "(default 2%%) or a number in the QoI's unit")
+    parser.add_argument("--transient", type=float, help="start of the statistics' window (s; default 2, quick 0.5)")
+    parser.add_argument("--stat-window", type=float, metavar="T",
+                        help="window of the statistics after the transient (s; default 20, quick 2)")
+    parser.add_argument("--reference-window", type=float, metavar="T",
+                        help="window of the references (s; default 40, quick 4)")
+    parser.add_argument("--members", type=int, help="members of the reference's ensemble (default 4, quick 3)")
+
+
+def split_qois(names: Sequence[str]) -> tuple[bool, list[str]]:
+    """(whether the pointwise study runs, the statistical QoIs), names checked."""
+    from .qoi import POINTWISE, statistic_name
+
+    statistical = [n for n in dict.fromkeys(names) if n != POINTWISE]
+    for name in statistical:
+        statistic_name(name)
+    return POINTWISE in names, statistical
+
+
 def _options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--window", type=float, nargs="+", default=[0.08, 0.2],
                         help="compare on [0, W] s for each W (default 0.08 0.2: before the first impact, "
                              "the first contact period)")
+    qoi_options(parser)
 
 
 def _run(folder: Path, args: argparse.Namespace) -> Path:
-    study(folder, quick=args.quick, windows=tuple(args.window), quiet=args.quiet)
-    return folder / "work_precision.png"
+    from . import qoi_workprecision
+    from .qoi import HalfWidth
+
+    pointwise, statistical = split_qois(args.qoi)
+    printed = folder / "work_precision.png"
+    if statistical:
+        qoi_workprecision.study(folder, qois=statistical, quick=args.quick, half_width=HalfWidth.parse(args.half_width),
+                                transient=args.transient, window=args.stat_window,
+                                reference_window=args.reference_window, members=args.members, quiet=args.quiet)
+        printed = folder / "work_precision_statistics.md"
+    if pointwise:
+        study(folder, quick=args.quick, windows=tuple(args.window), quiet=args.quiet)
+        printed = folder / "work_precision.png"
+    return printed
 
 
-#: ``work-precision [-o DIR] [--quick] [--window T]``; ``main`` is scripts/study_workprecision.py.
+#: ``work-precision [-o DIR] [--quick] [--window T] [--qoi NAME ...] [--half-width H]``; ``main`` is scripts/study_workprecision.py.
 COMMAND = StudyCommand("work_precision", _options, _run, name="work-precision",
                        help="error against CPU time for every method (PNG, md, CSV)",
                        description="Work-precision chart: tip error against the engine's CPU time.",

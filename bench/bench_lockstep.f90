@@ -1,0 +1,250 @@
+!> Lockstep ensembles against one member at a time (SPEC 13), measured in one run; prints a
+!> markdown table and `key value` lines, asserts nothing about time.
+!>
+!>   bench_lockstep [J [steps [repeats [every [observe]]]]]
+!>                                                    defaults: 19, 200000 (J = 19) or 3.8e6/J, 5,
+!>                                                    0 (0: nothing recorded), 1 (1: the shock log
+!>                                                    and statistics of every member, the scene's
+!>                                                    default; 0: &statistics off)
+!>
+!> Members: the paper's scene (Signorini, beta = 1/2, dt = 1e-6 s) with omega and amplitude
+!> varied per member. One at a time: start_state + advance of each member alone (the fused
+!> path), as many members as the largest group. Lockstep: simulate_lockstep of K = 1, 2, 4, 8,
+!> 16 members. Recorders keep nothing (bench_null_recorder). Wall-clock times of the loops only
+!> (system_clock), one core; the variants' repeats are interleaved; medians.
+!>
+!> The floor beside each: a step is bounded by the chain of its two substitutions (2n dependent
+!> multiply-adds, shared by the K members of a group: 2n latencies / K per member-step) and by
+!> its operations (20 n multiply-adds per member-step, 760 at J = 19; 30 n when recorded) over
+!> the peak rate of independent multiply-adds, both measured here by tiny kernels.
+program bench_lockstep
+   use, intrinsic :: iso_fortran_env, only: int64, error_unit
+   use beamstops_kinds, only: wp, ik
+   use beamstops_error, only: error_type
+   use beamstops_scene, only: scene_type, law_signorini
+   use beamstops_model, only: model_type, build_model
+   use beamstops_scheme, only: state_type, start_state, advance
+   use beamstops_summary, only: run_summary
+   use beamstops_lockstep, only: prepare_lockstep, simulate_lockstep
+   use bench_null_recorder, only: null_recorder
+   implicit none
+
+   integer, parameter :: groups(5) = [1, 2, 4, 8, 16]
+   integer :: elements, steps, repeats, every, observe, rep, g, n
+   real(wp), allocatable :: t_alone(:), t_group(:, :), t_latency(:), t_peak(:)
+   real(wp) :: alone, latency, peak, ns, floor_chain, floor_ops, ops
+   type(scene_type), allocatable :: scenes(:)
+   character(len=160) :: line
+
+   elements = int_argument(1, 19)
+   steps = int_argument(2, max(1000, int(3.8e6_wp/elements)))
+   repeats = int_argument(3, 5)
+   every = int_argument(4, 0)
+   observe = int_argument(5, 1)
+   n = 2*elements
+   allocate (t_alone(repeats), t_group(repeats, size(groups)), t_latency(repeats), t_peak(repeats))
+   allocate (scenes(maxval(groups)))
+   call members(scenes)
+
+   do rep = 1, repeats
+      t_latency(rep) = fma_latency()
+      t_peak(rep) = fma_throughput()
+      t_alone(rep) = time_alone(scenes)
+      do g = 1, size(groups)
+         t_group(rep, g) = time_group(scenes(1:groups(g)))
+      end do
+   end do
+
+   alone = median(t_alone)
+   latency = median(t_latency)
+   peak = median(t_peak)
+   ops = merge(30.0_wp, 20.0_wp, every > 0)*n
+   call put('J', real(elements, wp))
+   call put('n', real(n, wp))
+   call put('steps', real(steps, wp))
+   call put('fma_latency_ns', latency)
+   call put('fma_per_ns', peak)
+   call put('observe', real(observe, wp))
+   call put('alone_ns_per_member_step', alone)
+   print '(a)', ''
+   write (line, '(a,i0,a,i0,a,i0,a)') '| J = ', elements, ' (n = ', n, '), ', steps, &
+      & ' steps | ns per member-step | member-steps per s per core | × one at a time | floor ns | × floor |'
+   print '(a)', trim(line)
+   print '(a)', '|---|---|---|---|---|---|'
+   floor_chain = 2*n*latency
+   floor_ops = ops/peak
+   call table_row('one at a time', alone, max(floor_chain, floor_ops))
+   do g = 1, size(groups)
+      ns = median(t_group(:, g))
+      write (line, '(a,i0)') 'lockstep K = ', groups(g)
+      call table_row(trim(line), ns, max(floor_chain/groups(g), floor_ops))
+      write (line, '(a,i0,a)') 'lockstep_', groups(g), '_ns_per_member_step'
+      call put(trim(line), ns)
+   end do
+   print '(a)', ''
+   write (line, '(a,f0.3,a,f0.1,a,f0.0,a)') 'multiply-add latency ', latency, ' ns, peak ', peak, &
+      & ' independent multiply-adds per ns; ', ops, ' multiply-adds per member-step'
+   print '(a)', trim(line)
+
+contains
+
+   !> Members: the paper's scene at dt = 1e-6, omega and amplitude varied.
+   subroutine members(s)
+      type(scene_type), intent(out) :: s(:)
+      integer :: k
+      do k = 1, size(s)
+         s(k)%elements = elements
+         s(k)%dt = 1.0e-6_wp
+         s(k)%beta = 0.5_wp
+         s(k)%law = law_signorini
+         s(k)%t_end = 1.0e-6_wp*(steps + 1)
+         s(k)%omega = 10.0_wp + 0.25_wp*(k - 1)
+         s(k)%amplitude = 0.2_wp + 0.002_wp*(k - 1)
+         s(k)%record_every = huge(1)
+         if (every > 0) s(k)%record_every = every
+         s(k)%output_file = 'unused.h5'
+         s(k)%statistics = observe /= 0
+      end do
+   end subroutine members
+
+   !> ns per member-step, each member run alone on the fused path (start_state + advance).
+   function time_alone(s) result(ns)
+      type(scene_type), intent(in) :: s(:)
+      real(wp) :: ns
+      type(model_type) :: model
+      type(state_type) :: state
+      type(null_recorder) :: recorder
+      type(error_type), allocatable :: error
+      integer(int64) :: t0, t1, rate, total
+      integer :: k
+      total = 0
+      do k = 1, size(s)
+         call build_model(s(k), model, error)
+         if (allocated(error)) call fail(error%message)
+         call start_state(s(k), model, state, recorder, error)
+         if (allocated(error)) call fail(error%message)
+         call system_clock(t0, rate)
+         call advance(s(k), model, state, recorder, int(steps, ik))
+         call system_clock(t1)
+         total = total + (t1 - t0)
+         if (recorder%sink == 12345) print *, recorder%sink
+      end do
+      ns = 1.0e9_wp*real(total, wp)/real(rate, wp)/(real(steps, wp)*size(s))
+   end function time_alone
+
+   !> ns per member-step of the members in lockstep (simulate_lockstep, start included: it is
+   !> K one-scene starts, negligible beside the steps).
+   function time_group(s) result(ns)
+      type(scene_type), intent(in) :: s(:)
+      real(wp) :: ns
+      type(model_type) :: model
+      type(null_recorder) :: recorders(size(s))
+      type(run_summary) :: summaries(size(s))
+      type(error_type), allocatable :: error
+      integer(int64) :: t0, t1, rate
+      call prepare_lockstep(s, 'bench', model, error)
+      if (allocated(error)) call fail(error%message)
+      call system_clock(t0, rate)
+      call simulate_lockstep(s, model, recorders, summaries, error)
+      call system_clock(t1)
+      if (allocated(error)) call fail(error%message)
+      ns = 1.0e9_wp*real(t1 - t0, wp)/real(rate, wp)/(real(summaries(1)%steps, wp)*size(s))
+      if (recorders(1)%sink == 12345) print *, recorders(1)%sink
+   end function time_group
+
+   subroutine table_row(label, ns, floor)
+      character(len=*), intent(in) :: label
+      real(wp), intent(in) :: ns, floor
+      character(len=200) :: row
+      write (row, '(a,f0.1,a,es10.3,a,f0.2,a,f0.1,a,f0.2,a)') '| '//label//' | ', ns, ' | ', 1.0e9_wp/ns, ' | ', &
+         & alone/ns, ' | ', floor, ' | ', ns/floor, ' |'
+      print '(a)', trim(row)
+   end subroutine table_row
+
+   !> ns per dependent multiply-add x = b - a x.
+   function fma_latency() result(ns)
+      real(wp) :: ns
+      integer, parameter :: count = 20000000
+      real(wp) :: a, b, x
+      integer(int64) :: t0, t1, rate
+      integer :: k
+      a = 0.999_wp
+      b = 1.0e-3_wp
+      x = runtime_one()
+      call system_clock(t0, rate)
+      do k = 1, count
+         x = b - a*x
+      end do
+      call system_clock(t1)
+      ns = 1.0e9_wp*real(t1 - t0, wp)/real(rate, wp)/count
+      if (x == 12345) print *, x
+   end function fma_latency
+
+   !> Independent multiply-adds per ns: 64 accumulators, vectorized.
+   function fma_throughput() result(per_ns)
+      real(wp) :: per_ns
+      integer, parameter :: count = 2000000, width = 64
+      real(wp) :: acc(width), a, b
+      integer(int64) :: t0, t1, rate
+      integer :: k
+      a = 0.999_wp*runtime_one()
+      b = 1.0e-3_wp
+      acc = [(real(k, wp)/width, k=1, width)]
+      call system_clock(t0, rate)
+      do k = 1, count
+         acc = acc*a + b
+      end do
+      call system_clock(t1)
+      per_ns = real(count, wp)*width/(1.0e9_wp*real(t1 - t0, wp)/real(rate, wp))
+      if (sum(acc) == 12345) print *, acc(1)
+   end function fma_throughput
+
+   !> 1, but not known to the compiler.
+   function runtime_one() result(one)
+      real(wp) :: one
+      character(len=8) :: text
+      call get_environment_variable('BEAMSTOPS_BENCH_NEVER_SET', text)
+      one = merge(2.0_wp, 1.0_wp, text == 'two')
+   end function runtime_one
+
+   function median(t) result(m)
+      real(wp), intent(in) :: t(:)
+      real(wp) :: m, s(size(t)), v
+      integer :: i, j
+      s = t
+      do i = 2, size(s)
+         v = s(i)
+         j = i - 1
+         do while (j >= 1)
+            if (s(j) <= v) exit
+            s(j + 1) = s(j)
+            j = j - 1
+         end do
+         s(j + 1) = v
+      end do
+      m = 0.5_wp*(s((size(s) + 1)/2) + s(size(s)/2 + 1))
+   end function median
+
+   subroutine put(key, value)
+      character(len=*), intent(in) :: key
+      real(wp), intent(in) :: value
+      print '(a, 1x, es16.9)', key, value
+   end subroutine put
+
+   function int_argument(i, default) result(value)
+      integer, intent(in) :: i, default
+      integer :: value, status
+      character(len=64) :: text
+      value = default
+      if (command_argument_count() < i) return
+      call get_command_argument(i, text)
+      read (text, *, iostat=status) value
+      if (status /= 0) call fail('not an integer: '//trim(text))
+   end function int_argument
+
+   subroutine fail(message)
+      character(len=*), intent(in) :: message
+      write (error_unit, '(a)') 'bench_lockstep: '//message
+      error stop 1
+   end subroutine fail
+end program bench_lockstep

@@ -1,0 +1,518 @@
+!> The kd = 3 substitutions, products and dot products of beamstops_band_solve for
+!> lockstep_lanes right-hand sides at once, the member index innermost: arrays (lanes, n),
+!> column j holding row j of every member, so that each multiply-add of a row acts on all the
+!> lanes (SIMD across members) and the chain of a step is shared by them.
+!>
+!> Each row is one loop over the lanes (a compile-time width, marked for vectorization), so that
+!> a row is a few whole-register operations with no loop of its own to pay.
+!>
+!> Bit for bit: every routine performs, for each lane, the floating-point operations of its
+!> one-member counterpart in beamstops_band_solve, in the same order, with the same expressions
+!> and the same multiply-adds. The one-member routines are what the compiler made of them, and
+!> in three places it rounds a product before adding it (gfortran 12, -O3, znver3: where a
+!> running sum is a reduction it vectorizes in order, or a chain it keeps apart from multiply-adds):
+!> - back_substitution's first rows n-1 and n-2 (back_substitution_edge's loops): each product
+!>   rounded before it is subtracted;
+!> - forward_substitution_energy's three sums over the rows after its last triple of rows, when
+!>   there are two (n - 3 = 2 mod 3): each term rounded before it is added (one row: a
+!>   multiply-add); the sums start with u1 s1 + u2 s2 + u3 s3 as fma(u3, s3, fma(u1, s1, u2 s2));
+!> - dot's rows after the last eight, when four or more: the next four products rounded and
+!>   added in order, the rest by multiply-adds.
+!> Here those places round explicitly (add_rounded, subtract_rounded); everywhere else the
+!> multiply-adds are the compiler's, as in the one-member routines. tests/fortran/test_lockstep.f90
+!> checks every kernel lane by lane against its one-member counterpart (J = 4..13, 19, 20, 100,
+!> 101), and whole runs against the one-scene path: a change of compiler, flags or of
+!> beamstops_band_solve shows there first.
+!>
+!> n >= 2 kd + 2 (J >= 4) is assumed; beamstops_lockstep refuses smaller meshes.
+module beamstops_band_solve_lockstep
+   use beamstops_kinds, only: wp
+   use beamstops_band, only: kd
+   use beamstops_band_solve, only: band_solver, band_diagonals
+   implicit none
+   private
+   public :: lockstep_forward, lockstep_forward_energy, lockstep_back, lockstep_matvec, lockstep_dot
+   public :: lockstep_rhs, lockstep_update, lockstep_matvec_rhs
+   public :: lockstep_min_unknowns, lockstep_work_columns, lockstep_lanes
+
+   !> Fewest unknowns these routines handle (J >= 4).
+   integer, parameter :: lockstep_min_unknowns = 2*kd + 2
+   !> Columns of the work arrays of these routines.
+   integer, parameter :: lockstep_work_columns = 8
+   !> Members the routines advance at once (the first extent of their arrays): two AVX2
+   !> registers of doubles.
+   integer, parameter :: lockstep_lanes = 8
+
+contains
+
+   !> Forward substitution (I + N)^T w = b of every lane (beamstops_band_solve's
+   !> forward_substitution): b replaced by D^{-2} w. Row j scales row j - 3, the last it needs.
+   pure subroutine lockstep_forward(solver, b)
+      !> Solver from prepare_solver.
+      type(band_solver), intent(in) :: solver
+      !> Right-hand sides (lanes, n), replaced by D^{-2} w.
+      real(wp), intent(inout) :: b(lockstep_lanes, solver%n)
+      real(wp) :: xa(lockstep_lanes), xb(lockstep_lanes), xc(lockstep_lanes)
+      integer :: j, k, n
+      n = solver%n
+      associate (off => solver%off, inv_d2 => solver%inv_d2)
+         call forward_first_rows(off, inv_d2, n, b, xa, xb, xc)
+         do j = kd + 1, n - 2, 3
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               xa(k) = b(k, j) - off(1, j)*xa(k) - off(2, j)*xb(k) - off(3, j)*xc(k)
+               b(k, j) = xa(k)*inv_d2(j)
+               xb(k) = b(k, j + 1) - off(1, j + 1)*xb(k) - off(2, j + 1)*xc(k) - off(3, j + 1)*xa(k)
+               b(k, j + 1) = xb(k)*inv_d2(j + 1)
+               xc(k) = b(k, j + 2) - off(1, j + 2)*xc(k) - off(2, j + 2)*xa(k) - off(3, j + 2)*xb(k)
+               b(k, j + 2) = xc(k)*inv_d2(j + 2)
+            end do
+         end do
+         call forward_last_rows(off, inv_d2, j, n, b, xa, xb, xc)
+      end associate
+   end subroutine lockstep_forward
+
+   !> The first three rows of the forward substitution of every lane: b(:, 1:3) replaced by
+   !> D^{-2} w(:, 1:3), w(:, 1:3) returned in xa, xb, xc (beamstops_band_solve's first_rows).
+   pure subroutine forward_first_rows(off, inv_d2, n, b, xa, xb, xc)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: off(kd, n), inv_d2(n)
+      real(wp), intent(inout) :: b(lockstep_lanes, n)
+      real(wp), intent(out) :: xa(lockstep_lanes), xb(lockstep_lanes), xc(lockstep_lanes)
+      integer :: k
+!GCC$ ivdep
+!GCC$ vector
+      do k = 1, lockstep_lanes
+         xa(k) = b(k, 1)
+         xb(k) = b(k, 2) - off(3, 2)*xa(k)
+         xc(k) = b(k, 3) - off(2, 3)*xa(k) - off(3, 3)*xb(k)
+         b(k, 1) = xa(k)*inv_d2(1)
+         b(k, 2) = xb(k)*inv_d2(2)
+         b(k, 3) = xc(k)*inv_d2(3)
+      end do
+   end subroutine forward_first_rows
+
+   !> The rows j and j+1 (those of them <= n) left after the loop by three (last_rows).
+   pure subroutine forward_last_rows(off, inv_d2, j, n, b, xa, xb, xc)
+      integer, intent(in) :: j, n
+      real(wp), intent(in) :: off(kd, n), inv_d2(n)
+      real(wp), intent(inout) :: b(lockstep_lanes, n)
+      real(wp), intent(inout) :: xa(lockstep_lanes), xb(lockstep_lanes), xc(lockstep_lanes)
+      integer :: k
+      if (j <= n) then
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            xa(k) = b(k, j) - off(1, j)*xa(k) - off(2, j)*xb(k) - off(3, j)*xc(k)
+            b(k, j) = xa(k)*inv_d2(j)
+         end do
+      end if
+      if (j + 1 <= n) then
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            b(k, j + 1) = (b(k, j + 1) - off(1, j + 1)*xb(k) - off(2, j + 1)*xc(k) - off(3, j + 1)*xa(k))*inv_d2(j + 1)
+         end do
+      end if
+   end subroutine forward_last_rows
+
+   !> lockstep_forward with the dot products of the discrete energy of every lane beside it
+   !> (beamstops_band_solve's forward_substitution_energy): usu = u.su, dsu = d.su, dmd = d.M d.
+   pure subroutine lockstep_forward_energy(solver, mass, u, d, su, b, usu, dsu, dmd, work)
+      !> Solver from prepare_solver.
+      type(band_solver), intent(in) :: solver
+      !> M by diagonals.
+      type(band_diagonals), intent(in) :: mass
+      !> u, d and su of every lane (lanes, n).
+      real(wp), intent(in) :: u(lockstep_lanes, solver%n), d(lockstep_lanes, solver%n), su(lockstep_lanes, solver%n)
+      !> Right-hand sides (lanes, n), replaced by D^{-2} w.
+      real(wp), intent(inout) :: b(lockstep_lanes, solver%n)
+      !> u.su, d.su and d.M d of every lane (lanes).
+      real(wp), intent(out) :: usu(lockstep_lanes), dsu(lockstep_lanes), dmd(lockstep_lanes)
+      !> Work array (lanes, lockstep_work_columns).
+      real(wp), intent(out) :: work(lockstep_lanes, lockstep_work_columns)
+      real(wp) :: xa(lockstep_lanes), xb(lockstep_lanes), xc(lockstep_lanes)
+      integer :: i, j, k, n
+      n = solver%n
+      associate (off => solver%off, inv_d2 => solver%inv_d2, m => mass%a)
+         call forward_first_rows(off, inv_d2, n, b, xa, xb, xc)
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            usu(k) = u(k, 1)*su(k, 1) + u(k, 2)*su(k, 2) + u(k, 3)*su(k, 3)
+            dsu(k) = d(k, 1)*su(k, 1) + d(k, 2)*su(k, 2) + d(k, 3)*su(k, 3)
+            dmd(k) = d(k, 1)*m(1, 0)*d(k, 1) + d(k, 2)*(m(2, 0)*d(k, 2) + 2*m(2, 1)*d(k, 1)) &
+               & + d(k, 3)*(m(3, 0)*d(k, 3) + 2*(m(3, 1)*d(k, 2) + m(3, 2)*d(k, 1)))
+         end do
+         do j = kd + 1, n - 2, 3
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               xa(k) = b(k, j) - off(1, j)*xa(k) - off(2, j)*xb(k) - off(3, j)*xc(k)
+               b(k, j) = xa(k)*inv_d2(j)
+               xb(k) = b(k, j + 1) - off(1, j + 1)*xb(k) - off(2, j + 1)*xc(k) - off(3, j + 1)*xa(k)
+               b(k, j + 1) = xb(k)*inv_d2(j + 1)
+               xc(k) = b(k, j + 2) - off(1, j + 2)*xc(k) - off(2, j + 2)*xa(k) - off(3, j + 2)*xb(k)
+               b(k, j + 2) = xc(k)*inv_d2(j + 2)
+               usu(k) = usu(k) + u(k, j)*su(k, j)
+               dsu(k) = dsu(k) + d(k, j)*su(k, j)
+               dmd(k) = dmd(k) + d(k, j)*(m(j, 0)*d(k, j) + 2*(m(j, 1)*d(k, j - 1) + m(j, 2)*d(k, j - 2) &
+                  & + m(j, 3)*d(k, j - 3)))
+               usu(k) = usu(k) + u(k, j + 1)*su(k, j + 1)
+               dsu(k) = dsu(k) + d(k, j + 1)*su(k, j + 1)
+               dmd(k) = dmd(k) + d(k, j + 1)*(m(j + 1, 0)*d(k, j + 1) + 2*(m(j + 1, 1)*d(k, j) &
+                  & + m(j + 1, 2)*d(k, j - 1) + m(j + 1, 3)*d(k, j - 2)))
+               usu(k) = usu(k) + u(k, j + 2)*su(k, j + 2)
+               dsu(k) = dsu(k) + d(k, j + 2)*su(k, j + 2)
+               dmd(k) = dmd(k) + d(k, j + 2)*(m(j + 2, 0)*d(k, j + 2) + 2*(m(j + 2, 1)*d(k, j + 1) &
+                  & + m(j + 2, 2)*d(k, j) + m(j + 2, 3)*d(k, j - 1)))
+            end do
+         end do
+         call forward_last_rows(off, inv_d2, j, n, b, xa, xb, xc)
+         ! the rows after the last triple: one by a multiply-add; two, each term rounded
+         ! before it is added
+         if (j == n) then
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               usu(k) = usu(k) + u(k, j)*su(k, j)
+               dsu(k) = dsu(k) + d(k, j)*su(k, j)
+               dmd(k) = dmd(k) + d(k, j)*(m(j, 0)*d(k, j) + 2*(m(j, 1)*d(k, j - 1) + m(j, 2)*d(k, j - 2) &
+                  & + m(j, 3)*d(k, j - 3)))
+            end do
+         else
+            do i = j, n
+               call rounded_terms(i, n, mass, u, d, su, usu, dsu, dmd, work, solver%inv_d2(1))
+            end do
+         end if
+      end associate
+   end subroutine lockstep_forward_energy
+
+   !> The terms of row j of the energy sums, rounded, then added (add_rounded).
+   pure subroutine rounded_terms(j, n, mass, u, d, su, usu, dsu, dmd, work, positive)
+      integer, intent(in) :: j, n
+      type(band_diagonals), intent(in) :: mass
+      real(wp), intent(in) :: u(lockstep_lanes, n), d(lockstep_lanes, n), su(lockstep_lanes, n)
+      real(wp), intent(inout) :: usu(lockstep_lanes), dsu(lockstep_lanes), dmd(lockstep_lanes)
+      real(wp), intent(inout) :: work(lockstep_lanes, lockstep_work_columns)
+      real(wp), intent(in) :: positive
+      integer :: k
+      associate (m => mass%a)
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            work(k, 1) = u(k, j)*su(k, j)
+            work(k, 2) = d(k, j)*su(k, j)
+            work(k, 3) = d(k, j)*(m(j, 0)*d(k, j) + 2*(m(j, 1)*d(k, j - 1) + m(j, 2)*d(k, j - 2) &
+               & + m(j, 3)*d(k, j - 3)))
+         end do
+      end associate
+      call add_rounded(usu, work(:, 1), positive)
+      call add_rounded(dsu, work(:, 2), positive)
+      call add_rounded(dmd, work(:, 3), positive)
+   end subroutine rounded_terms
+
+   !> Back substitution (I + N) x = b of every lane (beamstops_band_solve's back_substitution,
+   !> its edge rows included).
+   pure subroutine lockstep_back(solver, b, work)
+      !> Solver from prepare_solver.
+      type(band_solver), intent(in) :: solver
+      !> D^{-2} w (lanes, n), replaced by x.
+      real(wp), intent(inout) :: b(lockstep_lanes, solver%n)
+      !> Work array (lanes, lockstep_work_columns).
+      real(wp), intent(out) :: work(lockstep_lanes, lockstep_work_columns)
+      real(wp) :: xa(lockstep_lanes), xb(lockstep_lanes), xc(lockstep_lanes)
+      integer :: i, k, n
+      n = solver%n
+      associate (off => solver%off)
+         ! the edge rows, each product rounded before its subtraction
+         work(:, 1) = off(3, n)*b(:, n)
+         call subtract_rounded(b(:, n - 1), work(:, 1), solver%inv_d2(1))
+         work(:, 1) = off(2, n)*b(:, n)
+         call subtract_rounded(b(:, n - 2), work(:, 1), solver%inv_d2(1))
+         work(:, 1) = off(3, n - 1)*b(:, n - 1)
+         call subtract_rounded(b(:, n - 2), work(:, 1), solver%inv_d2(1))
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            xa(k) = b(k, n)
+            xb(k) = b(k, n - 1)
+            xc(k) = b(k, n - 2)
+         end do
+         do i = n - kd, 3, -3
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               xa(k) = b(k, i) - off(1, i + 3)*xa(k) - off(2, i + 2)*xb(k) - off(3, i + 1)*xc(k)
+               b(k, i) = xa(k)
+               xb(k) = b(k, i - 1) - off(1, i + 2)*xb(k) - off(2, i + 1)*xc(k) - off(3, i)*xa(k)
+               b(k, i - 1) = xb(k)
+               xc(k) = b(k, i - 2) - off(1, i + 1)*xc(k) - off(2, i)*xa(k) - off(3, i - 1)*xb(k)
+               b(k, i - 2) = xc(k)
+            end do
+         end do
+         if (i >= 1) then
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               xa(k) = b(k, i) - off(1, i + 3)*xa(k) - off(2, i + 2)*xb(k) - off(3, i + 1)*xc(k)
+               b(k, i) = xa(k)
+            end do
+         end if
+         if (i - 1 >= 1) then
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               b(k, i - 1) = b(k, i - 1) - off(1, i + 2)*xb(k) - off(2, i + 1)*xc(k) - off(3, i)*xa(k)
+            end do
+         end if
+      end associate
+   end subroutine lockstep_back
+
+   !> y = A x of every lane for a symmetric band matrix by diagonals (beamstops_band_solve's
+   !> diagonal_matvec, n >= 2 kd + 1).
+   pure subroutine lockstep_matvec(diagonals, x, y)
+      !> Matrix by diagonals.
+      type(band_diagonals), intent(in) :: diagonals
+      !> Vectors (lanes, n).
+      real(wp), intent(in) :: x(lockstep_lanes, diagonals%n)
+      !> Products (lanes, n).
+      real(wp), intent(out) :: y(lockstep_lanes, diagonals%n)
+      integer :: j, k, n
+      n = diagonals%n
+      associate (a => diagonals%a)
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            y(k, 1) = a(1, 0)*x(k, 1) + a(2, 1)*x(k, 2) + a(3, 2)*x(k, 3) + a(4, 3)*x(k, 4)
+            y(k, 2) = a(2, 1)*x(k, 1) + a(2, 0)*x(k, 2) + a(3, 1)*x(k, 3) + a(4, 2)*x(k, 4) + a(5, 3)*x(k, 5)
+            y(k, 3) = a(3, 2)*x(k, 1) + a(3, 1)*x(k, 2) + a(3, 0)*x(k, 3) + a(4, 1)*x(k, 4) + a(5, 2)*x(k, 5) &
+               & + a(6, 3)*x(k, 6)
+         end do
+         do j = kd + 1, n - kd
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               y(k, j) = a(j, 3)*x(k, j - 3) + a(j, 2)*x(k, j - 2) + a(j, 1)*x(k, j - 1) + a(j, 0)*x(k, j) &
+                  & + a(j + 1, 1)*x(k, j + 1) + a(j + 2, 2)*x(k, j + 2) + a(j + 3, 3)*x(k, j + 3)
+            end do
+         end do
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            y(k, n - 2) = a(n - 2, 3)*x(k, n - 5) + a(n - 2, 2)*x(k, n - 4) + a(n - 2, 1)*x(k, n - 3) &
+               & + a(n - 2, 0)*x(k, n - 2) + a(n - 1, 1)*x(k, n - 1) + a(n, 2)*x(k, n)
+            y(k, n - 1) = a(n - 1, 3)*x(k, n - 4) + a(n - 1, 2)*x(k, n - 3) + a(n - 1, 1)*x(k, n - 2) &
+               & + a(n - 1, 0)*x(k, n - 1) + a(n, 1)*x(k, n)
+            y(k, n) = a(n, 3)*x(k, n - 3) + a(n, 2)*x(k, n - 2) + a(n, 1)*x(k, n - 1) + a(n, 0)*x(k, n)
+         end do
+      end associate
+   end subroutine lockstep_matvec
+
+   !> s_k = x_k . y_k of every lane with the eight partial sums of beamstops_band_solve's dot.
+   pure subroutine lockstep_dot(n, x, y, partial, s, positive)
+      !> Length of the vectors.
+      integer, intent(in) :: n
+      !> Vectors (lanes, n).
+      real(wp), intent(in) :: x(lockstep_lanes, n), y(lockstep_lanes, n)
+      !> Work array (lanes, lockstep_work_columns).
+      real(wp), intent(out) :: partial(lockstep_lanes, lockstep_work_columns)
+      !> The dot products (lanes).
+      real(wp), intent(out) :: s(lockstep_lanes)
+      !> Any positive number the compiler cannot see (add_rounded); the loop passes dt^2.
+      real(wp), intent(in) :: positive
+      integer :: j, k
+      partial(:, 1:8) = 0
+      do j = 1, n - 7, 8
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            partial(k, 1) = partial(k, 1) + x(k, j)*y(k, j)
+            partial(k, 2) = partial(k, 2) + x(k, j + 1)*y(k, j + 1)
+            partial(k, 3) = partial(k, 3) + x(k, j + 2)*y(k, j + 2)
+            partial(k, 4) = partial(k, 4) + x(k, j + 3)*y(k, j + 3)
+            partial(k, 5) = partial(k, 5) + x(k, j + 4)*y(k, j + 4)
+            partial(k, 6) = partial(k, 6) + x(k, j + 5)*y(k, j + 5)
+            partial(k, 7) = partial(k, 7) + x(k, j + 6)*y(k, j + 6)
+            partial(k, 8) = partial(k, 8) + x(k, j + 7)*y(k, j + 7)
+         end do
+      end do
+      call dot_tail(n, j, x, y, partial, s, positive)
+   end subroutine lockstep_dot
+
+   !> lockstep_matvec (S u) and lockstep_rhs (rhs = a g - b S u + spring e_{n-1}) in one pass.
+   pure subroutine lockstep_matvec_rhs(stiffness, u, a, g, b, spring, su, rhs)
+      !> S by diagonals.
+      type(band_diagonals), intent(in) :: stiffness
+      !> u of every lane (lanes, n).
+      real(wp), intent(in) :: u(lockstep_lanes, stiffness%n)
+      !> dt^2 times the load weight of every lane (lanes).
+      real(wp), intent(in) :: a(lockstep_lanes)
+      !> Load vectors (lanes, n).
+      real(wp), intent(in) :: g(lockstep_lanes, stiffness%n)
+      !> dt^2.
+      real(wp), intent(in) :: b
+      !> Force term of the tip row (lanes).
+      real(wp), intent(in) :: spring(lockstep_lanes)
+      !> S u (lanes, n).
+      real(wp), intent(out) :: su(lockstep_lanes, stiffness%n)
+      !> Right-hand sides (lanes, n).
+      real(wp), intent(out) :: rhs(lockstep_lanes, stiffness%n)
+      integer :: j, k, n
+      n = stiffness%n
+      associate (s => stiffness%a, x => u, y => su)
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            y(k, 1) = s(1, 0)*x(k, 1) + s(2, 1)*x(k, 2) + s(3, 2)*x(k, 3) + s(4, 3)*x(k, 4)
+            y(k, 2) = s(2, 1)*x(k, 1) + s(2, 0)*x(k, 2) + s(3, 1)*x(k, 3) + s(4, 2)*x(k, 4) + s(5, 3)*x(k, 5)
+            y(k, 3) = s(3, 2)*x(k, 1) + s(3, 1)*x(k, 2) + s(3, 0)*x(k, 3) + s(4, 1)*x(k, 4) + s(5, 2)*x(k, 5) &
+               & + s(6, 3)*x(k, 6)
+            rhs(k, 1) = a(k)*g(k, 1) - b*y(k, 1)
+            rhs(k, 2) = a(k)*g(k, 2) - b*y(k, 2)
+            rhs(k, 3) = a(k)*g(k, 3) - b*y(k, 3)
+         end do
+         do j = kd + 1, n - kd
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               y(k, j) = s(j, 3)*x(k, j - 3) + s(j, 2)*x(k, j - 2) + s(j, 1)*x(k, j - 1) + s(j, 0)*x(k, j) &
+                  & + s(j + 1, 1)*x(k, j + 1) + s(j + 2, 2)*x(k, j + 2) + s(j + 3, 3)*x(k, j + 3)
+               rhs(k, j) = a(k)*g(k, j) - b*y(k, j)
+            end do
+         end do
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            y(k, n - 2) = s(n - 2, 3)*x(k, n - 5) + s(n - 2, 2)*x(k, n - 4) + s(n - 2, 1)*x(k, n - 3) &
+               & + s(n - 2, 0)*x(k, n - 2) + s(n - 1, 1)*x(k, n - 1) + s(n, 2)*x(k, n)
+            y(k, n - 1) = s(n - 1, 3)*x(k, n - 4) + s(n - 1, 2)*x(k, n - 3) + s(n - 1, 1)*x(k, n - 2) &
+               & + s(n - 1, 0)*x(k, n - 1) + s(n, 1)*x(k, n)
+            y(k, n) = s(n, 3)*x(k, n - 3) + s(n, 2)*x(k, n - 2) + s(n, 1)*x(k, n - 1) + s(n, 0)*x(k, n)
+            rhs(k, n - 2) = a(k)*g(k, n - 2) - b*y(k, n - 2)
+            rhs(k, n - 1) = a(k)*g(k, n - 1) - b*y(k, n - 1)
+            rhs(k, n) = a(k)*g(k, n) - b*y(k, n)
+            rhs(k, n - 1) = rhs(k, n - 1) + spring(k)
+         end do
+      end associate
+   end subroutine lockstep_matvec_rhs
+
+   !> The end of a dot product from the eight partial sums and the rows j..n after them
+   !> (lockstep_dot).
+   pure subroutine dot_tail(n, first, x, y, partial, s, positive)
+      integer, intent(in) :: n, first
+      real(wp), intent(in) :: x(lockstep_lanes, n), y(lockstep_lanes, n)
+      real(wp), intent(inout) :: partial(lockstep_lanes, lockstep_work_columns)
+      real(wp), intent(out) :: s(lockstep_lanes)
+      real(wp), intent(in) :: positive
+      integer :: j, k
+      j = first
+!GCC$ ivdep
+!GCC$ vector
+      do k = 1, lockstep_lanes
+         s(k) = ((partial(k, 1) + partial(k, 5)) + (partial(k, 2) + partial(k, 6))) &
+            & + ((partial(k, 3) + partial(k, 7)) + (partial(k, 4) + partial(k, 8)))
+      end do
+      ! the rows after the last eight: four or more, the next four products rounded and added
+      ! in order; then the rest (at most three) by multiply-adds
+      if (n - j + 1 >= 4) then
+         partial(:, 1:4) = x(:, j:j + 3)*y(:, j:j + 3)
+         call add_rounded(s, partial(:, 1), positive)
+         call add_rounded(s, partial(:, 2), positive)
+         call add_rounded(s, partial(:, 3), positive)
+         call add_rounded(s, partial(:, 4), positive)
+         j = j + 4
+      end if
+      do j = j, n
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            s(k) = s(k) + x(k, j)*y(k, j)
+         end do
+      end do
+   end subroutine dot_tail
+
+   !> The right-hand sides of a step, rhs = a g - b S u plus `spring` in the tip row n-1 (the
+   !> forward pass of beamstops_scheme), of every lane.
+   pure subroutine lockstep_rhs(n, a, g, b, su, spring, rhs)
+      !> Unknowns.
+      integer, intent(in) :: n
+      !> dt^2 times the load weight of every lane (lanes).
+      real(wp), intent(in) :: a(lockstep_lanes)
+      !> Load vectors (lanes, n).
+      real(wp), intent(in) :: g(lockstep_lanes, n)
+      !> dt^2.
+      real(wp), intent(in) :: b
+      !> S u (lanes, n).
+      real(wp), intent(in) :: su(lockstep_lanes, n)
+      !> Force term of the tip row (lanes).
+      real(wp), intent(in) :: spring(lockstep_lanes)
+      !> Right-hand sides (lanes, n).
+      real(wp), intent(out) :: rhs(lockstep_lanes, n)
+      integer :: j, k
+      do j = 1, n
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            rhs(k, j) = a(k)*g(k, j) - b*su(k, j)
+         end do
+      end do
+!GCC$ ivdep
+!GCC$ vector
+      do k = 1, lockstep_lanes
+         rhs(k, n - 1) = rhs(k, n - 1) + spring(k)
+      end do
+   end subroutine lockstep_rhs
+
+   !> The update of a step, d^n = d^{n-1} + x + c z, u^{n+1} = u^n + d^n, of every lane.
+   pure subroutine lockstep_update(n, x, c, z, d, u)
+      !> Unknowns.
+      integer, intent(in) :: n
+      !> A^{-1} rhs (lanes, n).
+      real(wp), intent(in) :: x(lockstep_lanes, n)
+      !> Multiples of z (lanes).
+      real(wp), intent(in) :: c(lockstep_lanes)
+      !> z = A^{-1} e_tip (n).
+      real(wp), intent(in) :: z(n)
+      !> d^{n-1} and u^n on entry, d^n and u^{n+1} on return (lanes, n).
+      real(wp), intent(inout) :: d(lockstep_lanes, n), u(lockstep_lanes, n)
+      integer :: j, k
+      do j = 1, n
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            d(k, j) = d(k, j) + x(k, j) + c(k)*z(j)
+            u(k, j) = u(k, j) + d(k, j)
+         end do
+      end do
+   end subroutine lockstep_update
+
+   !> s = s + p with p already rounded: never contracted with the product that gave p. The
+   !> addition sits in a branch of its own (a multiply-add is formed only within one basic
+   !> block), on a condition the compiler cannot decide (positive > 0, always true: a value
+   !> read at run time), outside any loop (which could be unswitched on it), and p is used on
+   !> the other branch too, so that the product is not moved into it.
+   pure subroutine add_rounded(s, p, positive)
+      real(wp), intent(inout) :: s(lockstep_lanes)
+      real(wp), intent(in) :: p(lockstep_lanes)
+      real(wp), intent(in) :: positive
+      if (positive > 0) then
+         s = s + p
+      else
+         s = p
+      end if
+   end subroutine add_rounded
+
+   !> s = s - p with p already rounded (add_rounded).
+   pure subroutine subtract_rounded(s, p, positive)
+      real(wp), intent(inout) :: s(lockstep_lanes)
+      real(wp), intent(in) :: p(lockstep_lanes)
+      real(wp), intent(in) :: positive
+      if (positive > 0) then
+         s = s - p
+      else
+         s = p
+      end if
+   end subroutine subtract_rounded
+end module beamstops_band_solve_lockstep

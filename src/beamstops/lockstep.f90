@@ -1,0 +1,904 @@
+!> Lockstep ensembles (SPEC 13): K members that share A = M + dt^2 beta S (the same mesh,
+!> beam, time step, beta, contact law and number of steps) advance together, the member index
+!> innermost (arrays (K, n)), so that each multiply-add of the two substitutions of a step
+!> serves K members and the dependency chain of a step is paid once for all of them.
+!>
+!> A member may differ from the others in what does not enter A: the support (amplitude,
+!> omega, hence its load vector and initial velocity), the tip stops (lower, upper), the load
+!> rule, the start, what it records (record_every, snapshot_every) and where (its recorder).
+!> Each member keeps its own load averages, contact state, energy ledger, record cadence and
+!> recorder, and gets its own summary.
+!>
+!> Bit for bit: every member's records, snapshots and summary are those of the same scene run
+!> alone (beamstops_run's simulate, the fused path advance_fused of beamstops_scheme): the
+!> start is the one-scene start itself (start_state); each step does, per member, the
+!> floating-point operations of advance_fused in the same order (the load rotation and its
+!> restarts, the forward pass with its energy sums, the back substitution, the contact law of
+!> the tip, the update, the work and the energy the stops take), with the substitutions of
+!> beamstops_band_solve_lockstep; the runs are cut into the same blocks (block_steps), so that
+!> the delayed energy record of a block's last step is completed the same way. Each member
+!> feeds its own observer (shock log and statistics) every step, as run_scheme does, and gets
+!> run_scheme's summary (ledger, shocks, statistics). tests/fortran/test_lockstep.f90 compares
+!> every column, snapshot and summary value to the bit.
+!>
+!> Laws: Signorini and compliance at the tip, or none. Stops along the span (SPEC 7) are
+!> refused (their QP per member is not in this path yet).
+module beamstops_lockstep
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use beamstops_kinds, only: wp, ik
+   use beamstops_error, only: error_type, fatal_error
+   use beamstops_strings, only: fmt_real, fmt_int
+   use beamstops_scene, only: scene_type, steps_of, stop_count, law_none, law_signorini, law_compliance, law_name
+   use beamstops_model, only: model_type, build_model, check_stability
+   use beamstops_hermite, only: hermite_basis, gauss_points, gauss_weights
+   use beamstops_band, only: band_matvec
+   use beamstops_band_solve, only: band_solver, band_diagonals, prepare_solver, prepare_diagonals, diagonal_matvec, dot
+   use beamstops_band_solve_lockstep, only: lockstep_forward, lockstep_forward_energy, lockstep_back, &
+      & lockstep_matvec, lockstep_dot, lockstep_min_unknowns, lockstep_work_columns, &
+      & lockstep_lanes, lockstep_matvec_rhs, lockstep_update
+   use beamstops_state, only: state_type
+   use beamstops_scheme, only: start_state, block_steps
+   use beamstops_clock, only: thread_cpu_seconds
+   use beamstops_forcing, only: load_average, support_position, lift_shape, lift_slope
+      use beamstops_contact_compliance, only: spring_force, solve_spring_tip
+   use beamstops_observe_observer, only: observer_type
+   use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
+      & col_work, col_dissipated, col_damped
+   use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running
+   implicit none
+   private
+   public :: check_lockstep, prepare_lockstep, simulate_lockstep
+
+   !> Steps between two restarts of the load rotation from exact values (beamstops_scheme's
+   !> restart_every: the two must agree for the loads to agree to the bit).
+   integer(ik), parameter :: restart_every = 64
+
+   !> The operators of the fused loop, shared by the members.
+   type :: operators_type
+      !> Factor of A in the form of the fused substitutions.
+      type(band_solver) :: solver
+      !> S and M by diagonals.
+      type(band_diagonals) :: stiffness, mass
+   end type operators_type
+
+   !> The state of K members, the member index first: what advance_fused keeps in a
+   !> state_type and in its local variables, once per member.
+   type :: members_type
+      !> Members K, unknowns n, chunks of lockstep_lanes members, lanes in all (K padded), index
+      !> of the next step (shared).
+      integer :: k = 0, n = 0, chunks = 0, p = 0
+      integer(ik) :: step = 1
+      !> u^n, d^{n-1}, S u^n, right-hand side / solution, load vector g of each member (lanes, n,
+      !> chunks): member k is lane lane(k) of chunk chunk(k); the padding lanes stay zero.
+      real(wp), allocatable :: u(:, :, :), d(:, :, :), su(:, :, :), rhs(:, :, :), g(:, :, :)
+      !> Work array of the kernels (lanes, lockstep_work_columns).
+      real(wp), allocatable :: partial(:, :)
+      !> Per member, padded to p lanes: load averages sigma_{n-1}, sigma_n; g.d^{n-1}; spring forces p(u^{n-1}), p(u^n);
+      !> work, energy taken by the stops, E^{1/2}, reaction of the last step, largest
+      !> violation (K, per unit mass).
+      real(wp), allocatable :: sigma_prev(:), sigma_now(:), gd_prev(:), p_prev(:), p_now(:), work(:), &
+         & dissipated(:), energy0(:), reaction(:), max_violation(:)
+      !> Whether the last step was in contact; whether the member still runs (K).
+      logical, allocatable :: in_contact(:), active(:)
+      !> Impacts so far (K).
+      integer(ik), allocatable :: impacts(:)
+      !> The load rotation of each member (beamstops_scheme's load_rotation): its step index
+      !> (shared), f sin and f cos of omega c_k, cos and sin of omega dt (K).
+      integer(ik) :: load_k = 0
+      real(wp), allocatable :: sigma(:), cosine(:), cos_step(:), sin_step(:)
+      !> Tip stops of each member (padding lanes: -1, 1) (K).
+      real(wp), allocatable :: lower(:), upper(:)
+      !> Tip value and increment after the update (K).
+      real(wp), allocatable :: u_tip(:), d_tip(:)
+      !> Values of the step (K).
+      real(wp), allocatable :: sigma_next(:), weight(:), coef(:), spring(:), trial(:), c(:), tip_value(:), &
+         & r_step(:), u_tip_prev(:), d_tip_prev(:), r_prev(:), usu(:), dsu(:), dmd(:), u_old_su(:), gd(:)
+      !> Contact in the step; a record waiting for its energy (K).
+      logical, allocatable :: contact(:), pending(:)
+      !> Next record and snapshot step of each member (K).
+      integer(ik), allocatable :: next_record(:), next_snapshot(:)
+      !> Record rows waiting for their energy (n_columns, K).
+      real(wp), allocatable :: rows(:, :)
+      !> The shock log and statistics of each member (K; inactive unless its scene asks).
+      type(observer_type), allocatable :: observers(:)
+      !> One member's vectors, contiguous (n), and its snapshot buffer (J+1).
+      real(wp), allocatable :: vec_u(:), vec_d(:), vec_su(:), vec_s(:), shape(:)
+   end type members_type
+
+contains
+
+   !> Whether K scenes can run in lockstep with `model` (built from the first of them): the
+   !> same A (mesh, beam, dt, beta), the same law and compliance stiffness, the same number of
+   !> steps, the paper's scheme on the full model (no damping, restitution, mass redistribution
+   !> or reduced model), no stops
+   !> along the span, J >= 4. The message names the
+   !> first member and key that differ.
+   subroutine check_lockstep(scenes, model, error)
+      !> The members' validated scenes (K >= 1).
+      type(scene_type), intent(in) :: scenes(:)
+      !> The model built from scenes(1).
+      type(model_type), intent(in) :: model
+      !> Set when a member cannot join the others.
+      type(error_type), allocatable, intent(out) :: error
+      integer :: k
+      if (size(scenes) < 1) then
+         call fatal_error(error, 'lockstep: no members')
+         return
+      end if
+      if (model%n /= 2*scenes(1)%elements .or. model%dt /= scenes(1)%dt .or. model%beta /= scenes(1)%beta) then
+         call fatal_error(error, 'lockstep: the model was not built from the first member''s scene')
+         return
+      end if
+      if (model%n < lockstep_min_unknowns) then
+         call fatal_error(error, 'lockstep: &mesh elements = '//fmt_int(int(scenes(1)%elements, ik))// &
+            & ' is out of range for the lockstep path; allowed: elements >= '// &
+            & fmt_int(int(lockstep_min_unknowns/2, ik)))
+         return
+      end if
+      do k = 1, size(scenes)
+         if (stop_count(scenes(k)) > 0) then
+            call fatal_error(error, 'lockstep: member '//fmt_int(int(k, ik))//' has stops along the span '// &
+               & '(&stops nodes or x); the lockstep path runs tip stops only: run it alone')
+            return
+         end if
+         if (scenes(k)%modes > 0) then
+            call fatal_error(error, 'lockstep: member '//fmt_int(int(k, ik))//' is a reduced model (&mesh modes = '// &
+               & fmt_int(int(scenes(k)%modes, ik))//'); the lockstep path runs the full model: run it alone')
+            return
+         end if
+         if (scenes(k)%restitution /= 0 .or. scenes(k)%damping_mass /= 0 .or. scenes(k)%damping_stiffness /= 0 &
+            & .or. scenes(k)%damping_by_ratio .or. scenes(k)%redistributed_mass) then
+            call fatal_error(error, 'lockstep: member '//fmt_int(int(k, ik))//' asks for damping, restitution or '// &
+               & 'mass redistribution (&damping, &stops restitution or mass); the lockstep path runs the '// &
+               & 'paper''s scheme: run it alone')
+            return
+         end if
+         if (k == 1) cycle
+         call differ(k, 'mesh', 'elements', real(scenes(k)%elements, wp), real(scenes(1)%elements, wp))
+         call differ(k, 'beam', 'length', scenes(k)%length, scenes(1)%length)
+         call differ(k, 'beam', 'k2', scenes(k)%k2, scenes(1)%k2)
+         call differ(k, 'beam', 'mass_per_length', scenes(k)%mass_per_length, scenes(1)%mass_per_length)
+         call differ(k, 'time', 'dt', scenes(k)%dt, scenes(1)%dt)
+         call differ(k, 'time', 'beta', scenes(k)%beta, scenes(1)%beta)
+         call differ(k, 'time', 'steps (t_end/dt)', real(steps_of(scenes(k)), wp), real(steps_of(scenes(1)), wp))
+         if (allocated(error)) return
+         if (scenes(k)%law /= scenes(1)%law) then
+            call fatal_error(error, 'lockstep: member '//fmt_int(int(k, ik))//': &stops law = '''// &
+               & law_name(scenes(k)%law)//''' differs from member 1''s '''//law_name(scenes(1)%law)// &
+               & '''; lockstep members share the contact law')
+            return
+         end if
+         if (scenes(1)%law == law_compliance) &
+            & call differ(k, 'stops', 'stiffness_per_mass', scenes(k)%stiffness_per_mass, scenes(1)%stiffness_per_mass)
+         if (allocated(error)) return
+      end do
+
+   contains
+
+      !> Refuse member k when a value of its scene differs from member 1's.
+      subroutine differ(k, group, key, value, first)
+         integer, intent(in) :: k
+         character(len=*), intent(in) :: group, key
+         real(wp), intent(in) :: value, first
+         if (allocated(error)) return
+         if (value == first) return
+         call fatal_error(error, 'lockstep: member '//fmt_int(int(k, ik))//': &'//group//' '//key//' = '// &
+            & fmt_real(value)//' differs from member 1''s '//fmt_real(first)// &
+            & '; lockstep members share A = M + dt^2 beta S, the contact law and the steps: run it in another group')
+      end subroutine differ
+   end subroutine check_lockstep
+
+   !> Build the model once from the first member, refuse members that cannot join it
+   !> (check_lockstep) and members beyond the stability limit of their scene (check_stability).
+   subroutine prepare_lockstep(scenes, source, model, error)
+      !> The members' validated scenes.
+      type(scene_type), intent(in) :: scenes(:)
+      !> Where the scenes came from, for messages.
+      character(len=*), intent(in) :: source
+      !> The shared model, built from scenes(1).
+      type(model_type), intent(out) :: model
+      !> Set when the group cannot run.
+      type(error_type), allocatable, intent(out) :: error
+      integer :: k
+      if (size(scenes) < 1) then
+         call fatal_error(error, 'lockstep: no members')
+         return
+      end if
+      call build_model(scenes(1), model, error)
+      if (allocated(error)) return
+      call check_lockstep(scenes, model, error)
+      if (allocated(error)) return
+      do k = 1, size(scenes)
+         call check_stability(scenes(k), model, source//' (member '//fmt_int(int(k, ik))//')', error)
+         if (allocated(error)) return
+      end do
+   end subroutine prepare_lockstep
+
+   !> Run K members from t = 0 to their (common) end in lockstep, each feeding its recorder;
+   !> each member's records, snapshots and summary are those of simulate(scenes(k), ...) run
+   !> alone. A member whose recorder fails or whose solution blows up stops (its summary says
+   !> why) and the others go on. cpu_seconds of a summary is the member's share (1/K) of the
+   !> group's time loop.
+   subroutine simulate_lockstep(scenes, model, recorders, summaries, error, initial_displacement)
+      !> The members' validated scenes (K).
+      type(scene_type), intent(in) :: scenes(:)
+      !> The model built from scenes(1) (prepare_lockstep).
+      type(model_type), intent(in) :: model
+      !> One recorder per member (K), all of one type.
+      class(recorder_type), intent(inout) :: recorders(:)
+      !> One summary per member (K).
+      type(run_summary), intent(out) :: summaries(:)
+      !> Set when the group cannot start (a member refused, or its start failed).
+      type(error_type), allocatable, intent(out) :: error
+      !> Initial displacement u0 of the homogeneous unknown of each member (n, K), in place of
+      !> the model's (the members of an &ensemble: model%u0 plus their perturbation).
+      real(wp), intent(in), optional :: initial_displacement(:, :)
+      type(operators_type) :: ops
+      type(members_type) :: ms
+      integer(ik) :: steps, last
+      real(wp) :: t0, kinetic, cap
+      integer :: k, nk
+
+      nk = size(scenes)
+      if (size(recorders) /= nk .or. size(summaries) /= nk) then
+         call fatal_error(error, 'lockstep: '//fmt_int(int(nk, ik))//' scenes need as many recorders and summaries')
+         return
+      end if
+      call check_lockstep(scenes, model, error)
+      if (allocated(error)) return
+      call prepare_solver(model%factor, ops%solver)
+      call prepare_diagonals(model%stiffness, ops%stiffness)
+      call prepare_diagonals(model%mass, ops%mass)
+      if (present(initial_displacement)) then
+         if (size(initial_displacement, 1) /= model%n .or. size(initial_displacement, 2) /= nk) then
+            call fatal_error(error, 'lockstep: the initial displacements must be (n, K) = ('// &
+               & fmt_int(int(model%n, ik))//', '//fmt_int(int(nk, ik))//')')
+            return
+         end if
+      end if
+      call start_members(scenes, model, recorders, ms, error, initial_displacement)
+      if (allocated(error)) return
+
+      steps = steps_of(scenes(1))
+      do k = 1, nk
+         summaries(k)%status = status_running
+      end do
+      t0 = thread_cpu_seconds()
+      do while (ms%step <= steps .and. any(ms%active))
+         last = min(steps, ms%step + block_steps - 1)
+         call advance_members(scenes, model, ops, ms, recorders, last)
+         ms%step = last + 1
+         do k = 1, nk
+            if (.not. ms%active(k)) cycle
+            if (recorders(k)%failed) then
+               summaries(k)%status = status_failed
+               summaries(k)%message = 'the recorder could not write'
+               call finish_member(k, scenes(k), ms, model, summaries(k), t0)
+               cycle
+            end if
+            ms%vec_d = ms%d(lane(k), :, chunk(k))
+            call band_matvec(model%mass, ms%vec_d, ms%vec_s)
+            kinetic = 0.5_wp*dot_product(ms%vec_d, ms%vec_s)/model%dt2
+            cap = 1.0e8_wp*(0.5_wp*scenes(k)%length*(scenes(k)%amplitude*scenes(k)%omega)**2 + abs(ms%energy0(k)) &
+               & + abs(ms%work(k)) + abs(ms%dissipated(k)))
+            if (.not. ieee_is_finite(kinetic) .or. kinetic > cap) then
+               summaries(k)%status = status_diverged
+               summaries(k)%message = 'the solution blew up (kinetic energy beyond 1e8 times the energy supplied) '// &
+                  & 'before t = '//trim(real_text(real(ms%step - 1, wp)*model%dt))//' s'
+               call finish_member(k, scenes(k), ms, model, summaries(k), t0)
+               cycle
+            end if
+            if (ms%observers(k)%active) call ms%observers(k)%drain()
+            call recorders(k)%progress(ms%step - 1, steps)
+         end do
+      end do
+      do k = 1, nk
+         if (ms%active(k)) call finish_member(k, scenes(k), ms, model, summaries(k), t0)
+      end do
+   end subroutine simulate_lockstep
+
+   !> A member leaves the group: its summary (run_scheme's: counts, the energy ledger of
+   !> close_ledger, the shock log and statistics of its observer), and its lanes set to rest
+   !> (zeros stay zeros).
+   subroutine finish_member(k, scene, ms, model, summary, t0)
+      integer, intent(in) :: k
+      type(scene_type), intent(in) :: scene
+      type(members_type), intent(inout) :: ms
+      type(model_type), intent(in) :: model
+      type(run_summary), intent(inout) :: summary
+      real(wp), intent(in) :: t0
+      real(wp) :: dmd, usu, dsu, dsd, e_end, damped
+      summary%cpu_seconds = (thread_cpu_seconds() - t0)/ms%k
+      summary%steps = ms%step - 1
+      summary%t_final = real(summary%steps, wp)*model%dt
+      summary%impacts = ms%impacts(k)
+      summary%max_violation = ms%max_violation(k)
+      summary%contact_phases = ms%impacts(k)
+      ! the ledger (close_ledger): no damping in this path
+      damped = 0
+      ms%vec_u = ms%u(lane(k), :, chunk(k))
+      ms%vec_d = ms%d(lane(k), :, chunk(k))
+      call band_matvec(model%mass, ms%vec_d, ms%vec_s)
+      dmd = dot_product(ms%vec_d, ms%vec_s)
+      call band_matvec(model%stiffness, ms%vec_u, ms%vec_s)
+      usu = dot_product(ms%vec_u, ms%vec_s)
+      dsu = dot_product(ms%vec_d, ms%vec_s)
+      call band_matvec(model%stiffness, ms%vec_d, ms%vec_s)
+      dsd = dot_product(ms%vec_d, ms%vec_s)
+      e_end = energy(model, dmd, usu, dsu, usu - 2*dsu + dsd)
+      summary%work = scene%mass_per_length*ms%work(k)
+      summary%dissipated = scene%mass_per_length*ms%dissipated(k)
+      summary%damped = scene%mass_per_length*damped
+      summary%energy_residual = scene%mass_per_length*((e_end - ms%energy0(k)) &
+         & - (ms%work(k) - ms%dissipated(k) - damped))
+      if (summary%status == status_running .and. ms%step > steps_of(scene)) summary%status = status_complete
+      if (ms%observers(k)%active .and. summary%status /= status_running) then
+         call ms%observers(k)%finish(summary%shocks, summary%statistics)
+         summary%impacts = ms%observers(k)%shocks%shock_count()
+      end if
+      ms%active(k) = .false.
+      ms%u(lane(k), :, chunk(k)) = 0
+      ms%d(lane(k), :, chunk(k)) = 0
+      ms%g(lane(k), :, chunk(k)) = 0
+      ms%p_prev(k) = 0
+      ms%p_now(k) = 0
+   end subroutine finish_member
+
+   !> Start every member by the one-scene start (start_state, which hands each recorder its
+   !> record of t = 0) with the member's load vector and initial velocity, and gather the
+   !> states into the members' arrays.
+   subroutine start_members(scenes, model, recorders, ms, error, initial_displacement)
+      type(scene_type), intent(in) :: scenes(:)
+      type(model_type), intent(in) :: model
+      class(recorder_type), intent(inout) :: recorders(:)
+      type(members_type), intent(out) :: ms
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), intent(in), optional :: initial_displacement(:, :)
+      type(model_type) :: member
+      type(state_type) :: state
+      real(wp), allocatable :: bh(:), b1(:)
+      integer :: k, nk, n
+
+      nk = size(scenes)
+      n = model%n
+      ms%k = nk
+      ms%n = n
+      ms%chunks = (nk + lockstep_lanes - 1)/lockstep_lanes
+      ms%p = ms%chunks*lockstep_lanes
+      allocate (ms%u(lockstep_lanes, n, ms%chunks), ms%d(lockstep_lanes, n, ms%chunks), &
+         & ms%su(lockstep_lanes, n, ms%chunks), ms%rhs(lockstep_lanes, n, ms%chunks), &
+         & ms%g(lockstep_lanes, n, ms%chunks), ms%partial(lockstep_lanes, lockstep_work_columns))
+      ms%u = 0
+      ms%d = 0
+      ms%su = 0
+      ms%rhs = 0
+      ms%g = 0
+      nk = ms%p
+      allocate (ms%sigma_prev(nk), ms%sigma_now(nk), ms%gd_prev(nk), ms%p_prev(nk), ms%p_now(nk), ms%work(nk), &
+         & ms%dissipated(nk), ms%energy0(nk), ms%reaction(nk), ms%max_violation(nk), ms%in_contact(nk), &
+         & ms%active(nk), ms%impacts(nk))
+      allocate (ms%sigma(nk), ms%cosine(nk), ms%cos_step(nk), ms%sin_step(nk))
+      allocate (ms%sigma_next(nk), ms%weight(nk), ms%coef(nk), ms%spring(nk), ms%trial(nk), ms%c(nk), &
+         & ms%tip_value(nk), ms%r_step(nk), ms%u_tip_prev(nk), ms%d_tip_prev(nk), ms%r_prev(nk), ms%usu(nk), &
+         & ms%dsu(nk), ms%dmd(nk), ms%u_old_su(nk), ms%gd(nk), ms%contact(nk), ms%pending(nk), &
+         & ms%next_record(nk), ms%next_snapshot(nk), ms%rows(n_columns, nk))
+      allocate (ms%vec_u(n), ms%vec_d(n), ms%vec_su(n), ms%vec_s(n), ms%shape(size(model%x)))
+      allocate (ms%observers(ms%k))
+      allocate (ms%lower(nk), ms%upper(nk), ms%u_tip(nk), ms%d_tip(nk))
+      call zero_members(ms)
+      ms%lower = -1
+      ms%upper = 1
+      ms%u_tip = 0
+      ms%d_tip = 0
+      ms%active = .false.
+      ms%active(:ms%k) = .true.
+      nk = ms%k
+
+      call load_shapes(scenes(1)%elements, model%h, scenes(1)%length, bh, b1)
+      member = model
+      do k = 1, nk
+         member%load = member_load(scenes(k), bh, b1)
+         if (k == 1) then
+            if (any(member%load /= model%load)) then
+               call fatal_error(error, 'lockstep: internal: the members'' load vectors differ from the model''s')
+               return
+            end if
+         end if
+         member%v0(1::2) = -scenes(k)%amplitude*scenes(k)%omega*lift_shape(model%x(2:), scenes(k)%length)
+         member%v0(2::2) = -scenes(k)%amplitude*scenes(k)%omega*lift_slope(model%x(2:), scenes(k)%length)
+         if (present(initial_displacement)) member%u0 = initial_displacement(:, k)
+         call start_state(scenes(k), member, state, recorders(k), error)
+         if (allocated(error)) then
+            error%message = 'lockstep: member '//fmt_int(int(k, ik))//': '//error%message
+            return
+         end if
+         ms%g(lane(k), :, chunk(k)) = member%load
+         ms%lower(k) = scenes(k)%lower
+         ms%upper(k) = scenes(k)%upper
+         ms%u(lane(k), :, chunk(k)) = state%u
+         ms%d(lane(k), :, chunk(k)) = state%d
+         ms%su(lane(k), :, chunk(k)) = state%su
+         ms%sigma_prev(k) = state%sigma_prev
+         ms%sigma_now(k) = state%sigma_now
+         ms%gd_prev(k) = state%gd_prev
+         ms%p_prev(k) = state%p_prev
+         ms%p_now(k) = state%p_now
+         ms%work(k) = state%work
+         ms%dissipated(k) = state%dissipated
+         ms%energy0(k) = state%energy0
+         ms%reaction(k) = state%reaction
+         ms%max_violation(k) = state%max_violation
+         ms%in_contact(k) = state%in_contact
+         ms%impacts(k) = state%impacts
+         ms%observers(k) = state%observer
+         ms%step = state%step
+      end do
+   end subroutine start_members
+
+   !> Every per-member value zero (the padding lanes keep them).
+   subroutine zero_members(ms)
+      type(members_type), intent(inout) :: ms
+      ms%sigma_prev = 0
+      ms%sigma_now = 0
+      ms%gd_prev = 0
+      ms%p_prev = 0
+      ms%p_now = 0
+      ms%work = 0
+      ms%dissipated = 0
+      ms%energy0 = 0
+      ms%reaction = 0
+      ms%max_violation = 0
+      ms%in_contact = .false.
+      ms%impacts = 0
+      ms%sigma = 0
+      ms%cosine = 0
+      ms%cos_step = 0
+      ms%sin_step = 0
+      ms%sigma_next = 0
+      ms%weight = 0
+      ms%coef = 0
+      ms%spring = 0
+      ms%trial = 0
+      ms%c = 0
+      ms%tip_value = 0
+      ms%r_step = 0
+      ms%u_tip_prev = 0
+      ms%d_tip_prev = 0
+      ms%r_prev = 0
+      ms%usu = 0
+      ms%dsu = 0
+      ms%dmd = 0
+      ms%u_old_su = 0
+      ms%gd = 0
+      ms%contact = .false.
+      ms%pending = .false.
+      ms%next_record = huge(1_ik)
+      ms%next_snapshot = huge(1_ik)
+   end subroutine zero_members
+
+   !> The lane of member k in its chunk.
+   pure integer function lane(k)
+      integer, intent(in) :: k
+      lane = mod(k - 1, lockstep_lanes) + 1
+   end function lane
+
+   !> The chunk of member k.
+   pure integer function chunk(k)
+      integer, intent(in) :: k
+      chunk = (k - 1)/lockstep_lanes + 1
+   end function chunk
+
+   !> A member's load vector g = a (omega^2 (h, phi_i) + 8 k^2/L^4 (1, phi_i)), as build_model
+   !> forms it.
+   function member_load(scene, bh, b1) result(g)
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(in) :: bh(:), b1(:)
+      real(wp) :: g(size(bh))
+      real(wp) :: forcing_scale
+      forcing_scale = 8*scene%k2/scene%length**4
+      g = scene%amplitude*(scene%omega**2*bh + forcing_scale*b1)
+   end function member_load
+
+   !> Load shapes (h, phi_i) and (1, phi_i) by 4-point Gauss quadrature per element (the
+   !> quadrature of beamstops_model, whose routine is private there).
+   pure subroutine load_shapes(elements, h, length, bh, b1)
+      integer, intent(in) :: elements
+      real(wp), intent(in) :: h, length
+      real(wp), allocatable, intent(out) :: bh(:), b1(:)
+      real(wp) :: full_h(2*elements + 2), full_1(2*elements + 2), nq(4), xq
+      integer :: e, q
+      full_h = 0
+      full_1 = 0
+      do e = 1, elements
+         do q = 1, 4
+            nq = hermite_basis(gauss_points(q), h)*gauss_weights(q)*h
+            xq = (e - 1 + gauss_points(q))*h
+            full_h(2*e - 1:2*e + 2) = full_h(2*e - 1:2*e + 2) + nq*lift_shape(xq, length)
+            full_1(2*e - 1:2*e + 2) = full_1(2*e - 1:2*e + 2) + nq
+         end do
+      end do
+      bh = full_h(3:)
+      b1 = full_1(3:)
+   end subroutine load_shapes
+
+   !> Advance every member from ms%step through step `last` (advance_fused of beamstops_scheme,
+   !> per member, the member index innermost).
+   subroutine advance_members(scenes, model, ops, ms, recorders, last)
+      type(scene_type), intent(in) :: scenes(:)
+      type(model_type), intent(in) :: model
+      type(operators_type), intent(in) :: ops
+      type(members_type), intent(inout) :: ms
+      class(recorder_type), intent(inout) :: recorders(:)
+      integer(ik), intent(in) :: last
+      integer(ik) :: step, next_record, next_snapshot
+      integer :: k, c, lo, hi, n, tip, law
+      logical :: energy_wanted, pending, observing
+
+      n = ms%n
+      tip = model%tip
+      law = scenes(1)%law
+      do k = 1, ms%k
+         call first_events(scenes(k), ms%step, ms%next_record(k), ms%next_snapshot(k))
+      end do
+      next_record = minval(ms%next_record)
+      next_snapshot = minval(ms%next_snapshot)
+      observing = any(ms%observers%active)
+      ms%pending = .false.
+      pending = .false.
+      ms%u_old_su = 0
+      ms%dmd = 0
+      call start_loads(ms, ms%step + 1, scenes, model)
+      do step = ms%step, last
+         ms%sigma_next = ms%sigma
+         call next_loads(ms, scenes, model)
+         ms%weight = model%beta*ms%sigma_next + (1 - 2*model%beta)*ms%sigma_now + model%beta*ms%sigma_prev
+         ! the forward pass, a chunk of members after the other
+         ms%coef = model%dt2*ms%weight
+         if (law == law_compliance) ms%spring = model%dt2*((1 - 2*model%beta)*ms%p_now + model%beta*ms%p_prev)
+         energy_wanted = pending .or. step == next_record
+         do c = 1, ms%chunks
+            lo = (c - 1)*lockstep_lanes + 1
+            hi = c*lockstep_lanes
+            call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), ms%coef(lo:hi), ms%g(:, :, c), model%dt2, &
+               & ms%spring(lo:hi), ms%su(:, :, c), ms%rhs(:, :, c))
+            if (energy_wanted) then
+               call lockstep_forward_energy(ops%solver, ops%mass, ms%u(:, :, c), ms%d(:, :, c), ms%su(:, :, c), &
+                  & ms%rhs(:, :, c), ms%usu(lo:hi), ms%dsu(lo:hi), ms%dmd(lo:hi), ms%partial)
+            else
+               call lockstep_forward(ops%solver, ms%rhs(:, :, c))
+            end if
+         end do
+         if (pending) then
+            do k = 1, ms%k
+               if (.not. ms%pending(k)) cycle
+               ms%rows(col_energy, k) = scenes(k)%mass_per_length*energy(model, ms%dmd(k), ms%usu(k), ms%dsu(k), &
+                  & ms%u_old_su(k))
+               if (ms%active(k)) call recorders(k)%record(ms%rows(:, k))
+               ms%pending(k) = .false.
+            end do
+            pending = .false.
+         end if
+         if (energy_wanted) then
+            ms%u_old_su = ms%usu
+         else
+            ms%u_old_su = 0
+         end if
+         ! the back substitution and the tip step: the contact law, the update and the
+         ! bookkeeping (tip_step, close_step)
+         do c = 1, ms%chunks
+            lo = (c - 1)*lockstep_lanes + 1
+            hi = c*lockstep_lanes
+            call lockstep_back(ops%solver, ms%rhs(:, :, c), ms%partial)
+            ms%d_tip_prev(lo:hi) = ms%d(:, tip, c)
+            ms%u_tip_prev(lo:hi) = ms%u(:, tip, c)
+            ms%trial(lo:hi) = ms%u_tip_prev(lo:hi) + (ms%d_tip_prev(lo:hi) + ms%rhs(:, tip, c))
+         end do
+         call contact_law(law, scenes, model, ms)
+         do c = 1, ms%chunks
+            lo = (c - 1)*lockstep_lanes + 1
+            hi = c*lockstep_lanes
+            call lockstep_update(n, ms%rhs(:, :, c), ms%c(lo:hi), model%z, ms%d(:, :, c), ms%u(:, :, c))
+            call lockstep_dot(n, ms%g(:, :, c), ms%d(:, :, c), ms%partial, ms%gd(lo:hi), model%dt2)
+            ms%u_tip(lo:hi) = ms%u(:, tip, c)
+            ms%d_tip(lo:hi) = ms%d(:, tip, c)
+         end do
+         ms%r_prev = ms%reaction
+         call close_steps(law, ms)
+         if (law == law_signorini) then
+            do c = 1, ms%chunks
+               lo = (c - 1)*lockstep_lanes + 1
+               hi = c*lockstep_lanes
+               ms%u(:, tip, c) = ms%u_tip(lo:hi)
+               ms%d(:, tip, c) = ms%d_tip(lo:hi)
+            end do
+         end if
+         ! the shock log and statistics of each member that keeps them
+         if (observing) then
+            do k = 1, ms%k
+               if (ms%observers(k)%active .and. ms%active(k)) call ms%observers(k)%tip(real(step + 1, wp)*model%dt, &
+                  & ms%u_tip(k), ms%reaction(k), ms%dissipated(k))
+            end do
+         end if
+         ! records and snapshots
+         if (step == next_record .or. step == next_snapshot) then
+            do k = 1, ms%k
+               if (step == ms%next_record(k)) then
+                  ms%next_record(k) = ms%next_record(k) + scenes(k)%record_every
+                  call fill_row(scenes(k), model, ms, k, step, ms%rows(:, k))
+                  ms%pending(k) = .true.
+                  pending = .true.
+               end if
+               if (step == ms%next_snapshot(k)) then
+                  ms%next_snapshot(k) = ms%next_snapshot(k) + scenes(k)%snapshot_every
+                  if (ms%active(k)) call take_snapshot(scenes(k), model, ms, k, step, recorders(k))
+               end if
+            end do
+            next_record = minval(ms%next_record)
+            next_snapshot = minval(ms%next_snapshot)
+         end if
+      end do
+      ! S u^{last+1}; it also completes the waiting records, as advance_fused does (one member
+      ! at a time, with the one-member products and dot products).
+      do c = 1, ms%chunks
+         call lockstep_matvec(ops%stiffness, ms%u(:, :, c), ms%su(:, :, c))
+      end do
+      do k = 1, ms%k
+         if (.not. ms%pending(k)) cycle
+         ms%pending(k) = .false.
+         if (.not. ms%active(k)) cycle
+         ms%vec_u = ms%u(lane(k), :, chunk(k))
+         ms%vec_d = ms%d(lane(k), :, chunk(k))
+         ms%vec_su = ms%su(lane(k), :, chunk(k))
+         call diagonal_matvec(ops%mass, ms%vec_d, ms%vec_s)
+         ms%rows(col_energy, k) = scenes(k)%mass_per_length*energy(model, dot(ms%vec_d, ms%vec_s), &
+            & dot(ms%vec_u, ms%vec_su), dot(ms%vec_d, ms%vec_su), ms%u_old_su(k))
+         call recorders(k)%record(ms%rows(:, k))
+      end do
+   end subroutine advance_members
+
+   !> The contact law at the tip of every member (beamstops_scheme's contact_law and the
+   !> projection of beamstops_contact_tip_projection, written over the members): from the
+   !> trial tip values, the multiple c of z, the tip value, the reaction of the step, contact.
+   !> Padding lanes: trial 0 between their stops -1 and 1, so c = 0.
+   subroutine contact_law(law, scenes, model, ms)
+      integer, intent(in) :: law
+      type(scene_type), intent(in) :: scenes(:)
+      type(model_type), intent(in) :: model
+      type(members_type), intent(inout) :: ms
+      real(wp) :: p_next, z_tip
+      integer :: k, c, lo, hi
+      z_tip = model%z(model%tip)
+      select case (law)
+      case (law_signorini)
+         do c = 1, ms%chunks
+            lo = (c - 1)*lockstep_lanes + 1
+            hi = c*lockstep_lanes
+            call project_lanes(ms%trial(lo:hi), ms%lower(lo:hi), ms%upper(lo:hi), z_tip, model%dt2, &
+               & ms%tip_value(lo:hi), ms%c(lo:hi), ms%contact(lo:hi), ms%r_step(lo:hi))
+         end do
+      case (law_compliance)
+         do k = 1, ms%k
+            ms%tip_value(k) = solve_spring_tip(ms%trial(k), scenes(k)%lower, scenes(k)%upper, &
+               & scenes(k)%stiffness_per_mass, model%dt2*model%beta*model%z(model%tip))
+            p_next = spring_force(ms%tip_value(k), scenes(k)%lower, scenes(k)%upper, scenes(k)%stiffness_per_mass)
+            ms%c(k) = model%dt2*model%beta*p_next
+            ms%r_step(k) = model%beta*p_next + (1 - 2*model%beta)*ms%p_now(k) + model%beta*ms%p_prev(k)
+            ms%p_prev(k) = ms%p_now(k)
+            ms%p_now(k) = p_next
+            ms%contact(k) = ms%r_step(k) /= 0
+         end do
+      case default
+         ms%c = 0
+         ms%tip_value = ms%trial
+         ms%r_step = 0
+         ms%contact = .false.
+      end select
+   end subroutine contact_law
+
+   !> After the update, for every member (beamstops_scheme's close_step, written over the
+   !> members, on the gathered tip values u_tip, d_tip): the exact tip value (Signorini), the
+   !> violation, impacts, the work of the load and the energy the stops take, the load averages
+   !> moved on.
+   subroutine close_steps(law, ms)
+      integer, intent(in) :: law
+      type(members_type), intent(inout) :: ms
+      integer :: c, lo, hi
+      do c = 1, ms%chunks
+         lo = (c - 1)*lockstep_lanes + 1
+         hi = c*lockstep_lanes
+         call close_lanes(law, ms%contact(lo:hi), ms%tip_value(lo:hi), ms%u_tip_prev(lo:hi), ms%d_tip_prev(lo:hi), &
+            & ms%lower(lo:hi), ms%upper(lo:hi), ms%weight(lo:hi), ms%gd(lo:hi), ms%r_step(lo:hi), &
+            & ms%sigma_next(lo:hi), ms%u_tip(lo:hi), ms%d_tip(lo:hi), ms%max_violation(lo:hi), ms%impacts(lo:hi), &
+            & ms%in_contact(lo:hi), ms%work(lo:hi), ms%dissipated(lo:hi), ms%reaction(lo:hi), ms%gd_prev(lo:hi), &
+            & ms%sigma_prev(lo:hi), ms%sigma_now(lo:hi))
+      end do
+   end subroutine close_steps
+
+   !> The projection of the trial tip values on the stops of a chunk of lanes (beamstops_contact_
+   !> tip_projection's project_tip): tip value, multiple c of z, contact, reaction of the step.
+   pure subroutine project_lanes(trial, lower, upper, z_tip, dt2, tip_value, c, contact, r_step)
+      real(wp), intent(in) :: trial(lockstep_lanes), lower(lockstep_lanes), upper(lockstep_lanes), z_tip, dt2
+      real(wp), intent(out) :: tip_value(lockstep_lanes), c(lockstep_lanes), r_step(lockstep_lanes)
+      logical, intent(out) :: contact(lockstep_lanes)
+      integer :: k
+!GCC$ ivdep
+!GCC$ vector
+      do k = 1, lockstep_lanes
+         tip_value(k) = min(max(trial(k), lower(k)), upper(k))
+         c(k) = (tip_value(k) - trial(k))/z_tip
+         contact(k) = c(k) /= 0
+         r_step(k) = c(k)/dt2
+      end do
+   end subroutine project_lanes
+
+   !> close_steps for a chunk of lanes.
+   pure subroutine close_lanes(law, contact, tip_value, u_tip_prev, d_tip_prev, lower, upper, weight, gd, r_step, &
+      & sigma_next, u_tip, d_tip, max_violation, impacts, in_contact, work, dissipated, reaction, gd_prev, &
+      & sigma_prev, sigma_now)
+      integer, intent(in) :: law
+      logical, intent(in) :: contact(lockstep_lanes)
+      real(wp), intent(in) :: tip_value(lockstep_lanes), u_tip_prev(lockstep_lanes), d_tip_prev(lockstep_lanes), &
+         & lower(lockstep_lanes), upper(lockstep_lanes), weight(lockstep_lanes), gd(lockstep_lanes), &
+         & r_step(lockstep_lanes), sigma_next(lockstep_lanes)
+      real(wp), intent(inout) :: u_tip(lockstep_lanes), d_tip(lockstep_lanes), max_violation(lockstep_lanes), &
+         & work(lockstep_lanes), dissipated(lockstep_lanes), reaction(lockstep_lanes), gd_prev(lockstep_lanes), &
+         & sigma_prev(lockstep_lanes), sigma_now(lockstep_lanes)
+      integer(ik), intent(inout) :: impacts(lockstep_lanes)
+      logical, intent(inout) :: in_contact(lockstep_lanes)
+      integer :: k
+      if (law == law_signorini) then
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            if (contact(k)) then
+               u_tip(k) = tip_value(k)
+               d_tip(k) = tip_value(k) - u_tip_prev(k)
+            end if
+         end do
+      end if
+      if (law /= law_none) then
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            max_violation(k) = max(max_violation(k), max(u_tip(k) - upper(k), lower(k) - u_tip(k), 0.0_wp))
+         end do
+      end if
+!GCC$ ivdep
+!GCC$ vector
+      do k = 1, lockstep_lanes
+         if (contact(k) .and. .not. in_contact(k)) impacts(k) = impacts(k) + 1
+         in_contact(k) = contact(k)
+         work(k) = work(k) + 0.5_wp*weight(k)*(gd(k) + gd_prev(k))
+         dissipated(k) = dissipated(k) - 0.5_wp*r_step(k)*(d_tip(k) + d_tip_prev(k))
+         reaction(k) = r_step(k)
+         gd_prev(k) = gd(k)
+         sigma_prev(k) = sigma_now(k)
+         sigma_now(k) = sigma_next(k)
+      end do
+   end subroutine close_lanes
+
+   !> Member k's record row of step n, the energy column left for later (fill_row).
+   subroutine fill_row(scene, model, ms, k, step, row)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(members_type), intent(in) :: ms
+      integer, intent(in) :: k
+      integer(ik), intent(in) :: step
+      real(wp), intent(out) :: row(n_columns)
+      row(col_t) = real(step, wp)*model%dt
+      row(col_u) = ms%u_tip_prev(k)
+      row(col_v) = (ms%d(lane(k), model%tip, chunk(k)) + ms%d_tip_prev(k))/(2*model%dt)
+      row(col_reaction) = scene%mass_per_length*ms%r_prev(k)
+      row(col_energy) = 0
+      row(col_work) = scene%mass_per_length*ms%work(k)
+      row(col_dissipated) = scene%mass_per_length*ms%dissipated(k)
+      row(col_damped) = scene%mass_per_length*0.0_wp
+   end subroutine fill_row
+
+   !> Snapshot of member k's u^n (= u^{n+1} - d^n) at t_n (take_snapshot, physical_shape).
+   subroutine take_snapshot(scene, model, ms, k, step, recorder)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(members_type), intent(inout) :: ms
+      integer, intent(in) :: k
+      integer(ik), intent(in) :: step
+      class(recorder_type), intent(inout) :: recorder
+      real(wp) :: phi, t
+      ms%vec_s = ms%u(lane(k), :, chunk(k)) - ms%d(lane(k), :, chunk(k))
+      t = real(step, wp)*model%dt
+      phi = support_position(t, scene%amplitude, scene%omega)
+      ms%shape = model%lift*phi
+      ms%shape(2:) = ms%shape(2:) + ms%vec_s(1::2)
+      call recorder%snapshot(real(step, wp)*model%dt, ms%shape)
+   end subroutine take_snapshot
+
+   !> The load rotation of every member at step k (start_loads): from load_average at the last
+   !> multiple of restart_every, then rotated.
+   subroutine start_loads(ms, k, scenes, model)
+      type(members_type), intent(inout) :: ms
+      integer(ik), intent(in) :: k
+      type(scene_type), intent(in) :: scenes(:)
+      type(model_type), intent(in) :: model
+      call restart_loads(ms, (k/restart_every)*restart_every, scenes, model)
+      do while (ms%load_k < k)
+         call next_loads(ms, scenes, model)
+      end do
+   end subroutine start_loads
+
+   !> The load rotation of every member at step k, exact (restart_loads).
+   subroutine restart_loads(ms, k, scenes, model)
+      type(members_type), intent(inout) :: ms
+      integer(ik), intent(in) :: k
+      type(scene_type), intent(in) :: scenes(:)
+      type(model_type), intent(in) :: model
+      real(wp) :: centre, x, factor
+      integer :: m
+      ms%load_k = k
+      do m = 1, ms%k
+         centre = real(k, wp)*model%dt
+         if (.not. scenes(m)%centered_load) centre = (real(k, wp) + 0.5_wp)*model%dt
+         x = 0.5_wp*scenes(m)%omega*model%dt
+         if (abs(x) < 1.0e-8_wp) then
+            factor = 1 - x**2/6
+         else
+            factor = sin(x)/x
+         end if
+         ms%sigma(m) = load_average(k, model%dt, scenes(m)%omega, scenes(m)%centered_load)
+         ms%cosine(m) = factor*cos(scenes(m)%omega*centre)
+         ms%cos_step(m) = cos(scenes(m)%omega*model%dt)
+         ms%sin_step(m) = sin(scenes(m)%omega*model%dt)
+      end do
+   end subroutine restart_loads
+
+   !> The load rotation of every member moved on by one step (next_load).
+   subroutine next_loads(ms, scenes, model)
+      type(members_type), intent(inout) :: ms
+      type(scene_type), intent(in) :: scenes(:)
+      type(model_type), intent(in) :: model
+      real(wp) :: sigma
+      integer :: m
+      if (mod(ms%load_k + 1, restart_every) == 0) then
+         call restart_loads(ms, ms%load_k + 1, scenes, model)
+         return
+      end if
+      do m = 1, ms%p
+         sigma = ms%sigma(m)*ms%cos_step(m) + ms%cosine(m)*ms%sin_step(m)
+         ms%cosine(m) = ms%cosine(m)*ms%cos_step(m) - ms%sigma(m)*ms%sin_step(m)
+         ms%sigma(m) = sigma
+      end do
+      ms%load_k = ms%load_k + 1
+   end subroutine next_loads
+
+   !> The first recorded step and the first snapshot step at or after `step` (first_events).
+   pure subroutine first_events(scene, step, next_record, next_snapshot)
+      type(scene_type), intent(in) :: scene
+      integer(ik), intent(in) :: step
+      integer(ik), intent(out) :: next_record, next_snapshot
+      next_record = next_multiple(step, int(scene%record_every, ik))
+      next_snapshot = huge(step)
+      if (scene%snapshot_every > 0) next_snapshot = next_multiple(step, int(scene%snapshot_every, ik))
+   end subroutine first_events
+
+   !> The first multiple of `every` at or after `step`.
+   pure function next_multiple(step, every) result(m)
+      integer(ik), intent(in) :: step, every
+      integer(ik) :: m
+      m = ((step + every - 1)/every)*every
+   end function next_multiple
+
+   !> Discrete energy E^{n+1/2} per unit mass (beamstops_scheme's energy).
+   pure function energy(model, dmd, usu, dsu, u_old_s_u_old) result(e)
+      type(model_type), intent(in) :: model
+      real(wp), intent(in) :: dmd, usu, dsu, u_old_s_u_old
+      real(wp) :: e
+      e = 0.5_wp*dmd/model%dt2 + 0.5_wp*(model%beta*usu + model%beta*u_old_s_u_old &
+         & + (1 - 2*model%beta)*(usu - dsu))
+   end function energy
+
+   !> Text of a real for messages.
+   function real_text(x) result(s)
+      real(wp), intent(in) :: x
+      character(len=32) :: s
+      write (s, '(g0.6)') x
+   end function real_text
+end module beamstops_lockstep

@@ -1,0 +1,891 @@
+!> The time loop of a reduced (modal) model (SPEC 11; beamstops_reduced): the paper's scheme in
+!> increment form on q = (modal amplitudes, stop values),
+!>   A_r (d^n - d^{n-1}) = dt^2 (G^n l_r - S_r q^n),  q^{n+1} = q^n + d^n,
+!> with the load rules, starts, contact laws and energy bookkeeping of the full loop (scheme.f90):
+!> the tip projection (Lemma 4.1 with z_r = A_r^{-1} e_tip), the compliance spring at the tip, the
+!> box QP of the stops along the span on C_r = P_r^T A_r^{-1} P_r, or none. The stops are physical
+!> coordinates of q, so the laws are exact; T being a change of basis, the energy
+!>   E^{n+1/2} = 1/2 d^T M_r d/dt^2 + 1/2 [beta q^{n+1} S_r q^{n+1} + beta q^n S_r q^n
+!>               + (1 - 2 beta) q^n S_r q^{n+1}]
+!> is the full model's energy of u = T q, and its balance (SPEC 6) holds as in the full loop.
+!> A step costs O(r m + m^2) (the block solve of A_r and S_r q): the modal block is diagonal.
+!> Records go to the same recorder interface, snapshots expanded to the nodes (u = T q).
+!> The loop allocates nothing and writes nothing itself.
+module beamstops_reduced_scheme
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use beamstops_kinds, only: wp, ik
+   use beamstops_error, only: error_type, fatal_error
+   use beamstops_scene, only: scene_type, steps_of, law_none, law_signorini, law_compliance
+   use beamstops_reduced, only: reduced_model_type, block_solver_type, block_solve, reduced_stiffness_product, &
+      & reduced_mass_product
+   use beamstops_clock, only: thread_cpu_seconds
+   use beamstops_forcing, only: load_average, support_position
+   use beamstops_contact_tip_projection, only: project_tip
+   use beamstops_contact_compliance, only: spring_force, solve_spring_tip
+   use beamstops_contact_span_stops, only: span_stops_type, span_work_type, new_span_work, span_energy
+   use beamstops_contact_box_qp, only: qp_solved, qp_message
+   use beamstops_observe_observer, only: observer_type, new_observer
+   use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
+      & col_work, col_dissipated
+   use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running
+   implicit none
+   private
+   public :: reduced_state_type, start_reduced, advance_reduced, run_reduced, simulate_reduced, reduced_block_steps
+
+   !> Steps between progress reports and divergence checks.
+   integer(ik), parameter :: reduced_block_steps = 8192_ik
+
+   ! The load averages step after step by rotation, as the full loop's: a private copy of the
+   ! load_rotation that the physics branch moves into beamstops_forcing (same names, same
+   ! arithmetic); after the merge, use beamstops_forcing's and delete this one.
+   type :: load_rotation
+      integer(ik) :: k = 0
+      real(wp) :: sigma = 0, cosine = 0
+      real(wp) :: cos_step = 1, sin_step = 0
+      real(wp) :: dt = 0, omega = 0
+      logical :: centered = .true.
+   end type load_rotation
+   integer(ik), parameter :: restart_every = 64
+
+   !> Everything the reduced loop carries from step n to step n + 1.
+   type :: reduced_state_type
+      !> Index n of the next step (the step that computes q^{n+1}).
+      integer(ik) :: step = 1
+      !> q^n and d^{n-1} = q^n - q^{n-1} (r + m).
+      real(wp), allocatable :: q(:), d(:)
+      !> S_r q^n, and the right-hand side / increment of a step (r + m).
+      real(wp), allocatable :: sq(:), x(:)
+      !> B^T D^{-1} y_a of a step, and the multipliers of the stops acting in it (m).
+      real(wp), allocatable :: acc(:), multiplier(:)
+      !> The stop coordinates (1..m) acting in a step: active(1:n_active) (m).
+      integer, allocatable :: active(:)
+      !> Number of stops acting in the step.
+      integer :: n_active = 0
+      !> Snapshot buffer: physical displacement at the nodes x_0..x_J (J + 1).
+      real(wp), allocatable :: shape(:)
+      !> Load averages sigma_{n-1}, sigma_n.
+      real(wp) :: sigma_prev = 0, sigma_now = 0
+      !> l_r . d^{n-1}.
+      real(wp) :: gd_prev = 0
+      !> Spring forces p(u^{n-1}), p(u^n) at the tip (compliance).
+      real(wp) :: p_prev = 0, p_now = 0
+      !> Work of the load and energy taken by the stops so far, per unit mass.
+      real(wp) :: work = 0, dissipated = 0
+      !> E^{1/2} per unit mass (reference of the divergence check).
+      real(wp) :: energy0 = 0
+      !> Reaction per unit mass at the tip of the step that gave q^n.
+      real(wp) :: reaction = 0
+      !> The same for each stop along the span (m; unallocated without them).
+      real(wp), allocatable :: stop_reaction(:)
+      !> Stops along the span: the program on C_r and its work arrays.
+      type(span_work_type) :: span
+      !> Whether the previous step was in contact.
+      logical :: in_contact = .false.
+      !> Impacts so far.
+      integer(ik) :: impacts = 0
+      !> CPU time of the loop so far (s).
+      real(wp) :: cpu_seconds = 0
+      !> Largest violation of the stops so far (m).
+      real(wp) :: max_violation = 0
+      !> The shock log and the running statistics (&statistics enabled).
+      type(observer_type) :: observer
+   end type reduced_state_type
+
+contains
+
+   !> Run a reduced model from t = 0 to t_end, feeding `recorder` (the entry run.f90 dispatches to
+   !> when scene%modes > 0, with the model from prepare_reduced).
+   subroutine simulate_reduced(scene, reduced, recorder, summary, error)
+      !> Validated scene.
+      type(scene_type), intent(in) :: scene
+      !> Its reduced model (prepare_reduced).
+      type(reduced_model_type), intent(in) :: reduced
+      !> Receives records and snapshots.
+      class(recorder_type), intent(inout) :: recorder
+      !> Outcome.
+      type(run_summary), intent(out) :: summary
+      !> Set when the run cannot start.
+      type(error_type), allocatable, intent(out) :: error
+      type(reduced_state_type) :: state
+      call start_reduced(scene, reduced, state, recorder, error)
+      if (allocated(error)) return
+      call run_reduced(scene, reduced, state, recorder, summary)
+   end subroutine simulate_reduced
+
+   !> Start: q^0 = q0 and q^1 by the Taylor start (M_r a0 = G(0) l_r - S_r q0 + p(u0_tip) e_tip) or
+   !> the Euler start, projected into K; hands the record (and snapshot) of t = 0 to the recorder.
+   subroutine start_reduced(scene, reduced, state, recorder, error)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      !> Its reduced model.
+      type(reduced_model_type), intent(in) :: reduced
+      !> State at n = 1 on return.
+      type(reduced_state_type), intent(out) :: state
+      !> Receives the record of t = 0.
+      class(recorder_type), intent(inout) :: recorder
+      !> Set when the start's contact problem fails.
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: c, tip_value, row(n_columns), dt
+      integer :: s, pt
+
+      s = reduced%size
+      dt = reduced%dt
+      pt = tip_coordinate(reduced)
+      allocate (state%q(s), state%d(s), state%sq(s), state%x(s), state%shape(size(reduced%x)))
+      allocate (state%acc(reduced%m), state%multiplier(reduced%m), state%active(reduced%m))
+      state%q = reduced%q0 + dt*reduced%v0
+      if (scene%taylor_start) then
+         call reduced_stiffness_product(reduced, reduced%q0, state%sq)
+         state%x = support_position(0.0_wp, 1.0_wp, scene%omega)*reduced%load - state%sq
+         if (scene%law == law_compliance .and. pt > 0) state%x(pt) = state%x(pt) + &
+            & spring_force(reduced%q0(pt), scene%lower, scene%upper, scene%stiffness_per_mass)
+         call block_solve(reduced%m_solver, state%x)
+         state%q = state%q + 0.5_wp*reduced%dt2*state%x
+      end if
+      if (reduced%stops%m > 0) then
+         call start_span(scene, reduced, state, error)
+         if (allocated(error)) return
+      else if (scene%law == law_signorini) then
+         call project_tip(state%q(pt), scene%lower, scene%upper, reduced%z(pt, reduced%tip_stop), c, tip_value)
+         state%q = state%q + c*reduced%z(:, reduced%tip_stop)
+         state%q(pt) = tip_value
+      end if
+      state%d = state%q - reduced%q0
+      state%sigma_prev = load_average(0_ik, dt, scene%omega, scene%centered_load)
+      state%sigma_now = load_average(1_ik, dt, scene%omega, scene%centered_load)
+      state%gd_prev = dot_product(reduced%load, state%d)
+      if (scene%law == law_compliance .and. pt > 0) then
+         state%p_prev = spring_force(reduced%q0(pt), scene%lower, scene%upper, scene%stiffness_per_mass)
+         state%p_now = spring_force(state%q(pt), scene%lower, scene%upper, scene%stiffness_per_mass)
+      end if
+      if (scene%law /= law_none .and. reduced%stops%m == 0) state%max_violation = violation(state%q(pt), scene)
+      call reduced_stiffness_product(reduced, reduced%q0, state%x)
+      call reduced_stiffness_product(reduced, state%q, state%sq)
+      state%energy0 = energy(reduced, reduced_mass_product(reduced, state%d), dot_product(state%q, state%sq), &
+         & dot_product(state%d, state%sq), dot_product(reduced%q0, state%x))
+      row = 0
+      row(col_u) = dot_product(reduced%tip_row, reduced%q0)
+      row(col_v) = dot_product(reduced%tip_row, reduced%v0)
+      row(col_energy) = scene%mass_per_length*state%energy0
+      if (reduced%stops%m > 0) then
+         state%span%record_u = reduced%q0(reduced%r + 1:) + reduced%stops%lift*support_position(0.0_wp, &
+            & scene%amplitude, scene%omega)
+         state%span%record_reaction = 0
+         call recorder%record_stops(state%span%record_u, state%span%record_reaction)
+      end if
+      call recorder%record(row)
+      if (scene%snapshot_every > 0) then
+         call physical_shape(reduced, reduced%q0, 0.0_wp, scene, state%shape)
+         call recorder%snapshot(0.0_wp, state%shape)
+      end if
+      state%step = 1
+      if (scene%statistics) then
+         if (reduced%stops%m > 0) then
+            call new_observer(state%observer, reduced%stops%m, reduced%q0(reduced%r + 1:) + reduced%stops%lift* &
+               & support_position(0.0_wp, scene%amplitude, scene%omega), scene%mass_per_length, reduced%dt, &
+               & scene%rest_time, scene%transient, scene%t_end, scene%batches, scene%bins, scene%histogram_lower, &
+               & scene%histogram_upper, 0.0_wp, error)
+            if (allocated(error)) return
+            call state%observer%span(reduced%dt, state%q(reduced%r + 1:) + reduced%stops%lift* &
+               & support_position(reduced%dt, scene%amplitude, scene%omega), state%stop_reaction, &
+               & dot_product(reduced%tip_row, state%q), state%dissipated)
+         else
+            call new_observer(state%observer, 1, [dot_product(reduced%tip_row, reduced%q0)], scene%mass_per_length, &
+               & reduced%dt, scene%rest_time, scene%transient, scene%t_end, scene%batches, scene%bins, &
+               & scene%histogram_lower, scene%histogram_upper, 0.0_wp, error)
+            if (allocated(error)) return
+            call state%observer%tip(reduced%dt, dot_product(reduced%tip_row, state%q), state%reaction, state%dissipated)
+         end if
+      end if
+   end subroutine start_reduced
+
+   !> The stops along the span at the start: their work arrays, and q^1 projected on the bounds of
+   !> t_1 (the QP on the trial values of q^1 at the stops).
+   subroutine start_span(scene, reduced, state, error)
+      type(scene_type), intent(in) :: scene
+      type(reduced_model_type), intent(in) :: reduced
+      type(reduced_state_type), intent(inout) :: state
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: c, worst
+      integer :: col
+      allocate (state%stop_reaction(reduced%stops%m))
+      state%stop_reaction = 0
+      call new_span_work(state%span, reduced%stops, error)
+      if (allocated(error)) return
+      if (scene%law /= law_signorini) return
+      state%x = 0
+      call stops_contact(reduced%stops, state%span, state%q, state%x, state%x, &
+         & support_position(reduced%dt, scene%amplitude, scene%omega), .true., state%span%info)
+      if (state%span%info /= qp_solved) then
+         call fatal_error(error, 'the start q^1: '//qp_message(state%span%info))
+         return
+      end if
+      call correction(reduced, state%span, state%x, c, col)
+      if (col > 0) then
+         state%q = state%q + c*reduced%z(:, col)
+      else
+         state%q = state%q + state%x
+      end if
+      worst = 0
+      state%x = 0
+      call stops_settle(reduced%stops, state%span, state%q, state%x, worst)
+      state%max_violation = worst
+   end subroutine start_span
+
+   !> Run from the state's step to the scene's last step in blocks; between blocks the
+   !> divergence check and progress (no checkpoints: validate_reduced refuses them). Fills the
+   !> summary.
+   subroutine run_reduced(scene, reduced, state, recorder, summary)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      !> Its reduced model.
+      type(reduced_model_type), intent(in) :: reduced
+      !> State (from start_reduced), advanced to the end.
+      type(reduced_state_type), intent(inout) :: state
+      !> Receives the records.
+      class(recorder_type), intent(inout) :: recorder
+      !> Outcome of the run.
+      type(run_summary), intent(inout) :: summary
+      integer(ik) :: steps, last, done
+      real(wp) :: t0, kinetic, cap
+      steps = steps_of(scene)
+      summary%status = status_running
+      t0 = thread_cpu_seconds() - state%cpu_seconds
+      do while (state%step <= steps)
+         last = min(steps, state%step + reduced_block_steps - 1)
+         call advance_reduced(scene, reduced, state, recorder, last, done)
+         state%cpu_seconds = thread_cpu_seconds() - t0
+         if (recorder%failed) then
+            summary%status = status_failed
+            summary%message = 'the recorder could not write'
+            exit
+         end if
+         if (state%span%info /= qp_solved) then
+            summary%status = status_failed
+            summary%message = qp_message(state%span%info)//' at t = '// &
+               & trim(real_text(real(state%step, wp)*reduced%dt))//' s'
+            exit
+         end if
+         kinetic = 0.5_wp*reduced_mass_product(reduced, state%d)/reduced%dt2
+         cap = 1.0e8_wp*(0.5_wp*scene%length*(scene%amplitude*scene%omega)**2 + abs(state%energy0) &
+            & + abs(state%work) + abs(state%dissipated))
+         if (.not. ieee_is_finite(kinetic) .or. kinetic > cap) then
+            summary%status = status_diverged
+            summary%message = 'the solution blew up (kinetic energy beyond 1e8 times the energy supplied) '// &
+               & 'before t = '//trim(real_text(real(state%step - 1, wp)*reduced%dt))//' s'
+            exit
+         end if
+         if (state%observer%active) call state%observer%drain()
+         call recorder%progress(state%step - 1, steps)
+      end do
+      summary%cpu_seconds = state%cpu_seconds
+      summary%steps = state%step - 1
+      summary%t_final = real(summary%steps, wp)*reduced%dt
+      summary%impacts = state%impacts
+      summary%contact_phases = state%impacts
+      summary%max_violation = state%max_violation
+      if (summary%status == status_running) summary%status = status_complete
+      if (state%observer%active) then
+         call state%observer%finish(summary%shocks, summary%statistics)
+         summary%impacts = state%observer%shocks%shock_count()
+      end if
+   end subroutine run_reduced
+
+   !> Advance from state%step through step `last` (computing q^{last+1}), recording on the way.
+   !> `done` is the last step done: `last`, unless the QP of a step fails (state%span%info).
+   subroutine advance_reduced(scene, reduced, state, recorder, last, done)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      !> Its reduced model.
+      type(reduced_model_type), intent(in) :: reduced
+      !> State, advanced.
+      type(reduced_state_type), intent(inout) :: state
+      !> Receives the records.
+      class(recorder_type), intent(inout) :: recorder
+      !> Last step to do.
+      integer(ik), intent(in) :: last
+      !> Last step done.
+      integer(ik), intent(out) :: done
+      integer(ik) :: step, next_record, next_snapshot
+      integer :: pt
+      real(wp) :: sigma_next, weight, c, gd, tip_value, r_step, r_prev, old_tip, old_dtip
+      real(wp) :: u_tip_prev, d_tip_prev, u_old_su, phi_prev, phi_now, phi_next, dt2, row(n_columns)
+      real(wp) :: usu, dsu, dmd
+      logical :: contact, recording, span, enforce
+      type(load_rotation) :: loads
+
+      dt2 = reduced%dt2
+      pt = tip_coordinate(reduced)
+      span = reduced%stops%m > 0
+      enforce = scene%law == law_signorini
+      next_record = next_multiple(state%step, int(scene%record_every, ik))
+      next_snapshot = huge(step)
+      if (scene%snapshot_every > 0) next_snapshot = next_multiple(state%step, int(scene%snapshot_every, ik))
+      done = state%step - 1
+      u_old_su = 0
+      u_tip_prev = 0
+      d_tip_prev = 0
+      phi_prev = support_position(real(state%step - 1, wp)*reduced%dt, scene%amplitude, scene%omega)
+      phi_now = support_position(real(state%step, wp)*reduced%dt, scene%amplitude, scene%omega)
+      call start_loads(loads, state%step + 1, reduced%dt, scene%omega, scene%centered_load)
+      do step = state%step, last
+         sigma_next = loads%sigma
+         call next_load(loads)
+         weight = reduced%beta*sigma_next + (1 - 2*reduced%beta)*state%sigma_now + reduced%beta*state%sigma_prev
+         recording = step == next_record
+         if (recording) then
+            u_old_su = stiffness_norm2(reduced, state%q)
+            u_tip_prev = tip_value_of(reduced, state%q)
+            d_tip_prev = tip_value_of(reduced, state%d)
+         end if
+         ! x = A_r^{-1} dt^2 (weight l_r - S_r q): the modal part left as D^{-1} y_a (modal_rhs), the
+         ! stop part complete; the modal part is finished by modal_update with the contact's
+         ! correction.
+         call modal_rhs(reduced%r, reduced%m, reduced%a_solver%dinv, reduced%a_solver%b, reduced%lambda, &
+            & reduced%load, state%q, dt2, weight, state%x, state%acc)
+         call stop_rhs(reduced, state%q, dt2, weight, state%acc, state%x)
+         r_prev = state%reaction
+         if (span) then
+            phi_next = support_position(real(step + 1, wp)*reduced%dt, scene%amplitude, scene%omega)
+            call stop_solve(reduced%a_solver, state%x)
+            call stops_contact(reduced%stops, state%span, state%q, state%d, state%x, phi_next, enforce, state%span%info)
+            if (state%span%info /= qp_solved) exit
+            state%n_active = 0
+            if (state%span%contact) then
+               state%n_active = state%span%qp%n_active
+               state%active(:state%n_active) = state%span%qp%active(:state%n_active)
+               state%multiplier(:state%n_active) = state%span%lambda(state%active(:state%n_active))
+            end if
+            call modal_update(reduced%r, reduced%m, reduced%size, reduced%a_solver%w, reduced%z, reduced%load, &
+               & state%n_active, state%active, state%multiplier, state%x, state%d, state%q, gd)
+            contact = state%span%contact
+            if (enforce) call stops_settle(reduced%stops, state%span, state%q, state%d, state%max_violation)
+            r_step = 0
+            if (reduced%stops%tip > 0) r_step = state%span%lambda(reduced%stops%tip)/dt2
+            if (contact .and. .not. state%in_contact) state%impacts = state%impacts + 1
+            state%in_contact = contact
+            state%work = state%work + 0.5_wp*weight*(gd + state%gd_prev)
+            call span_energy(reduced%stops, state%span, state%d, dt2, phi_next - phi_prev, state%dissipated, &
+               & state%work)
+            state%reaction = r_step
+            if (recording) then
+               state%span%record_u = state%span%u_prev + reduced%stops%lift*phi_now
+               state%span%record_reaction = scene%mass_per_length*state%stop_reaction
+               call recorder%record_stops(state%span%record_u, state%span%record_reaction)
+            end if
+            state%stop_reaction = state%span%lambda/dt2
+            if (state%observer%active) call state%observer%span(real(step + 1, wp)*reduced%dt, &
+               & state%q(reduced%r + 1:) + reduced%stops%lift*phi_next, state%stop_reaction, &
+               & dot_product(reduced%tip_row, state%q), state%dissipated)
+            phi_prev = phi_now
+            phi_now = phi_next
+         else
+            if (scene%law == law_compliance) state%x(pt) = state%x(pt) + &
+               & dt2*((1 - 2*reduced%beta)*state%p_now + reduced%beta*state%p_prev)
+            call stop_solve(reduced%a_solver, state%x)
+            old_tip = state%q(pt)
+            old_dtip = state%d(pt)
+            call contact_law(scene, reduced, state, old_tip + (old_dtip + state%x(pt)), c, tip_value, r_step, contact)
+            state%n_active = 0
+            if (c /= 0) then
+               state%n_active = 1
+               state%active(1) = reduced%tip_stop
+               state%multiplier(1) = c
+            end if
+            call modal_update(reduced%r, reduced%m, reduced%size, reduced%a_solver%w, reduced%z, reduced%load, &
+               & state%n_active, state%active, state%multiplier, state%x, state%d, state%q, gd)
+            if (scene%law == law_signorini .and. contact) then
+               state%q(pt) = tip_value
+               state%d(pt) = tip_value - old_tip
+            end if
+            if (scene%law /= law_none) state%max_violation = max(state%max_violation, violation(state%q(pt), scene))
+            if (contact .and. .not. state%in_contact) state%impacts = state%impacts + 1
+            state%in_contact = contact
+            state%work = state%work + 0.5_wp*weight*(gd + state%gd_prev)
+            state%dissipated = state%dissipated - 0.5_wp*r_step*(state%d(pt) + old_dtip)
+            state%reaction = r_step
+            if (state%observer%active) call state%observer%tip(real(step + 1, wp)*reduced%dt, state%q(pt), r_step, &
+               & state%dissipated)
+         end if
+         state%gd_prev = gd
+         state%sigma_prev = state%sigma_now
+         state%sigma_now = sigma_next
+         if (recording) then
+            next_record = next_record + scene%record_every
+            row = 0
+            row(col_t) = real(step, wp)*reduced%dt
+            row(col_u) = u_tip_prev
+            row(col_v) = (tip_value_of(reduced, state%d) + d_tip_prev)/(2*reduced%dt)
+            row(col_reaction) = scene%mass_per_length*r_prev
+            row(col_work) = scene%mass_per_length*state%work
+            row(col_dissipated) = scene%mass_per_length*state%dissipated
+            call energy_terms(reduced%r, reduced%m, reduced%lambda, reduced%a_solver%b, state%q, state%d, state%acc, &
+               & usu, dsu, dmd)
+            call stop_energy_terms(reduced, state%q, state%d, usu, dsu, dmd)
+            row(col_energy) = scene%mass_per_length*energy(reduced, dmd, usu, dsu, u_old_su)
+            call recorder%record(row)
+         end if
+         if (step == next_snapshot) then
+            next_snapshot = next_snapshot + scene%snapshot_every
+            state%x = state%q - state%d
+            call physical_shape(reduced, state%x, real(step, wp)*reduced%dt, scene, state%shape)
+            call recorder%snapshot(real(step, wp)*reduced%dt, state%shape)
+         end if
+         done = step
+      end do
+      state%step = done + 1
+   end subroutine advance_reduced
+
+   !> load_rotation at step k: from load_average at the last multiple of restart_every, then
+   !> rotated, so that the value of every step is the same however the run is cut into calls.
+   pure subroutine start_loads(loads, k, dt, omega, centered)
+      type(load_rotation), intent(out) :: loads
+      integer(ik), intent(in) :: k
+      real(wp), intent(in) :: dt, omega
+      logical, intent(in) :: centered
+      loads%dt = dt
+      loads%omega = omega
+      loads%centered = centered
+      call restart_loads(loads, (k/restart_every)*restart_every)
+      do while (loads%k < k)
+         call next_load(loads)
+      end do
+   end subroutine start_loads
+
+   !> load_rotation at step k, exact: load_average and the same centre and factor for the cosine.
+   pure subroutine restart_loads(loads, k)
+      type(load_rotation), intent(inout) :: loads
+      integer(ik), intent(in) :: k
+      real(wp) :: centre, x, factor
+      centre = real(k, wp)*loads%dt
+      if (.not. loads%centered) centre = (real(k, wp) + 0.5_wp)*loads%dt
+      x = 0.5_wp*loads%omega*loads%dt
+      if (abs(x) < 1.0e-8_wp) then
+         factor = 1 - x**2/6
+      else
+         factor = sin(x)/x
+      end if
+      loads%k = k
+      loads%sigma = load_average(k, loads%dt, loads%omega, loads%centered)
+      loads%cosine = factor*cos(loads%omega*centre)
+      loads%cos_step = cos(loads%omega*loads%dt)
+      loads%sin_step = sin(loads%omega*loads%dt)
+   end subroutine restart_loads
+
+   !> load_rotation moved on to step k + 1.
+   pure subroutine next_load(loads)
+      type(load_rotation), intent(inout) :: loads
+      real(wp) :: sigma
+      if (mod(loads%k + 1, restart_every) == 0) then
+         call restart_loads(loads, loads%k + 1)
+         return
+      end if
+      sigma = loads%sigma*loads%cos_step + loads%cosine*loads%sin_step
+      loads%cosine = loads%cosine*loads%cos_step - loads%sigma*loads%sin_step
+      loads%sigma = sigma
+      loads%k = loads%k + 1
+   end subroutine next_load
+
+   !> The tip value of a reduced vector: its tip coordinate when the tip is a stop, else T(tip, :) q.
+   pure function tip_value_of(reduced, q) result(u)
+      type(reduced_model_type), intent(in) :: reduced
+      real(wp), intent(in) :: q(:)
+      real(wp) :: u
+      if (reduced%tip_stop > 0) then
+         u = q(reduced%r + reduced%tip_stop)
+      else
+         u = dot_product(reduced%tip_row, q)
+      end if
+   end function tip_value_of
+
+   !> q^T S_r q = sum lambda_k a_k^2 + p^T K_pp p.
+   pure function stiffness_norm2(reduced, q) result(qsq)
+      type(reduced_model_type), intent(in) :: reduced
+      real(wp), intent(in) :: q(:)
+      real(wp) :: qsq
+      integer :: r, i, j
+      real(wp) :: acc
+      r = reduced%r
+      qsq = 0
+      do i = 1, r
+         qsq = qsq + reduced%lambda(i)*q(i)*q(i)
+      end do
+      do j = 1, reduced%m
+         acc = 0
+         do i = 1, reduced%m
+            acc = acc + reduced%stiffness_pp(i, j)*q(r + i)
+         end do
+         qsq = qsq + q(r + j)*acc
+      end do
+   end function stiffness_norm2
+
+   !> The modal parts of q.S_r q, d.S_r q and d.M_r d in one sweep (the coupling's B d_a kept in
+   !> dmd as d_p . (B^T d_a), twice).
+   pure subroutine energy_terms(r, m, lambda, b, q, d, bd, usu, dsu, dmd)
+      integer, intent(in) :: r, m
+      real(wp), intent(in) :: lambda(r), b(r, m), q(r + m), d(r + m)
+      !> Workspace (m).
+      real(wp), intent(out) :: bd(m)
+      real(wp), intent(out) :: usu, dsu, dmd
+      integer :: i, j
+      real(wp) :: b1
+      usu = 0
+      dsu = 0
+      dmd = 0
+      bd = 0
+      b1 = 0
+      do i = 1, r
+         usu = usu + lambda(i)*q(i)*q(i)
+         dsu = dsu + lambda(i)*d(i)*q(i)
+         dmd = dmd + d(i)*d(i)
+         b1 = b1 + b(i, 1)*d(i)
+      end do
+      bd(1) = b1
+      do j = 2, m
+         bd(j) = dot_product(b(:, j), d(1:r))
+      end do
+      do j = 1, m
+         dmd = dmd + 2*d(r + j)*bd(j)
+      end do
+   end subroutine energy_terms
+
+   !> The stop block's parts of q.S_r q, d.S_r q and d.M_r d, added (O(m^2)).
+   pure subroutine stop_energy_terms(reduced, q, d, usu, dsu, dmd)
+      type(reduced_model_type), intent(in) :: reduced
+      real(wp), intent(in) :: q(:), d(:)
+      real(wp), intent(inout) :: usu, dsu, dmd
+      integer :: r, i, j
+      real(wp) :: kq, md
+      r = reduced%r
+      do j = 1, reduced%m
+         kq = 0
+         md = 0
+         do i = 1, reduced%m
+            kq = kq + reduced%stiffness_pp(i, j)*q(r + i)
+            md = md + reduced%mass_pp(i, j)*d(r + i)
+         end do
+         usu = usu + q(r + j)*kq
+         dsu = dsu + d(r + j)*kq
+         dmd = dmd + d(r + j)*md
+      end do
+   end subroutine stop_energy_terms
+
+   !> First pass over the modal coordinates: x_a = D^{-1} dt^2 (weight l_a - Lambda a) and
+   !> acc = B^T x_a, in one sweep (O(r m)).
+   pure subroutine modal_rhs(r, m, dinv, b, lambda, load, q, dt2, weight, x, acc)
+      integer, intent(in) :: r, m
+      real(wp), intent(in) :: dinv(r), b(r, m), lambda(r), load(r + m), q(r + m), dt2, weight
+      real(wp), intent(inout) :: x(r + m)
+      real(wp), intent(out) :: acc(m)
+      integer :: i, j
+      real(wp) :: xi, a1
+      if (m == 1) then
+         a1 = 0
+         do i = 1, r
+            xi = dinv(i)*(dt2*(weight*load(i) - lambda(i)*q(i)))
+            x(i) = xi
+            a1 = a1 + b(i, 1)*xi
+         end do
+         acc(1) = a1
+      else
+         do i = 1, r
+            x(i) = dinv(i)*(dt2*(weight*load(i) - lambda(i)*q(i)))
+         end do
+         do j = 1, m
+            a1 = 0
+            do i = 1, r
+               a1 = a1 + b(i, j)*x(i)
+            end do
+            acc(j) = a1
+         end do
+      end if
+   end subroutine modal_rhs
+
+   !> The stop part of the right-hand side less B^T D^{-1} y_a: dt^2 (weight l_p - K_pp p) - acc.
+   pure subroutine stop_rhs(reduced, q, dt2, weight, acc, x)
+      type(reduced_model_type), intent(in) :: reduced
+      real(wp), intent(in) :: q(:), dt2, weight, acc(:)
+      real(wp), intent(inout) :: x(:)
+      integer :: j, k, r
+      real(wp) :: kq
+      r = reduced%r
+      do j = 1, reduced%m
+         kq = 0
+         do k = 1, reduced%m
+            kq = kq + reduced%stiffness_pp(j, k)*q(r + k)
+         end do
+         x(r + j) = dt2*(weight*reduced%load(r + j) - kq) - acc(j)
+      end do
+   end subroutine stop_rhs
+
+   !> x_p = H^{-1} x_p (R^T R = H) in place.
+   pure subroutine stop_solve(solver, x)
+      type(block_solver_type), intent(in) :: solver
+      real(wp), intent(inout) :: x(:)
+      integer :: i, j, r, m
+      real(wp) :: acc
+      r = solver%r
+      m = solver%m
+      if (m == 1) then
+         x(r + 1) = x(r + 1)*(solver%rdiag(1)*solver%rdiag(1))
+         return
+      end if
+      do j = 1, m
+         acc = x(r + j)
+         do i = 1, j - 1
+            acc = acc - solver%hfac(i, j)*x(r + i)
+         end do
+         x(r + j) = acc*solver%rdiag(j)
+      end do
+      do j = m, 1, -1
+         acc = x(r + j)
+         do i = j + 1, m
+            acc = acc - solver%hfac(j, i)*x(r + i)
+         end do
+         x(r + j) = acc*solver%rdiag(j)
+      end do
+   end subroutine stop_solve
+
+   !> Second pass, the update: x_a = D^{-1} y_a - W x_p, plus the contact's correction
+   !> sum_k multiplier_k z(:, active_k) on every coordinate; d^n = d^{n-1} + x, q^{n+1} = q^n + d^n,
+   !> and gd = l_r . d^n, in one sweep (O(r (m + n_active))).
+   pure subroutine modal_update(r, m, s, w, z, load, n_active, active, multiplier, x, d, q, gd)
+      integer, intent(in) :: r, m, s, n_active
+      real(wp), intent(in) :: w(r, m), z(s, m), load(s)
+      integer, intent(in) :: active(m)
+      real(wp), intent(in) :: multiplier(m)
+      real(wp), intent(inout) :: x(s), d(s), q(s)
+      real(wp), intent(out) :: gd
+      integer :: i, j, a
+      real(wp) :: xi, xp, c
+      gd = 0
+      if (m == 1 .and. n_active == 0) then
+         xp = x(r + 1)
+         do i = 1, r
+            d(i) = d(i) + (x(i) - w(i, 1)*xp)
+            q(i) = q(i) + d(i)
+            gd = gd + load(i)*d(i)
+         end do
+      else if (m == 1) then
+         xp = x(r + 1)
+         c = multiplier(1)
+         do i = 1, r
+            d(i) = d(i) + ((x(i) - w(i, 1)*xp) + c*z(i, 1))
+            q(i) = q(i) + d(i)
+            gd = gd + load(i)*d(i)
+         end do
+      else
+         do j = 1, m
+            xp = x(r + j)
+            do i = 1, r
+               x(i) = x(i) - w(i, j)*xp
+            end do
+         end do
+         do j = 1, n_active
+            a = active(j)
+            c = multiplier(j)
+            do i = 1, r
+               x(i) = x(i) + c*z(i, a)
+            end do
+         end do
+         do i = 1, r
+            d(i) = d(i) + x(i)
+            q(i) = q(i) + d(i)
+            gd = gd + load(i)*d(i)
+         end do
+      end if
+      do i = r + 1, s
+         xi = x(i)
+         do j = 1, n_active
+            xi = xi + multiplier(j)*z(i, active(j))
+         end do
+         d(i) = d(i) + xi
+         q(i) = q(i) + d(i)
+         gd = gd + load(i)*d(i)
+      end do
+   end subroutine modal_update
+
+   !> The contact of a step with stops along the span (the paper's law: each stop's value at
+   !> t_{n+1} within its bounds): the trial values q^n + d^{n-1} + x at the stop coordinates, the
+   !> bounds of u at phi = phi(t_{n+1}), and the multipliers of the box QP on C_r (zero when no
+   !> trial value is out); keeps q^n and d^{n-1} there for the record and span_energy. Without
+   !> `enforce` (law 'none') only that. The reduced loop's own (the full loop's span_contact of
+   !> contact/span_stops.f90 carries restitution), on the same span_work_type.
+   subroutine stops_contact(stops, work, q, d, x, phi, enforce, info)
+      type(span_stops_type), intent(in) :: stops
+      type(span_work_type), intent(inout) :: work
+      real(wp), intent(in) :: q(:), d(:), x(:)
+      real(wp), intent(in) :: phi
+      logical, intent(in) :: enforce
+      integer, intent(out) :: info
+      integer :: i, k
+      logical :: out
+      info = qp_solved
+      out = .false.
+      do i = 1, stops%m
+         k = stops%unknown(i)
+         work%u_prev(i) = q(k)
+         work%d_prev(i) = d(k)
+         work%trial(i) = q(k) + (d(k) + x(k))
+         work%lo(i) = stops%lower(i) - stops%lift(i)*phi
+         work%hi(i) = stops%upper(i) - stops%lift(i)*phi
+         out = out .or. work%trial(i) < work%lo(i) .or. work%trial(i) > work%hi(i)
+      end do
+      if (.not. (out .and. enforce)) then
+         if (work%contact) then
+            work%lambda = 0
+            work%qp%n_active = 0
+         end if
+         work%contact = .false.
+         return
+      end if
+      call work%qp%solve(work%trial, work%lo, work%hi, work%lambda, work%y, info)
+      work%contact = work%qp%n_active > 0
+   end subroutine stops_contact
+
+   !> The active stops exactly on their bounds, d^n their exact increment there, and the largest
+   !> violation of a bound by the stop coordinates (the bounds of the step; 0 but for round-off).
+   subroutine stops_settle(stops, work, q, d, worst)
+      type(span_stops_type), intent(in) :: stops
+      type(span_work_type), intent(in) :: work
+      real(wp), intent(inout) :: q(:), d(:)
+      real(wp), intent(inout) :: worst
+      integer :: j, a, k
+      if (work%contact) then
+         do j = 1, work%qp%n_active
+            a = work%qp%active(j)
+            k = stops%unknown(a)
+            q(k) = work%y(a)
+            d(k) = work%y(a) - work%u_prev(a)
+         end do
+      end if
+      do j = 1, stops%m
+         k = stops%unknown(j)
+         worst = max(worst, q(k) - work%hi(j), work%lo(j) - q(k))
+      end do
+   end subroutine stops_settle
+
+   !> The correction A_r^{-1} P_r lambda of a step with stops along the span: one active stop, its
+   !> column `col` and multiplier c (the loop's rank-one update, as the tip's); more, the
+   !> correction folded into x (col = 0, c = 0); none, col = 0, c = 0.
+   pure subroutine correction(reduced, work, x, c, col)
+      type(reduced_model_type), intent(in) :: reduced
+      type(span_work_type), intent(in) :: work
+      real(wp), intent(inout) :: x(:)
+      real(wp), intent(out) :: c
+      integer, intent(out) :: col
+      integer :: i, j, a, k
+      real(wp) :: acc
+      c = 0
+      col = 0
+      k = 0
+      if (work%contact) k = work%qp%n_active
+      if (k == 1) then
+         col = work%qp%active(1)
+         c = work%lambda(col)
+      else if (k > 1) then
+         do i = 1, size(x)
+            acc = x(i)
+            do j = 1, k
+               a = work%qp%active(j)
+               acc = acc + work%lambda(a)*reduced%z(i, a)
+            end do
+            x(i) = acc
+         end do
+      end if
+   end subroutine correction
+
+   !> The contact law at the tip coordinate: from the trial tip value, the multiple c of z_r to
+   !> add, the tip value, the reaction per unit mass of the step and whether it is in contact.
+   subroutine contact_law(scene, reduced, state, trial, c, tip_value, r_step, contact)
+      type(scene_type), intent(in) :: scene
+      type(reduced_model_type), intent(in) :: reduced
+      type(reduced_state_type), intent(inout) :: state
+      real(wp), intent(in) :: trial
+      real(wp), intent(out) :: c, tip_value, r_step
+      logical, intent(out) :: contact
+      real(wp) :: p_next, z_tip
+      z_tip = reduced%z(tip_coordinate(reduced), reduced%tip_stop)
+      select case (scene%law)
+      case (law_signorini)
+         if (trial >= scene%lower .and. trial <= scene%upper) then
+            ! Between the stops: project_tip's c = 0 and tip value = trial, without its division.
+            c = 0
+            tip_value = trial
+         else
+            call project_tip(trial, scene%lower, scene%upper, z_tip, c, tip_value)
+         end if
+         contact = c /= 0
+         r_step = c/reduced%dt2
+      case (law_compliance)
+         tip_value = solve_spring_tip(trial, scene%lower, scene%upper, scene%stiffness_per_mass, &
+            & reduced%dt2*reduced%beta*z_tip)
+         p_next = spring_force(tip_value, scene%lower, scene%upper, scene%stiffness_per_mass)
+         c = reduced%dt2*reduced%beta*p_next
+         r_step = reduced%beta*p_next + (1 - 2*reduced%beta)*state%p_now + reduced%beta*state%p_prev
+         state%p_prev = state%p_now
+         state%p_now = p_next
+         contact = r_step /= 0
+      case default
+         c = 0
+         tip_value = trial
+         r_step = 0
+         contact = .false.
+      end select
+   end subroutine contact_law
+
+   !> Index of the tip value in q (r + tip_stop), 0 when the tip is not a stop coordinate.
+   pure function tip_coordinate(reduced) result(pt)
+      type(reduced_model_type), intent(in) :: reduced
+      integer :: pt
+      pt = 0
+      if (reduced%tip_stop > 0) pt = reduced%r + reduced%tip_stop
+   end function tip_coordinate
+
+   !> Discrete energy E^{n+1/2} per unit mass from d.M_r d, q.S_r q, d.S_r q (q = q^{n+1}, d = d^n)
+   !> and q^n.S_r q^n.
+   pure function energy(reduced, dmd, usu, dsu, u_old_s_u_old) result(e)
+      type(reduced_model_type), intent(in) :: reduced
+      real(wp), intent(in) :: dmd, usu, dsu, u_old_s_u_old
+      real(wp) :: e
+      e = 0.5_wp*dmd/reduced%dt2 + 0.5_wp*(reduced%beta*usu + reduced%beta*u_old_s_u_old &
+         & + (1 - 2*reduced%beta)*(usu - dsu))
+   end function energy
+
+   !> Violation of the stops by a tip value (m).
+   pure function violation(u_tip, scene) result(v)
+      real(wp), intent(in) :: u_tip
+      type(scene_type), intent(in) :: scene
+      real(wp) :: v
+      v = max(u_tip - scene%upper, scene%lower - u_tip, 0.0_wp)
+   end function violation
+
+   !> Physical displacement (T q)(x_i) + h(x_i) phi(t) at the nodes x_0..x_J, O(J (r + m)).
+   pure subroutine physical_shape(reduced, q, t, scene, shape)
+      type(reduced_model_type), intent(in) :: reduced
+      real(wp), intent(in) :: q(:), t
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(out) :: shape(:)
+      integer :: k, i
+      shape = reduced%lift*support_position(t, scene%amplitude, scene%omega)
+      do k = 1, reduced%size
+         do i = 2, size(shape)
+            shape(i) = shape(i) + reduced%basis(2*i - 3, k)*q(k)
+         end do
+      end do
+   end subroutine physical_shape
+
+   !> The first multiple of `every` at or after `step`.
+   pure function next_multiple(step, every) result(m)
+      integer(ik), intent(in) :: step, every
+      integer(ik) :: m
+      m = ((step + every - 1)/every)*every
+   end function next_multiple
+
+   !> Text of a real for messages.
+   function real_text(x) result(s)
+      real(wp), intent(in) :: x
+      character(len=32) :: s
+      write (s, '(g0.6)') x
+   end function real_text
+end module beamstops_reduced_scheme

@@ -1,0 +1,577 @@
+!> Lockstep ensembles (SPEC 13, beamstops_lockstep): every member of a group run in lockstep
+!> equals the same scene run alone (simulate, the one-scene fused path) bit for bit: every
+!> column of every record, every snapshot, the summary. Groups of K = 1, 3, 5, 8, 13 (not
+!> multiples of the vector width) whose members differ in omega, amplitude, tip stops, load
+!> rule, start and record cadences; without contact, with Signorini stops and with
+!> compliance; runs long enough to cross blocks (block_steps), load restarts and contacts.
+!> The summaries too: counts, the energy ledger, the shock log and the statistics tables.
+!> Groups that cannot share A are refused with a message naming the member and the key.
+module test_lockstep
+   use, intrinsic :: iso_fortran_env, only: int64
+   use testing
+   use beamstops, only: ik, scene_type, model_type, array_recorder, run_summary, validate_scene, prepare_run, &
+      & simulate, record_count, snapshot_count, law_none, law_signorini, law_compliance, status_complete, &
+      & prepare_lockstep, simulate_lockstep
+   use beamstops_recorder, only: n_columns
+   use beamstops_ensemble, only: perturbation_of, run_members
+   use beamstops_observe_statistics, only: statistics_table, ensemble_table
+   use beamstops_scheme, only: start_state, run_scheme
+   use beamstops_state, only: state_type
+   use beamstops_model, only: build_model
+   use beamstops_band_solve, only: band_solver, band_diagonals, prepare_solver, prepare_diagonals, diagonal_matvec, &
+      & forward_substitution, forward_substitution_energy, back_substitution, dot
+   use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_work_columns, lockstep_matvec, &
+      & lockstep_forward, lockstep_forward_energy, lockstep_back, lockstep_dot, lockstep_update
+   implicit none
+   private
+   public :: collect_lockstep
+
+   !> Columns of a record, for messages.
+   character(len=10), parameter :: column_names(n_columns) = [character(len=10) :: 't', 'u', 'v', 'reaction', &
+      & 'energy', 'work', 'dissipated', 'damped']
+
+contains
+
+   !> Tests of the suite.
+   subroutine collect_lockstep(tests)
+      !> The suite's tests.
+      type(unittest_type), allocatable, intent(out) :: tests(:)
+      tests = [ &
+         & new_unittest('kernels: each lane equals the one-member kernel to the bit, J = 4..13, 19, 20, 100, 101', &
+         & test_kernels), &
+         & new_unittest('K = 1, Signorini, beta = 1/2', test_one), &
+         & new_unittest('K = 3, no stops, beta = 1/4, different omega and amplitude', test_free_three), &
+         & new_unittest('K = 5, Signorini, beta = 1/2, different stops, omega, amplitude, cadences', test_signorini_five), &
+         & new_unittest('K = 8, compliance 1e8, beta = 1/4', test_compliance_eight), &
+         & new_unittest('K = 13, Signorini, beta = 1/4, paper''s load and Euler start for some, checkpoint_every set', &
+         & test_signorini_thirteen), &
+         & new_unittest('K = 8, J = 100, Signorini, beta = 1/2', test_fine_eight), &
+         & new_unittest('a member whose recorder fails stops; the others go on, still bit for bit', test_failing_member), &
+         & new_unittest('K = 6 ensemble members (perturbed initial displacements), Signorini: each as run alone', &
+         & test_ensemble), &
+         & new_unittest('&ensemble members = 6: run_members (in lockstep) gives the table of the members run '// &
+         & 'one after the other', test_run_members), &
+         & new_unittest('members that do not share A are refused', test_refused) &
+         & ]
+   end subroutine collect_lockstep
+
+   !> The paper's scene on J elements, dt, beta, a law, t_end.
+   function base_scene(elements, dt, beta, law, t_end) result(scene)
+      integer, intent(in) :: elements, law
+      real(wp), intent(in) :: dt, beta, t_end
+      type(scene_type) :: scene
+      scene%elements = elements
+      scene%dt = dt
+      scene%beta = beta
+      scene%law = law
+      scene%t_end = t_end
+      if (law == law_compliance) scene%stiffness_per_mass = 1.0e8_wp
+   end function base_scene
+
+   !> K members of a base scene, member k varied by k: omega, amplitude, stops, cadences; the
+   !> load rule and the start of some members switched when `vary_rules`.
+   function members_of(base, k_members, vary_rules) result(scenes)
+      type(scene_type), intent(in) :: base
+      integer, intent(in) :: k_members
+      logical, intent(in) :: vary_rules
+      type(scene_type) :: scenes(k_members)
+      integer :: k
+      real(wp) :: s
+      do k = 1, k_members
+         scenes(k) = base
+         s = real(k - 1, wp)/max(1, k_members - 1)
+         if (k_members > 1) then
+            scenes(k)%omega = 8.0_wp + 6.0_wp*s
+            scenes(k)%amplitude = 0.25_wp - 0.1_wp*s
+            scenes(k)%lower = -0.08_wp - 0.04_wp*mod(k, 3)
+            scenes(k)%upper = 0.07_wp + 0.05_wp*s
+         end if
+         scenes(k)%record_every = 1 + mod(k - 1, 4)*2
+         scenes(k)%snapshot_every = merge(0, 97*k, mod(k, 3) == 0)
+         if (vary_rules) then
+            scenes(k)%centered_load = mod(k, 2) == 1
+            scenes(k)%taylor_start = mod(k, 4) /= 2
+         end if
+      end do
+   end function members_of
+
+   !> Run the members in lockstep and each alone; compare them to the bit. With `contact`, some
+   !> member must have hit a stop.
+   subroutine compare_group(scenes, error, contact)
+      type(scene_type), intent(in) :: scenes(:)
+      type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: contact
+      type(array_recorder), allocatable :: group(:)
+      type(array_recorder) :: alone
+      type(run_summary) :: summaries(size(scenes)), summary
+      type(model_type) :: model
+      integer :: k, nk
+      character(len=:), allocatable :: who
+
+      nk = size(scenes)
+      do k = 1, nk
+         call validate_scene(scenes(k), 'member '//int_text(k), error)
+         if (allocated(error)) return
+      end do
+      call prepare_lockstep(scenes, 'test group', model, error)
+      if (allocated(error)) return
+      allocate (group(nk))
+      do k = 1, nk
+         call reserve(group(k), scenes(k))
+      end do
+      call simulate_lockstep(scenes, model, group, summaries, error)
+      if (allocated(error)) return
+      do k = 1, nk
+         who = 'member '//int_text(k)//' of '//int_text(nk)
+         call run_alone(scenes(k), alone, summary, error)
+         if (allocated(error)) return
+         call check(error, summaries(k)%status == status_complete .and. summary%status == status_complete, &
+            & who//': both runs complete ('//summaries(k)%status//', '//summary%status//')')
+         if (allocated(error)) return
+         call same_summary(summaries(k), summary, who, error)
+         if (allocated(error)) return
+         call same_records(group(k), alone, who, error)
+         if (allocated(error)) return
+      end do
+      if (present(contact)) then
+         if (contact) call check(error, sum(summaries%impacts) > 0, 'some member hit a stop (impacts: '// &
+            & int_text(sum(summaries%impacts))//')')
+      end if
+   end subroutine compare_group
+
+   !> Room for every record and snapshot of a scene.
+   subroutine reserve(rec, scene)
+      type(array_recorder), intent(inout) :: rec
+      type(scene_type), intent(in) :: scene
+      call rec%reserve(record_count(scene), snapshot_count(scene), scene%elements + 1)
+   end subroutine reserve
+
+   !> The scene run alone: prepare_run and simulate (the one-scene fused path).
+   subroutine run_alone(scene, rec, summary, error)
+      type(scene_type), intent(in) :: scene
+      type(array_recorder), intent(out) :: rec
+      type(run_summary), intent(out) :: summary
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      call prepare_run(scene, 'test scene', model, error)
+      if (allocated(error)) return
+      call reserve(rec, scene)
+      call simulate(scene, model, rec, summary, error)
+   end subroutine run_alone
+
+   !> The summaries agree (but for the CPU time).
+   subroutine same_summary(a, b, who, error)
+      type(run_summary), intent(in) :: a, b
+      character(len=*), intent(in) :: who
+      type(error_type), allocatable, intent(out) :: error
+      call check(error, a%steps == b%steps .and. a%impacts == b%impacts, who//': steps '//int_text(a%steps)//' and '// &
+         & int_text(b%steps)//', impacts '//int_text(a%impacts)//' and '//int_text(b%impacts))
+      if (allocated(error)) return
+      call check(error, same_bits(a%max_violation, b%max_violation), who//': max_violation '// &
+         & real_text(a%max_violation)//' and '//real_text(b%max_violation))
+      if (allocated(error)) return
+      call check(error, same_bits(a%t_final, b%t_final), who//': t_final')
+      if (allocated(error)) return
+      call check(error, a%contact_phases == b%contact_phases .and. same_bits(a%work, b%work) .and. &
+         & same_bits(a%dissipated, b%dissipated) .and. same_bits(a%damped, b%damped) .and. &
+         & same_bits(a%energy_residual, b%energy_residual), who//': the ledger (work '//real_text(a%work)//' and '// &
+         & real_text(b%work)//', residual '//real_text(a%energy_residual)//' and '//real_text(b%energy_residual)//')')
+      if (allocated(error)) return
+      call same_observations(a, b, who, error)
+   end subroutine same_summary
+
+   !> The shock logs and the statistics tables of two summaries, bit for bit.
+   subroutine same_observations(a, b, who, error)
+      type(run_summary), intent(in) :: a, b
+      character(len=*), intent(in) :: who
+      type(error_type), allocatable, intent(out) :: error
+      integer :: q
+      call check(error, allocated(a%shocks) .eqv. allocated(b%shocks), who//': shock logs kept alike')
+      if (allocated(error)) return
+      if (allocated(a%shocks)) then
+         call check(error, all(shape(a%shocks) == shape(b%shocks)), who//': '//int_text(size(a%shocks, 2))//' and '// &
+            & int_text(size(b%shocks, 2))//' shocks')
+         if (allocated(error)) return
+         call check(error, all(same_bits(a%shocks, b%shocks)), who//': the shock log')
+         if (allocated(error)) return
+      end if
+      call check(error, allocated(a%statistics%quantity) .eqv. allocated(b%statistics%quantity), &
+         & who//': statistics kept alike')
+      if (allocated(error) .or. .not. allocated(a%statistics%quantity)) return
+      call check(error, size(a%statistics%quantity) == size(b%statistics%quantity), who//': statistics tables')
+      if (allocated(error)) return
+      do q = 1, size(a%statistics%quantity)
+         associate (x => a%statistics%quantity(q), y => b%statistics%quantity(q))
+            call check(error, x%name == y%name .and. size(x%value) == size(y%value), who//': statistic '//x%name)
+            if (allocated(error)) return
+            call check(error, all(same_bits(x%value, y%value)) .and. all(same_bits(x%half_width, y%half_width)), &
+               & who//': statistic '//x%name//' (value and half-width)')
+            if (allocated(error)) return
+         end associate
+      end do
+   end subroutine same_observations
+
+   !> Every record and snapshot, bit for bit.
+   subroutine same_records(a, b, who, error)
+      type(array_recorder), intent(in) :: a, b
+      character(len=*), intent(in) :: who
+      type(error_type), allocatable, intent(out) :: error
+      integer(ik) :: i
+      integer :: c
+      call check(error, a%filled == b%filled .and. a%snaps == b%snaps, who//': '//int_text(a%filled)//' and '// &
+         & int_text(b%filled)//' records, '//int_text(a%snaps)//' and '//int_text(b%snaps)//' snapshots')
+      if (allocated(error)) return
+      do i = 1, a%filled
+         do c = 1, n_columns
+            if (same_bits(a%rows(c, i), b%rows(c, i))) cycle
+            call test_failed(error, who//': record '//int_text(i)//' (t = '//real_text(b%rows(1, i))//'), column '// &
+               & trim(column_names(c))//': lockstep '//real_text(a%rows(c, i))//', alone '//real_text(b%rows(c, i)))
+            return
+         end do
+      end do
+      do i = 1, a%snaps
+         if (.not. same_bits(a%snap_t(i), b%snap_t(i)) .or. &
+            & any(transfer(a%snap_u(:, i), 1_int64, size(a%snap_u, 1)) /= &
+            & transfer(b%snap_u(:, i), 1_int64, size(b%snap_u, 1)))) then
+            call test_failed(error, who//': snapshot '//int_text(i)//' (t = '//real_text(b%snap_t(i))//') differs')
+            return
+         end if
+      end do
+      call check(error, a%filled > 0, who//': records were kept')
+   end subroutine same_records
+
+   !> Two reals with the same bits.
+   elemental function same_bits(a, b) result(same)
+      real(wp), intent(in) :: a, b
+      logical :: same
+      same = transfer(a, 1_int64) == transfer(b, 1_int64)
+   end function same_bits
+
+   !> The kernels of beamstops_band_solve_lockstep against those of beamstops_band_solve, lane by
+   !> lane, on random vectors: the product by S, both substitutions (with and without the
+   !> energy sums), the dot product, the update. The place to look first when the one-scene
+   !> path or the compiler changes: the lockstep kernels reproduce where the compiled
+   !> one-member kernels round (see the notes of beamstops_band_solve_lockstep).
+   subroutine test_kernels(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: meshes(14) = [4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 19, 20, 100, 101]
+      integer, parameter :: lanes = lockstep_lanes
+      type(scene_type) :: scene
+      type(model_type) :: model
+      type(band_solver) :: solver
+      type(band_diagonals) :: s, m
+      real(wp), allocatable :: x(:, :), y(:, :), b(:, :), u(:, :), d(:, :), v(:), w(:)
+      real(wp) :: work(lanes, lockstep_work_columns), usu(lanes), dsu(lanes), dmd(lanes), dd(lanes), c(lanes)
+      real(wp) :: e(3)
+      integer :: a, rep, k, n
+      character(len=:), allocatable :: where
+      do a = 1, size(meshes)
+         scene%elements = meshes(a)
+         scene%dt = 1.0e-5_wp
+         call build_model(scene, model, error)
+         if (allocated(error)) return
+         call prepare_solver(model%factor, solver)
+         call prepare_diagonals(model%stiffness, s)
+         call prepare_diagonals(model%mass, m)
+         n = model%n
+         if (allocated(x)) deallocate (x, y, b, u, d, v, w)
+         allocate (x(lanes, n), y(lanes, n), b(lanes, n), u(lanes, n), d(lanes, n), v(n), w(n))
+         do rep = 1, 20
+            call random_number(x)
+            call random_number(u)
+            call random_number(d)
+            call random_number(c)
+            x = x - 0.5_wp
+            u = u - 0.5_wp
+            d = d - 0.5_wp
+            where = 'J = '//int_text(meshes(a))//': '
+            call lockstep_matvec(s, x, y)
+            do k = 1, lanes
+               call diagonal_matvec(s, x(k, :), v)
+               if (.not. all(same_bits(v, y(k, :)))) call test_failed(error, where//'S x, lane '//int_text(k))
+            end do
+            b = x
+            call lockstep_forward(solver, b)
+            do k = 1, lanes
+               v = x(k, :)
+               call forward_substitution(solver, v)
+               if (.not. all(same_bits(v, b(k, :)))) call test_failed(error, where//'forward substitution, lane '//int_text(k))
+            end do
+            b = x
+            call lockstep_back(solver, b, work)
+            do k = 1, lanes
+               v = x(k, :)
+               call back_substitution(solver, v)
+               if (.not. all(same_bits(v, b(k, :)))) call test_failed(error, where//'back substitution, lane '//int_text(k))
+            end do
+            b = x
+            call lockstep_forward_energy(solver, m, u, d, y, b, usu, dsu, dmd, work)
+            do k = 1, lanes
+               v = x(k, :)
+               call forward_substitution_energy(solver, m, u(k, :), d(k, :), y(k, :), v, e(1), e(2), e(3))
+               if (.not. all(same_bits(v, b(k, :)))) call test_failed(error, where//'forward substitution with the '// &
+                  & 'energy sums, lane '//int_text(k))
+               if (.not. same_bits(e(1), usu(k))) call test_failed(error, where//'u.S u, lane '//int_text(k))
+               if (.not. same_bits(e(2), dsu(k))) call test_failed(error, where//'d.S u, lane '//int_text(k))
+               if (.not. same_bits(e(3), dmd(k))) call test_failed(error, where//'d.M d, lane '//int_text(k))
+            end do
+            call lockstep_dot(n, u, d, work, dd, 1.0_wp)
+            do k = 1, lanes
+               if (.not. same_bits(dot(u(k, :), d(k, :)), dd(k))) call test_failed(error, where//'dot, lane '//int_text(k))
+            end do
+            b = d
+            y = u
+            call lockstep_update(n, x, c, model%z, b, y)
+            do k = 1, lanes
+               v = d(k, :) + x(k, :) + c(k)*model%z
+               w = u(k, :) + v
+               if (.not. (all(same_bits(v, b(k, :))) .and. all(same_bits(w, y(k, :))))) &
+                  & call test_failed(error, where//'update, lane '//int_text(k))
+            end do
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine test_kernels
+
+   subroutine test_one(error)
+      type(error_type), allocatable, intent(out) :: error
+      call compare_group(members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.2_wp), 1, .false.), error, &
+         & contact=.true.)
+   end subroutine test_one
+
+   subroutine test_free_three(error)
+      type(error_type), allocatable, intent(out) :: error
+      call compare_group(members_of(base_scene(19, 1.0e-5_wp, 0.25_wp, law_none, 0.2_wp), 3, .true.), error)
+   end subroutine test_free_three
+
+   subroutine test_signorini_five(error)
+      type(error_type), allocatable, intent(out) :: error
+      call compare_group(members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.25_wp), 5, .false.), error, &
+         & contact=.true.)
+   end subroutine test_signorini_five
+
+   subroutine test_compliance_eight(error)
+      type(error_type), allocatable, intent(out) :: error
+      call compare_group(members_of(base_scene(19, 4.0e-6_wp, 0.25_wp, law_compliance, 0.15_wp), 8, .true.), error, &
+         & contact=.true.)
+   end subroutine test_compliance_eight
+
+   subroutine test_signorini_thirteen(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type), allocatable :: scenes(:)
+      integer :: k
+      scenes = members_of(base_scene(13, 2.0e-5_wp, 0.25_wp, law_signorini, 0.3_wp), 13, .true.)
+      do k = 1, size(scenes)
+         scenes(k)%checkpoint_every = 5000
+      end do
+      call compare_group(scenes, error, contact=.true.)
+   end subroutine test_signorini_thirteen
+
+   subroutine test_fine_eight(error)
+      type(error_type), allocatable, intent(out) :: error
+      call compare_group(members_of(base_scene(100, 4.0e-6_wp, 0.5_wp, law_signorini, 0.12_wp), 8, .false.), error, &
+         & contact=.true.)
+   end subroutine test_fine_eight
+
+   !> K = 3, member 2 records every third step into room for 3000 rows: member 2 ends 'failed' after the block in which its
+   !> recorder failed (as the same scene alone), members 1 and 3 complete and equal their runs
+   !> alone.
+   subroutine test_failing_member(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type), allocatable :: scenes(:)
+      type(array_recorder) :: group(3), alone
+      type(run_summary) :: summaries(3), summary
+      type(model_type) :: model
+      integer :: k
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.25_wp), 3, .false.)
+      call prepare_lockstep(scenes, 'test group', model, error)
+      if (allocated(error)) return
+      do k = 1, 3
+         call reserve(group(k), scenes(k))
+      end do
+      deallocate (group(2)%rows)
+      allocate (group(2)%rows(n_columns, 3000))
+      call simulate_lockstep(scenes, model, group, summaries, error)
+      if (allocated(error)) return
+      call check(error, summaries(2)%status == 'failed' .and. summaries(2)%steps == 16384, &
+         & 'member 2 failed at the end of its second block: '//summaries(2)%status//' after '// &
+         & int_text(summaries(2)%steps)//' steps')
+      if (allocated(error)) return
+      do k = 1, 3, 2
+         call run_alone(scenes(k), alone, summary, error)
+         if (allocated(error)) return
+         call check(error, summaries(k)%status == status_complete, 'member '//int_text(k)//' completes')
+         if (allocated(error)) return
+         call same_summary(summaries(k), summary, 'member '//int_text(k), error)
+         if (allocated(error)) return
+         call same_records(group(k), alone, 'member '//int_text(k), error)
+         if (allocated(error)) return
+      end do
+   end subroutine test_failing_member
+
+   !> The members of an &ensemble (ensemble.f90: model%u0 plus perturbation_of(delta, seed, k)),
+   !> in lockstep through the initial displacements, against each run alone on a model with that
+   !> u0 (what run_members does).
+   subroutine test_ensemble(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: nk = 6
+      type(scene_type) :: scenes(nk)
+      type(array_recorder) :: group(nk), alone(nk)
+      type(run_summary) :: summaries(nk), summary
+      type(model_type) :: model, member_model
+      real(wp), allocatable :: u0(:, :)
+      integer :: k
+      scenes = base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.3_wp)
+      call prepare_lockstep(scenes, 'test group', model, error)
+      if (allocated(error)) return
+      allocate (u0(model%n, nk))
+      do k = 1, nk
+         u0(:, k) = model%u0 + perturbation_of(1.0e-4_wp, 7, k, model%n)
+         call reserve(group(k), scenes(k))
+      end do
+      call simulate_lockstep(scenes, model, group, summaries, error, initial_displacement=u0)
+      if (allocated(error)) return
+      do k = 1, nk
+         member_model = model
+         member_model%u0 = u0(:, k)
+         call reserve(alone(k), scenes(k))
+         call simulate(scenes(k), member_model, alone(k), summary, error)
+         if (allocated(error)) return
+         call same_summary(summaries(k), summary, 'ensemble member '//int_text(k), error)
+         if (allocated(error)) return
+         call same_records(group(k), alone(k), 'ensemble member '//int_text(k), error)
+         if (allocated(error)) return
+      end do
+      call check(error, any(group(1)%rows(2, :group(1)%filled) /= group(2)%rows(2, :group(2)%filled)), &
+         & 'the members differ')
+   end subroutine test_ensemble
+
+   !> run_members (ensemble.f90, members 2..K in lockstep) against the members run one after the
+   !> other as it ran them before (start_state + run_scheme on a model with the perturbed u0, no
+   !> records): the same ensemble table, bit for bit.
+   subroutine test_run_members(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene, member_scene
+      type(model_type) :: model, member_model
+      type(array_recorder) :: rec
+      type(array_recorder) :: quiet
+      type(run_summary) :: summary, member
+      type(state_type) :: state
+      type(statistics_table) :: tables(6), reference
+      integer :: k
+      scene = base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.3_wp)
+      scene%members = 6
+      scene%perturbation = 1.0e-4_wp
+      scene%seed = 3
+      call prepare_run(scene, 'test ensemble', model, error)
+      if (allocated(error)) return
+      call reserve(rec, scene)
+      member_scene = scene
+      member_scene%members = 1
+      call simulate(member_scene, model, rec, summary, error)
+      if (allocated(error)) return
+      tables(1) = summary%statistics
+      call run_members(scene, model, summary, error)
+      if (allocated(error)) return
+      member_scene%snapshot_every = 0
+      member_scene%record_every = huge(1)
+      call quiet%reserve(1_ik, 0_ik, scene%elements + 1)
+      do k = 2, 6
+         member_model = model
+         member_model%u0 = model%u0 + perturbation_of(scene%perturbation, scene%seed, k, size(model%u0))
+         quiet%filled = 0
+         call start_state(member_scene, member_model, state, quiet, error)
+         if (allocated(error)) return
+         member = run_summary()
+         call run_scheme(member_scene, member_model, state, quiet, member)
+         call check(error, member%status == status_complete, 'member '//int_text(k)//' completes')
+         if (allocated(error)) return
+         tables(k) = member%statistics
+      end do
+      call ensemble_table(tables, reference, error)
+      if (allocated(error)) return
+      call check(error, summary%ensemble_members == 6, 'six members: '//int_text(summary%ensemble_members))
+      if (allocated(error)) return
+      call check(error, allocated(reference%quantity), 'an ensemble table')
+      if (allocated(error)) return
+      call check(error, size(reference%quantity) > 0, 'an ensemble table with quantities')
+      if (allocated(error)) return
+      block
+         type(run_summary) :: a, b
+         a%statistics = summary%ensemble
+         b%statistics = reference
+         call same_observations(a, b, 'the ensemble table', error)
+      end block
+   end subroutine test_run_members
+
+   !> Members that differ in what A depends on, in the law, in the steps, or with stops along
+   !> the span are refused, the message naming the member and the key.
+   subroutine test_refused(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scenes(3)
+      type(model_type) :: model
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      scenes(3)%dt = 2.0e-5_wp
+      call expect_refusal(scenes, 'member 3: &time dt', error)
+      if (allocated(error)) return
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      scenes(2)%elements = 20
+      call expect_refusal(scenes, 'member 2: &mesh elements', error)
+      if (allocated(error)) return
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      scenes(2)%law = law_compliance
+      scenes(2)%stiffness_per_mass = 1.0e8_wp
+      call expect_refusal(scenes, 'member 2: &stops law', error)
+      if (allocated(error)) return
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      scenes(3)%k2 = 300.0_wp
+      call expect_refusal(scenes, 'member 3: &beam k2', error)
+      if (allocated(error)) return
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      scenes(2)%t_end = 0.02_wp
+      call expect_refusal(scenes, 'member 2: &time steps', error)
+      if (allocated(error)) return
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      scenes(2)%stop_nodes = [10, 19]
+      scenes(2)%stop_lower = [-0.05_wp, -0.1_wp]
+      scenes(2)%stop_upper = [0.05_wp, 0.1_wp]
+      call expect_refusal(scenes, 'member 2 has stops along the span', error)
+      if (allocated(error)) return
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      scenes(3)%restitution = 0.5_wp
+      call expect_refusal(scenes, 'member 3 asks for damping, restitution or mass redistribution', error)
+      if (allocated(error)) return
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      scenes(2)%modes = 6
+      call expect_refusal(scenes, 'member 2 is a reduced model', error)
+      if (allocated(error)) return
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      scenes(1)%damping_mass = 1.0_wp
+      call expect_refusal(scenes, 'member 1 asks for damping', error)
+      if (allocated(error)) return
+      scenes = members_of(base_scene(3, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
+      call expect_refusal(scenes, '&mesh elements = 3', error)
+      if (allocated(error)) return
+      call prepare_lockstep(scenes(1:0), 'test group', model, error)
+      call check(error, allocated(error), 'an empty group is refused')
+      if (allocated(error)) then
+         if (index(error%message, 'no members') > 0) deallocate (error)
+      end if
+   end subroutine test_refused
+
+   !> prepare_lockstep refuses the group with a message containing `expected`.
+   subroutine expect_refusal(scenes, expected, error)
+      type(scene_type), intent(in) :: scenes(:)
+      character(len=*), intent(in) :: expected
+      type(error_type), allocatable, intent(out) :: error
+      type(model_type) :: model
+      type(error_type), allocatable :: refusal
+      call prepare_lockstep(scenes, 'test group', model, refusal)
+      if (.not. allocated(refusal)) then
+         call test_failed(error, 'not refused: '//expected)
+         return
+      end if
+      call check(error, index(refusal%message, expected) > 0, 'the message "'//refusal%message// &
+         & '" names "'//expected//'"')
+   end subroutine expect_refusal
+end module test_lockstep

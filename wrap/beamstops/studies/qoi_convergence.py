@@ -1,0 +1,124 @@
+"""Convergence of statistical QoIs in Δt and in J (``converge --qoi NAME ...``): the paper's scene
+(Signorini, β = 1/2, e = 0) run after a transient at a ladder of Δt (J = 19) and of J (fixed Δt),
+each QoI's value ± batch-means half-width against a fine reference (smaller Δt, or larger J, and a
+longer window; the Δt reference also across perturbed members), "within the reference's interval"
+when |v − v_ref| ≤ h + h_ref.
+
+Files (per QoI): ``qoi_convergence_<qoi>_dt.{md,csv}``, ``qoi_convergence_<qoi>_J.{md,csv}``,
+``qoi_convergence_<qoi>.png`` (value ± h against Δt and against J with the reference's band);
+``qoi_convergence.md`` gathers the tables.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Optional
+
+from ..scene import Scene
+from .common import Table, out_dir, progress
+from .qoi import HalfWidth, Measured, measure, statistic_name
+from .qoi_report import errorbar_panel, table
+from .qoi_workprecision import Settings, settings
+
+__all__ = ["Ladders", "ladders", "Runs", "run_ladders", "study"]
+
+
+@dataclass(frozen=True)
+class Ladders:
+    """The Δt ladder (at the base J) and its reference Δt; the J ladder (at ``dt_of_j``) and its reference J."""
+
+    dts: tuple[float, ...]
+    dt_reference: float
+    elements: tuple[int, ...]
+    elements_reference: int
+    dt_of_j: float
+
+
+def ladders(quick: bool) -> Ladders:
+    if quick:
+        return Ladders((4e-5, 2e-5), 1e-5, (5, 10), 19, 2e-5)
+    return Ladders(tuple(4e-5 / 2**k for k in range(5)), 1.25e-6, (5, 10, 19), 38, 5e-6)
+
+
+@dataclass(frozen=True)
+class Runs:
+    """The runs of both ladders and their references."""
+
+    base: Scene
+    by_dt: list[Measured]
+    dt_reference: Measured
+    by_j: list[Measured]
+    j_reference: Measured
+
+
+def run_ladders(base: Scene, lad: Ladders, s: Settings, quiet: bool = False) -> Runs:
+    """Every Δt and J of the ladders and both references (the Δt reference with ``s.members`` members)."""
+    todo: list[tuple[str, object]] = ([("dt", dt) for dt in lad.dts] + [("dt_ref", lad.dt_reference)]
+                                      + [("J", j) for j in lad.elements] + [("J_ref", lad.elements_reference)])
+    out: dict[str, list[Measured]] = {"dt": [], "dt_ref": [], "J": [], "J_ref": []}
+    for kind, x in progress(todo, "converge (statistics)", quiet=quiet):
+        if kind.startswith("dt"):
+            scene = base.replace(dt=x)
+        else:
+            scene = base.replace(dt=lad.dt_of_j, elements=x)
+        reference = kind.endswith("_ref")
+        out[kind].append(measure(scene, s.transient, s.reference_window if reference else s.window, batches=s.batches,
+                                 members=s.members if kind == "dt_ref" else 1, perturbation=s.perturbation))
+    return Runs(base, out["dt"], out["dt_ref"][0], out["J"], out["J_ref"][0])
+
+
+def tables(runs: Runs, qoi: str, half_width: HalfWidth, s: Settings) -> tuple[Table, Table]:
+    """The Δt table and the J table of one QoI."""
+    b = runs.base
+    scene = f"paper's scene (Signorini, e = {b.restitution:g}, β = {b.beta:g}, centred load), {s.describe()}"
+    by_dt = table(f"{qoi} ({statistic_name(qoi)}) against Δt, J = {b.elements}, h* = {half_width}", ["Δt (s)"],
+                  [([m.scene.dt], m) for m in runs.by_dt], ([runs.dt_reference.scene.dt], runs.dt_reference), qoi,
+                  half_width,
+                  note=f"{scene}. Reference: Δt = {runs.dt_reference.scene.dt:g} s. Within: |v − v_ref| ≤ h + h_ref; "
+                       "T* = T (h/h*)², cost* = CPU (transient + T*)/(transient + T) (engine cpu_seconds; the "
+                       "ensemble row: members × member 1's).")
+    dt_j = runs.j_reference.scene.dt
+    by_j = table(f"{qoi} ({statistic_name(qoi)}) against J, Δt = {dt_j:g} s, h* = {half_width}", ["J"],
+                 [([m.scene.elements], m) for m in runs.by_j], ([runs.j_reference.scene.elements], runs.j_reference),
+                 qoi, half_width, note=f"{scene}. Reference: J = {runs.j_reference.scene.elements}.")
+    return by_dt, by_j
+
+
+def draw(runs: Runs, qoi: str, path: Path) -> Path:
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(11, 4.5), layout="constrained")
+    errorbar_panel(fig.add_subplot(1, 2, 1), [m.scene.dt for m in runs.by_dt], runs.by_dt, runs.dt_reference, qoi,
+                   reference_x=runs.dt_reference.scene.dt, xlabel="Δt (s)",
+                   title=f"{statistic_name(qoi)} against Δt (J = {runs.base.elements})")
+    errorbar_panel(fig.add_subplot(1, 2, 2), [m.scene.elements for m in runs.by_j], runs.by_j, runs.j_reference, qoi,
+                   reference_x=runs.j_reference.scene.elements, xlabel="J (elements)",
+                   title=f"{statistic_name(qoi)} against J (Δt = {runs.j_reference.scene.dt:g} s)")
+    fig.savefig(path, dpi=110)
+    return path
+
+
+def study(folder: Optional[Path] = None, *, qois: Sequence[str] = ("stop_power",), quick: bool = False,
+          half_width: HalfWidth = HalfWidth(0.02, True), transient: Optional[float] = None,
+          window: Optional[float] = None, reference_window: Optional[float] = None, members: Optional[int] = None,
+          quiet: bool = False) -> dict[str, tuple[Table, Table]]:
+    """Run both ladders once; write the tables and the chart of every QoI."""
+    for q in qois:
+        statistic_name(q)
+    folder = out_dir(folder, "convergence")
+    s, _ = settings(quick, transient, window, reference_window, members)
+    runs = run_ladders(Scene(beta=0.5), ladders(quick), s, quiet)
+    out: dict[str, tuple[Table, Table]] = {}
+    text = []
+    for q in qois:
+        by_dt, by_j = tables(runs, q, half_width, s)
+        by_dt.write(folder, f"qoi_convergence_{q}_dt")
+        by_j.write(folder, f"qoi_convergence_{q}_J")
+        draw(runs, q, folder / f"qoi_convergence_{q}.png")
+        text += [by_dt.markdown(), by_j.markdown()]
+        out[q] = (by_dt, by_j)
+    (folder / "qoi_convergence.md").write_text("# Convergence of statistics in Δt and J\n\n" + "\n".join(text),
+                                                encoding="utf-8")
+    return out
