@@ -289,8 +289,6 @@ quantity = "damped"
     assert spec.reductions["damped"]["quantity"] == "damped"
     spec = load_spec(write_spec("[scene]\nelements = 4\n[axes]\nratio = [0.01, 0.02]\n"))
     assert [p.scene.ratio for p in spec.points] == [(0.01, 0.01), (0.02, 0.02)]
-    with pytest.raises(SpecError, match="modes"):
-        load_spec(write_spec("[scene]\nmodes = 1\n[axes]\nomega = [10]\n"))
 
 
 def test_damped_bifurcation_spec_is_valid() -> None:

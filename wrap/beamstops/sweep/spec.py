@@ -77,11 +77,10 @@ FORMAT = 1
 DEFAULT_MAX_POINTS = 10_000
 #: [sweep] max_points cannot go beyond this.
 HARD_MAX_POINTS = 10_000_000
-#: Keys a sweep may set: every namelist key but the output file, which the sweep names, the
-#: positions of stops along the span and the damping's two mode numbers (lists: give them in the
-#: base namelist).
+#: Keys a sweep may set: every namelist key but the output file, which the sweep names, and the
+#: positions of stops along the span (lists).
 SCENE_KEYS: tuple[str, ...] = tuple(key for keys in GROUPS.values() for key in keys
-                                    if key not in ("file", "nodes", "x", "modes"))
+                                    if key not in ("file", "nodes", "x"))
 _INT_KEYS = {f.name for f in dataclasses.fields(Scene) if f.type in ("int", int)}
 _KIND = {f.name: {"float": "real", "int": "integer", "bool": "boolean"}.get(str(f.type), "text")
          for f in dataclasses.fields(Scene)}
