@@ -6,13 +6,18 @@ resumable: a second call only draws) and draws from its summary table:
 
 - top: u(L, kT), T = 2π/ω, for every k after the transient (one dot per sample), with
   the stops; a point whose samples repeat with a period p (``strobe_period``) is drawn
-  in colour, the others in black;
-- bottom: the energy the stops take per forcing period over the whole run, and the
-  number of impacts per period.
+  in the colour of its p (1, 2, 3, ≥ 4), the others in black;
+- bottom: the energy the stops take per forcing period over the whole run (and the
+  Rayleigh damping's, when the sweep has a ``damped`` reduction), and the number of
+  shocks (the engine's ``impacts``) per period.
+
+Beside the image, a markdown table (same name, ``.md``): how many values of ω settle on a
+period-p motion at the stroboscope (from ``strobe_period``), and the windows of ω where they do.
 
 Usage::
 
     python scripts/bifurcation.py                      # 300 points, out/bifurcation/bifurcation.png
+    python scripts/bifurcation.py --spec input/sweeps/bifurcation_damped.toml   # ζ = 1.5 %, out/bifurcation_damped/
     python scripts/bifurcation.py --quick              # 12 short points (a test), out/bifurcation-quick/
     python scripts/bifurcation.py -j 8 -o DIR --png FILE
     mpiexec -n 9 python -m mpi4py.futures scripts/bifurcation.py   # on MPI ranks
@@ -43,6 +48,42 @@ QUICK = ("axes.omega.num=12", "periods.t_end=16", "reductions.strobe.transient_p
          "reductions.u_max.after_periods=8")
 
 
+#: Colours of the period classes: (label, test on strobe_period, colour).
+CLASSES = (("no period ≤ max_period", lambda p: p == 0, "k"), ("period 1", lambda p: p == 1, "tab:blue"),
+           ("period 2", lambda p: p == 2, "tab:orange"), ("period 3", lambda p: p == 3, "tab:green"),
+           ("period ≥ 4", lambda p: p >= 4, "tab:purple"))
+
+
+def periods_table(rows: list[dict[str, Any]]) -> str:
+    """Markdown: values of ω per stroboscopic period p (0: none found), and the windows of ω (runs of
+    successive values of ω with the same p > 0), from the sweep's ``strobe_period`` column."""
+    done = sorted((r for r in rows if r.get("status") == "complete" and r.get("strobe")), key=lambda r: r["omega"])
+    total = len(done)
+    counts: dict[int, int] = {}
+    for r in done:
+        counts[int(r["strobe_period"])] = counts.get(int(r["strobe_period"]), 0) + 1
+    lines = ["| stroboscopic period p | values of ω | fraction |", "|---|---|---|"]
+    for p in sorted(counts, key=lambda p: (p == 0, p)):
+        lines.append(f"| {p if p else 'none ≤ max_period'} | {counts[p]} | {counts[p] / total:.1%} |")
+    periodic = total - counts.get(0, 0)
+    lines += ["", f"Periodic (any p): {periodic} of {total} values of ω ({periodic / max(total, 1):.1%}).", "",
+              "| window of ω (rad/s) | p | values of ω |", "|---|---|---|"]
+    start, windows = 0, 0
+    for i in range(1, total + 1):
+        if i == total or done[i]["strobe_period"] != done[start]["strobe_period"]:
+            p = int(done[start]["strobe_period"])
+            if p and i - start >= 2:
+                lines.append(f"| {done[start]['omega']:.4g} – {done[i - 1]['omega']:.4g} | {p} | {i - start} |")
+                windows += 1
+            start = i
+    if not windows:
+        lines.append("| none | – | 0 |")
+    lines.append("")
+    lines.append("Windows of at least two successive values of ω; period p: the smallest p ≤ max_period with "
+                 "|u(L, (k+p)T) − u(L, kT)| ≤ tolerance for every sample after the transient.")
+    return "\n".join(lines) + "\n"
+
+
 def draw(rows: list[dict[str, Any]], path: Path, title: str = "", stops: Sequence[float] = ()) -> Path:
     """The diagram of a sweep's summary rows (an axis omega, a strobe reduction named 'strobe')."""
     done = [r for r in rows if r.get("status") == "complete" and r.get("strobe")]
@@ -50,13 +91,13 @@ def draw(rows: list[dict[str, Any]], path: Path, title: str = "", stops: Sequenc
     with rc_context({"font.size": 9}):
         fig = Figure(figsize=(8.0, 6.4), constrained_layout=True)
         top, bottom = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.3]})
-        for periodic in (False, True):
-            chosen = [r for r in done if bool(r.get("strobe_period")) == periodic]
+        for label, test, colour in CLASSES:
+            chosen = [r for r in done if test(int(r.get("strobe_period") or 0))]
             x = np.concatenate([np.full(len(r["strobe"]), r["omega"]) for r in chosen]) if chosen else np.empty(0)
             y = np.concatenate([np.asarray(r["strobe"], dtype=float) for r in chosen]) if chosen else np.empty(0)
             if x.size:
-                top.scatter(x, y, s=1.5, linewidths=0, color="tab:blue" if periodic else "k",
-                            label="period-p motion (strobe_period > 0)" if periodic else "no period ≤ max_period")
+                top.scatter(x, y, s=1.5 if colour == "k" else 3, linewidths=0, color=colour,
+                            label=f"{label} ({len(chosen)} values of ω)")
         if bad:
             top.scatter([r["omega"] for r in bad], np.zeros(len(bad)), marker="x", color="tab:red", s=12,
                         label=f"failed or diverged ({len(bad)})")
@@ -72,10 +113,13 @@ def draw(rows: list[dict[str, Any]], path: Path, title: str = "", stops: Sequenc
             energy = np.array([(r.get("dissipated") or 0.0) for r in done]) / periods
             impacts = np.array([(r.get("impacts") or 0) for r in done]) / periods
             bottom.plot(omega, energy, color="k", linewidth=0.8, label="energy taken by the stops per period (J)")
+            if any(r.get("damped") is not None for r in done):
+                damped = np.array([(r.get("damped") or 0.0) for r in done]) / periods
+                bottom.plot(omega, damped, color="tab:green", linewidth=0.8, label="energy taken by damping per period (J)")
             bottom.set_ylabel("J per period")
             twin = bottom.twinx()
-            twin.plot(omega, impacts, color="tab:orange", linewidth=0.8, label="impacts per period")
-            twin.set_ylabel("impacts per period", color="tab:orange")
+            twin.plot(omega, impacts, color="tab:orange", linewidth=0.8, label="shocks per period")
+            twin.set_ylabel("shocks per period", color="tab:orange")
             bottom.legend(loc="upper left", fontsize=7)
         bottom.set_xlabel("forcing frequency ω (rad/s)")
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -86,8 +130,8 @@ def draw(rows: list[dict[str, Any]], path: Path, title: str = "", stops: Sequenc
 def main(argv: Optional[Sequence[str]] = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--spec", type=Path, default=SPEC, help=f"sweep specification (default: {SPEC.relative_to(ROOT)})")
-    parser.add_argument("-o", "--output", type=Path, help="sweep folder (default: out/bifurcation, "
-                                                          "out/bifurcation-quick with --quick)")
+    parser.add_argument("-o", "--output", type=Path, help="sweep folder (default: out/SPEC's name, "
+                                                          "out/SPEC's name-quick with --quick)")
     parser.add_argument("--png", type=Path, help="image (default: OUTPUT/bifurcation.png)")
     parser.add_argument("--quick", action="store_true", help="12 short points (tests)")
     parser.add_argument("-j", "--jobs", type=int, help="local worker processes (default: every core)")
@@ -98,7 +142,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     args = parser.parse_args(argv)
 
     overrides = (list(QUICK) if args.quick else []) + list(args.set)
-    out = args.output or ROOT / "out" / ("bifurcation-quick" if args.quick else "bifurcation")
+    out = args.output or ROOT / "out" / (args.spec.stem + ("-quick" if args.quick else ""))
     png = args.png or out / "bifurcation.png"
     try:
         spec = sweep.load_spec(args.spec, overrides=overrides)
@@ -110,12 +154,18 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return 1
     except KeyboardInterrupt:
         return 130
-    title = (f"Stroboscopic tip displacement u(L, kT), T = 2π/ω: {len(rows)} values of ω, "
-             f"k ≥ {spec.reductions['strobe']['transient_periods']} of {spec.periods['t_end']:g} periods")
     scene = spec.points[0].scene
+    ratios = dict.fromkeys(scene.ratio)  # one value when both modes have the same ratio
+    damping = f", damping ζ = {', '.join(f'{z:g}' for z in ratios)}" if ratios else ""
+    title = (f"Stroboscopic tip displacement u(L, kT), T = 2π/ω\n{len(rows)} values of ω, "
+             f"k ≥ {spec.reductions['strobe']['transient_periods']} of {spec.periods['t_end']:g} periods{damping}")
     draw(rows, png, title=title, stops=(scene.lower, scene.upper))
-    command = "python scripts/bifurcation.py" + (" --quick" if args.quick else "") + "".join(
-        f" --set {shlex.quote(s)}" for s in args.set)
+    command = "python scripts/bifurcation.py" + (" --quick" if args.quick else "") + (
+        f" --spec {shlex.quote(str(args.spec.relative_to(ROOT) if args.spec.is_relative_to(ROOT) else args.spec))}"
+        if args.spec.resolve() != SPEC else "") + "".join(f" --set {shlex.quote(s)}" for s in args.set)
+    md = png.with_suffix(".md")
+    md.write_text(f"# {title.replace(chr(10), ': ')}\n\n![bifurcation diagram]({png.name})\n\n{periods_table(rows)}\n"
+                  f"Regenerate: `{command}`\n", encoding="utf-8")
     print(f"{png}  ({outcome.complete}/{outcome.total} points complete; regenerate: {command})")
     return 0
 

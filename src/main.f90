@@ -62,9 +62,9 @@ program beamstops_main
 
    !> The subcommands of `python -m beamstops` (wrap/beamstops/cli.py) and their one-line help;
    !> tests/python/test_cli.py checks that they are exactly the Python parser's.
-   integer, parameter :: n_python_commands = 7
+   integer, parameter :: n_python_commands = 8
    character(len=*), parameter :: python_commands(n_python_commands) = [character(len=14) :: 'plot', 'sweep', &
-      & 'converge', 'work-precision', 'stability-map', 'compliance', 'plan']
+      & 'converge', 'work-precision', 'stability-map', 'compliance', 'contact-laws', 'plan']
    character(len=*), parameter :: python_help(n_python_commands) = [character(len=80) :: &
       & 'plot the HDF5 output of a run (tip, shape, energy, phase, reaction, stops)', &
       & 'run a parameter sweep (TOML specification) on local cores or MPI ranks', &
@@ -72,6 +72,7 @@ program beamstops_main
       & 'error against CPU time for every method (PNG, markdown, CSV)', &
       & 'stable/unstable maps in (beta, dt) and (J, dt) (PNG, markdown, CSV)', &
       & 'normal compliance: spurious oscillations and penetration', &
+      & 'contact laws: energy, violation, chatter, convergence in dt', &
       & 'the cheapest model (law, mesh, dt) whose estimated error is under a tolerance']
    !> What the Python of the environment runs: beamstops.cli.main with the arguments, or one
    !> message and exit status 2 when the package cannot be imported.

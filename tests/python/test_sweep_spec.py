@@ -268,3 +268,29 @@ def test_strobe_samples_and_period_detection() -> None:
     t = np.arange(0, 4001) * 1e-3
     times, samples, offset = strobe(t, np.cos(omega * t), omega, transient_periods=2)
     assert 0 < offset <= 0.5e-3 + 1e-15 and samples.size == int(4.0 / period) - 1
+
+
+def test_damping_ratio_in_scene_and_axis_and_damped_reduction(write_spec: Callable[..., Path]) -> None:
+    spec = load_spec(write_spec("""
+[scene]
+elements = 4
+dt = 1e-4
+t_end = 0.1
+ratio = 0.015
+
+[axes]
+omega = [10, 20]
+
+[reductions.damped]
+kind = "final"
+quantity = "damped"
+"""))
+    assert all(p.scene.ratio == (0.015, 0.015) for p in spec.points)
+    assert spec.reductions["damped"]["quantity"] == "damped"
+    spec = load_spec(write_spec("[scene]\nelements = 4\n[axes]\nratio = [0.01, 0.02]\n"))
+    assert [p.scene.ratio for p in spec.points] == [(0.01, 0.01), (0.02, 0.02)]
+
+
+def test_damped_bifurcation_spec_is_valid() -> None:
+    spec = load_spec(ROOT / "input" / "sweeps" / "bifurcation_damped.toml")
+    assert spec.points[0].scene.ratio and "damped" in spec.reductions

@@ -1,5 +1,5 @@
 """Subcommands of the studies for ``python -m beamstops`` (appended to cli.COMMANDS):
-``converge``, ``work-precision``, ``stability-map``, ``compliance``; and :class:`StudyCommand`,
+``converge``, ``work-precision``, ``stability-map``, ``compliance``, ``contact-laws``; and :class:`StudyCommand`,
 the command line every study shares (its subcommand and the ``main`` of its script)."""
 
 from __future__ import annotations
@@ -76,6 +76,13 @@ def register_compliance(subparsers: argparse._SubParsersAction) -> None:
     register(subparsers)
 
 
+def register_contact_laws(subparsers: argparse._SubParsersAction) -> None:
+    from .contact_laws import register
+
+    register(subparsers)
+
+
 #: The studies' registrars, in the order `--help` lists them.
 STUDIES: list[Callable[[argparse._SubParsersAction], None]] = [register_converge, register_work_precision,
-                                                               register_stability_map, register_compliance]
+                                                               register_stability_map, register_compliance,
+                                                               register_contact_laws]

@@ -155,13 +155,13 @@ class TipError:
     """sqrt(∫ (u - u_ref)² dt), trapezoid on the record grid (m s^½)."""
 
 
-def tip_error(result: Result, reference: Result, window: float) -> TipError:
-    """Tip errors of a run against a reference recorded on the same grid, over [0, window]."""
+def tip_error(result: Result, reference: Result, window: float, start: float = 0.0) -> TipError:
+    """Tip errors of a run against a reference recorded on the same grid, over [start, window]."""
     n = min(result.t.size, reference.t.size)
     t = result.t[:n]
     if not np.allclose(t, reference.t[:n], rtol=0, atol=1e-9 * max(1.0, float(t[-1]))):
         raise ValueError("runs not recorded on the same grid")
-    keep = t <= window * (1 + 1e-12)
+    keep = (t <= window * (1 + 1e-12)) & (t >= start * (1 - 1e-12))
     e = result.tip_u[:n][keep] - reference.tip_u[:n][keep]
     if e.size == 0 or not np.all(np.isfinite(e)):
         return TipError(math.inf, math.inf)
@@ -211,11 +211,15 @@ class Table:
         return "\n".join(lines) + "\n"
 
     def write(self, folder: Path, stem: str) -> tuple[Path, Path]:
-        md, csv_path = folder / f"{stem}.md", folder / f"{stem}.csv"
+        md = folder / f"{stem}.md"
         md.write_text(self.markdown(), encoding="utf-8")
+        return md, self.write_csv(folder / f"{stem}.csv")
+
+    def write_csv(self, csv_path: Path) -> Path:
+        """The rows as CSV (reals written so that they read back exactly)."""
         with csv_path.open("w", newline="", encoding="utf-8") as f:
             writer = csv.writer(f)
             writer.writerow(self.columns)
             for row in self.rows:
                 writer.writerow([repr(x) if isinstance(x, float) else x for x in row])
-        return md, csv_path
+        return csv_path

@@ -30,7 +30,7 @@ A specification (``input/sweeps/*.toml``)::
 
     [reductions.u_max]
     kind = "max"                  # max, min, mean, rms, peak_to_peak, final
-    quantity = "tip_u"            # tip_u, tip_v, reaction, energy, work, dissipated
+    quantity = "tip_u"            # tip_u, tip_v, reaction, energy, work, dissipated, damped
     after_periods = 50            # or after = 1.5 (s): only the records from then on
 
 Axis and scene keys are the namelist keys of :class:`beamstops.Scene` (fields and the
@@ -88,6 +88,9 @@ _KIND.update({key: "real" for key in ("stiffness", "youngs_modulus", "density", 
 # Stops along the span (issue 8): the Scene holds lower and upper as tuples then; a sweep sets one
 # value, for every stop. Their positions (nodes, x) are lists: give them in the base namelist.
 _KIND.update({"lower": "real", "upper": "real"})
+# Rayleigh damping (issue 12): a sweep sets one damping ratio, the same at both modes (the Scene
+# holds a tuple); two different ratios go in the base namelist.
+_KIND.update({"ratio": "real"})
 
 _TABLES = ("sweep", "scene", "axes", "periods", "reductions")
 _SWEEP_KEYS = ("base", "mode", "zip", "max_points", "timeout", "description")
@@ -96,7 +99,7 @@ _RANGE_KEYS = ("start", "stop", "num", "step", "spacing")
 _MODES = ("product", "zip")
 
 #: Result arrays a reduction may read (names of :class:`beamstops.Result`).
-QUANTITIES = ("tip_u", "tip_v", "reaction", "energy", "work", "dissipated")
+QUANTITIES = ("tip_u", "tip_v", "reaction", "energy", "work", "dissipated", "damped")
 _WINDOW = {"quantity": "tip_u", "after": None, "after_periods": None}
 #: Reduction kinds and their keys with defaults.
 REDUCTION_KINDS: dict[str, dict[str, Any]] = {
