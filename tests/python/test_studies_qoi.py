@@ -27,7 +27,7 @@ def test_files_and_every_law(quick_tables: tuple[Path, dict[str, object]]) -> No
             f"work_precision_{q}{suffix}" for q in QOIS for suffix in (".md", ".csv", ".png", "_dt.png")]:
         assert (folder / name).stat().st_size > 0, name
     labels = [law.label for law in qoi_workprecision.settings(True)[1]]
-    assert len(labels) == 4
+    assert len(labels) == 5 and any(label.startswith("reduced") for label in labels)
     for q in QOIS:
         with (folder / f"work_precision_{q}.csv").open(encoding="utf-8") as f:
             rows = list(csv.DictReader(f))
@@ -108,6 +108,10 @@ def test_cli_converge_qoi(tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
     assert "qoi_convergence.md" in capsys.readouterr().out
     text = (tmp_path / "qoi_convergence_stop_power_dt.md").read_text(encoding="utf-8")
     assert "reference" in text and "across 3 members" in text
+    # the reduced models (modes r) against the full model
+    with (tmp_path / "qoi_convergence_tip_rms_modes.csv").open(encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    assert [row["modes r"] for row in rows] == ["4", "8", "full"]
 
 
 @pytest.mark.parametrize("options", [["--qoi", "speed"], ["--qoi", "stop_power", "--half-width", "-2%"]])

@@ -34,12 +34,14 @@ class Ladders:
     elements: tuple[int, ...]
     elements_reference: int
     dt_of_j: float
+    modes: tuple[int, ...] = ()
+    """Reduced models (&mesh modes) at the base J and ``dt_of_j``, against the full model there."""
 
 
 def ladders(quick: bool) -> Ladders:
     if quick:
-        return Ladders((4e-5, 2e-5), 1e-5, (5, 10), 19, 2e-5)
-    return Ladders(tuple(4e-5 / 2**k for k in range(5)), 1.25e-6, (5, 10, 19), 38, 5e-6)
+        return Ladders((4e-5, 2e-5), 1e-5, (5, 10), 19, 2e-5, (4, 8))
+    return Ladders(tuple(4e-5 / 2**k for k in range(5)), 1.25e-6, (5, 10, 19), 38, 5e-6, (2, 4, 8, 16))
 
 
 @dataclass(frozen=True)
@@ -51,26 +53,31 @@ class Runs:
     dt_reference: Measured
     by_j: list[Measured]
     j_reference: Measured
+    by_r: list[Measured]
+    r_reference: Measured
 
 
 def run_ladders(base: Scene, lad: Ladders, s: Settings, quiet: bool = False) -> Runs:
     """Every Δt and J of the ladders and both references (the Δt reference with ``s.members`` members)."""
     todo: list[tuple[str, object]] = ([("dt", dt) for dt in lad.dts] + [("dt_ref", lad.dt_reference)]
-                                      + [("J", j) for j in lad.elements] + [("J_ref", lad.elements_reference)])
-    out: dict[str, list[Measured]] = {"dt": [], "dt_ref": [], "J": [], "J_ref": []}
+                                      + [("J", j) for j in lad.elements] + [("J_ref", lad.elements_reference)]
+                                      + [("r", r) for r in lad.modes] + [("r_ref", 0)])
+    out: dict[str, list[Measured]] = {"dt": [], "dt_ref": [], "J": [], "J_ref": [], "r": [], "r_ref": []}
     for kind, x in progress(todo, "converge (statistics)", quiet=quiet):
         if kind.startswith("dt"):
             scene = base.replace(dt=x)
+        elif kind.startswith("r"):
+            scene = base.replace(dt=lad.dt_of_j, modes=x)
         else:
             scene = base.replace(dt=lad.dt_of_j, elements=x)
         reference = kind.endswith("_ref")
         out[kind].append(measure(scene, s.transient, s.reference_window if reference else s.window, batches=s.batches,
                                  members=s.members if kind == "dt_ref" else 1, perturbation=s.perturbation))
-    return Runs(base, out["dt"], out["dt_ref"][0], out["J"], out["J_ref"][0])
+    return Runs(base, out["dt"], out["dt_ref"][0], out["J"], out["J_ref"][0], out["r"], out["r_ref"][0])
 
 
-def tables(runs: Runs, qoi: str, half_width: HalfWidth, s: Settings) -> tuple[Table, Table]:
-    """The Δt table and the J table of one QoI."""
+def tables(runs: Runs, qoi: str, half_width: HalfWidth, s: Settings) -> tuple[Table, Table, Table]:
+    """The Δt table, the J table and the table of reduced models (modes r) of one QoI."""
     b = runs.base
     scene = f"paper's scene (Signorini, e = {b.restitution:g}, β = {b.beta:g}, centred load), {s.describe()}"
     by_dt = table(f"{qoi} ({statistic_name(qoi)}) against Δt, J = {b.elements}, h* = {half_width}", ["Δt (s)"],
@@ -83,19 +90,29 @@ def tables(runs: Runs, qoi: str, half_width: HalfWidth, s: Settings) -> tuple[Ta
     by_j = table(f"{qoi} ({statistic_name(qoi)}) against J, Δt = {dt_j:g} s, h* = {half_width}", ["J"],
                  [([m.scene.elements], m) for m in runs.by_j], ([runs.j_reference.scene.elements], runs.j_reference),
                  qoi, half_width, note=f"{scene}. Reference: J = {runs.j_reference.scene.elements}.")
-    return by_dt, by_j
+    by_r = table(f"{qoi} ({statistic_name(qoi)}) against the modes r of a reduced model, J = {b.elements}, "
+                 f"Δt = {dt_j:g} s, h* = {half_width}", ["modes r"],
+                 [([m.scene.modes], m) for m in runs.by_r], (["full"], runs.r_reference), qoi, half_width,
+                 note=f"{scene}. Reference: the full finite-element model (modes = 0) at the same J and Δt; "
+                      "CPU: the reduced models' own (engine cpu_seconds).")
+    return by_dt, by_j, by_r
 
 
 def draw(runs: Runs, qoi: str, path: Path) -> Path:
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(11, 4.5), layout="constrained")
-    errorbar_panel(fig.add_subplot(1, 2, 1), [m.scene.dt for m in runs.by_dt], runs.by_dt, runs.dt_reference, qoi,
+    fig = Figure(figsize=(16, 4.5), layout="constrained")
+    errorbar_panel(fig.add_subplot(1, 3, 1), [m.scene.dt for m in runs.by_dt], runs.by_dt, runs.dt_reference, qoi,
                    reference_x=runs.dt_reference.scene.dt, xlabel="Δt (s)",
                    title=f"{statistic_name(qoi)} against Δt (J = {runs.base.elements})")
-    errorbar_panel(fig.add_subplot(1, 2, 2), [m.scene.elements for m in runs.by_j], runs.by_j, runs.j_reference, qoi,
+    errorbar_panel(fig.add_subplot(1, 3, 2), [m.scene.elements for m in runs.by_j], runs.by_j, runs.j_reference, qoi,
                    reference_x=runs.j_reference.scene.elements, xlabel="J (elements)",
                    title=f"{statistic_name(qoi)} against J (Δt = {runs.j_reference.scene.dt:g} s)")
+    if runs.by_r:
+        full = 2 * runs.base.elements - 1  # where the full model stands on the axis of modes
+        errorbar_panel(fig.add_subplot(1, 3, 3), [m.scene.modes for m in runs.by_r], runs.by_r, runs.r_reference,
+                       qoi, reference_x=full, xlabel="modes r (reduced model; rightmost: the full model)",
+                       title=f"{statistic_name(qoi)} against modes r (J = {runs.base.elements})")
     fig.savefig(path, dpi=110)
     return path
 
@@ -103,22 +120,23 @@ def draw(runs: Runs, qoi: str, path: Path) -> Path:
 def study(folder: Optional[Path] = None, *, qois: Sequence[str] = ("stop_power",), quick: bool = False,
           half_width: HalfWidth = HalfWidth(0.02, True), transient: Optional[float] = None,
           window: Optional[float] = None, reference_window: Optional[float] = None, members: Optional[int] = None,
-          quiet: bool = False) -> dict[str, tuple[Table, Table]]:
+          quiet: bool = False) -> dict[str, tuple[Table, Table, Table]]:
     """Run both ladders once; write the tables and the chart of every QoI."""
     for q in qois:
         statistic_name(q)
     folder = out_dir(folder, "convergence")
     s, _ = settings(quick, transient, window, reference_window, members)
     runs = run_ladders(Scene(beta=0.5), ladders(quick), s, quiet)
-    out: dict[str, tuple[Table, Table]] = {}
+    out: dict[str, tuple[Table, Table, Table]] = {}
     text = []
     for q in qois:
-        by_dt, by_j = tables(runs, q, half_width, s)
+        by_dt, by_j, by_r = tables(runs, q, half_width, s)
         by_dt.write(folder, f"qoi_convergence_{q}_dt")
         by_j.write(folder, f"qoi_convergence_{q}_J")
+        by_r.write(folder, f"qoi_convergence_{q}_modes")
         draw(runs, q, folder / f"qoi_convergence_{q}.png")
-        text += [by_dt.markdown(), by_j.markdown()]
-        out[q] = (by_dt, by_j)
-    (folder / "qoi_convergence.md").write_text("# Convergence of statistics in Δt and J\n\n" + "\n".join(text),
+        text += [by_dt.markdown(), by_j.markdown(), by_r.markdown()]
+        out[q] = (by_dt, by_j, by_r)
+    (folder / "qoi_convergence.md").write_text("# Convergence of statistics in Δt, J and modes r\n\n" + "\n".join(text),
                                                 encoding="utf-8")
     return out
