@@ -185,7 +185,11 @@ class Scene:
 
     @classmethod
     def _of_canonical(cls, text: str) -> Scene:
-        return cls(**_fields_of(text))
+        """The scene of the engine's canonical text, as it is: no second reading by the engine
+        (the canonical text reads back as itself)."""
+        scene = object.__new__(cls)
+        _adopt(scene, text)
+        return scene
 
     def replace(self, _source: str = "scene", **changes: Any) -> Scene:
         """A copy with some keys changed: any field, or a route (the material, ``stiffness``, ``x``).
