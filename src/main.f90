@@ -1,6 +1,8 @@
 !> The `beamstops` command-line program:
 !>   beamstops run FILE.nml [-o OUT.h5] [--restart]   run a scene (or resume it from its last
 !>                                        checkpoint), write its HDF5 file, print a summary
+!>   beamstops run A.nml B.nml ... [--restart]   run several scenes, the ones that share A in
+!>                                        lockstep (beamstops_batch), each into its own file
 !>   beamstops info FILE.nml              print the scene, its discretization and limits
 !>   beamstops plot | sweep | converge | ... ARGS   the subcommands of `python -m beamstops`,
 !>                                        handed (execv) to the Python of the program's environment
@@ -10,9 +12,10 @@ program beamstops_main
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use beamstops
    use beamstops_checkpoint, only: checkpoint_path, read_checkpoint, is_checkpoint
-   use beamstops_files, only: file_exists, remove_file
+   use beamstops_files, only: file_exists, remove_file, same_file
    use beamstops_recorder_hdf5, only: partial_path, check_output_path
    use beamstops_run, only: continue_run
+   use beamstops_batch, only: lockstep_groups, simulate_group
    implicit none
 
    interface
@@ -55,6 +58,11 @@ program beamstops_main
       end function c_readlink
    end interface
 
+   !> A file name of the command line.
+   type :: path_type
+      character(len=:), allocatable :: text
+   end type path_type
+
    !> A C string (NUL-terminated), for execv's argument vector.
    type :: c_string
       character(kind=c_char), allocatable :: text(:)
@@ -93,13 +101,16 @@ program beamstops_main
 
    integer, parameter :: exit_input = 1, exit_usage = 2, exit_diverged = 3, exit_output = 4
    character(len=:), allocatable :: command, path, out
+   type(path_type), allocatable :: paths(:)
    logical :: restart = .false.
    type(scene_type) :: scene
    type(model_type) :: model
    type(error_type), allocatable :: error
 
    call ignore_file_size_signal()
-   call parse_arguments(command, path, out, restart)
+   call parse_arguments(command, paths, out, restart)
+   if (size(paths) > 1) call run_several(paths, restart)
+   path = paths(1)%text
    call read_scene(path, scene, error)
    call stop_on(error, exit_input)
    if (allocated(out)) scene%output_file = out
@@ -109,16 +120,19 @@ program beamstops_main
    case ('info')
       call print_info(scene, model)
    case ('run')
-      call run_to_file(scene, model, path, restart)
+      call quit(run_to_file(scene, model, path, restart, c_isatty(2_c_int) == 1))
    end select
 
 contains
 
-   subroutine parse_arguments(command, path, out, restart)
-      character(len=:), allocatable, intent(out) :: command, path, out
+   subroutine parse_arguments(command, paths, out, restart)
+      character(len=:), allocatable, intent(out) :: command, out
+      type(path_type), allocatable, intent(out) :: paths(:)
+      type(path_type) :: item
       logical, intent(inout) :: restart
       character(len=4096) :: arg
       integer :: i, n
+      allocate (paths(0))
       n = command_argument_count()
       if (n < 1) call usage('missing command')
       call get_command_argument(1, arg)
@@ -147,12 +161,16 @@ contains
             if (command /= 'run') call usage("'--restart' goes with 'run'")
             restart = .true.
          case default
-            if (arg(1:1) == '-' .or. allocated(path)) call usage("unexpected argument '"//trim(arg)//"'")
-            path = trim(arg)
+            if (arg(1:1) == '-' .or. (command /= 'run' .and. size(paths) > 0)) &
+               & call usage("unexpected argument '"//trim(arg)//"'")
+            item%text = trim(arg)
+            paths = [paths, item]
          end select
          i = i + 1
       end do
-      if (.not. allocated(path)) call usage('missing namelist file')
+      if (size(paths) == 0) call usage('missing namelist file')
+      if (size(paths) > 1 .and. allocated(out)) call usage("'-o' names the output of one scene; with several "// &
+         & 'namelist files each scene writes its own (&output file; default: the input''s name with .h5)')
    end subroutine parse_arguments
 
    !> The help (on stdout), or a problem and the help on stderr with exit status 2.
@@ -169,6 +187,9 @@ contains
          & '  run FILE.nml [-o OUT.h5] [--restart]', &
          & '                  run a scene, write its HDF5 output (OUT.h5.partial until the run is done);', &
          & '                  with --restart, continue from the last checkpoint (&output checkpoint_every)', &
+         & '  run A.nml B.nml ... [--restart]', &
+         & '                  run several scenes, those that share A = M + dt^2 beta S in lockstep, each', &
+         & '                  into its own output (&output file); every file is checked before any runs', &
          & '  info FILE.nml   print the scene, kappa_h, stability limits and cost, without running', &
          & 'commands of the Python package (python -m beamstops of this environment; COMMAND --help):'
       do k = 1, n_python_commands
@@ -293,15 +314,18 @@ contains
       previous = c_signal(sigxfsz, transfer(sig_ign, c_null_funptr))
    end subroutine ignore_file_size_signal
 
-   !> Run a scene into its HDF5 output. The output path is checked before anything is written
+   !> Run a scene into its HDF5 output; the exit status (0: complete), every problem told on
+   !> stderr. The output path is checked before anything is written
    !> (not the input, not a file other than a beamstops output); the run writes OUT.partial
    !> and the recorder renames it onto OUT when the run went to its end (complete or diverged).
    !> With `restart`, the partial file continues from the checkpoint OUT.checkpoint.
-   subroutine run_to_file(scene, model, input, restart)
+   integer function run_to_file(scene, model, input, restart, progress) result(status)
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
       character(len=*), intent(in) :: input
       logical, intent(in) :: restart
+      !> Print a progress line on stderr.
+      logical, intent(in) :: progress
       type(hdf5_recorder) :: recorder
       type(run_summary) :: summary
       type(state_type) :: state
@@ -309,16 +333,14 @@ contains
       character(len=:), allocatable :: output, partial, checkpoint
       integer(ik) :: records, snapshots
       logical :: resume
+      status = 0
       output = scene%output_file
       partial = partial_path(output)
       checkpoint = checkpoint_path(output)
       call check_output_path(output, input, error)
-      call stop_on(error, exit_output)
-      if (file_exists(checkpoint) .and. .not. is_checkpoint(checkpoint)) then
-         call fatal_error(error, checkpoint//': exists and is not a beamstops checkpoint; refusing to overwrite it '// &
-            & '(move it away)')
-         call stop_on(error, exit_output)
-      end if
+      if (reported(error, exit_output, status)) return
+      call check_checkpoint_path(checkpoint, error)
+      if (reported(error, exit_output, status)) return
       resume = .false.
       if (restart) then
          if (.not. file_exists(checkpoint)) then
@@ -332,15 +354,15 @@ contains
       end if
       if (resume) then
          call read_checkpoint(checkpoint, scene, model, state, records, snapshots, error)
-         call stop_on(error, exit_input)
+         if (reported(error, exit_input, status)) return
          call recorder%reopen(output, scene, model, records, snapshots, error)
-         call stop_on(error, exit_output)
+         if (reported(error, exit_output, status)) return
       else
          call remove_file(checkpoint)
          call recorder%open(output, scene, model, error)
-         call stop_on(error, exit_output)
+         if (reported(error, exit_output, status)) return
       end if
-      recorder%show_progress = c_isatty(2_c_int) == 1
+      recorder%show_progress = progress
       if (scene%modes > 0) then
          call simulate(scene, model, recorder, summary, error)
       else if (.not. resume) then
@@ -353,28 +375,187 @@ contains
          call continue_run(scene, model, state, recorder, summary, write_error, checkpoint)
       end if
       call recorder%finish(summary, finish_error)
-      call stop_on(error, exit_input)
-      if (allocated(write_error)) call stop_on_write(write_error, output)
-      if (allocated(finish_error)) call stop_on_write(finish_error, output)
-      if (summary%status == status_complete .or. summary%status == status_diverged) call remove_file(checkpoint)
+      status = run_outcome(scene, summary, error, write_error, finish_error)
+   end function run_to_file
+
+   !> Refuse a checkpoint path that holds something else than a beamstops checkpoint.
+   subroutine check_checkpoint_path(checkpoint, error)
+      character(len=*), intent(in) :: checkpoint
+      type(error_type), allocatable, intent(out) :: error
+      if (file_exists(checkpoint) .and. .not. is_checkpoint(checkpoint)) call fatal_error(error, checkpoint// &
+         & ': exists and is not a beamstops checkpoint; refusing to overwrite it (move it away)')
+   end subroutine check_checkpoint_path
+
+   !> The end of a run whose recorder is finished: the messages, the summary line and the exit
+   !> status (0 complete, 1 the run could not start, 3 diverged or failed, 4 a write failed).
+   integer function run_outcome(scene, summary, start_error, write_error, finish_error) result(status)
+      type(scene_type), intent(in) :: scene
+      type(run_summary), intent(in) :: summary
+      type(error_type), allocatable, intent(in) :: start_error, write_error, finish_error
+      character(len=:), allocatable :: output
+      status = 0
+      output = scene%output_file
+      if (reported(start_error, exit_input, status)) return
+      if (allocated(write_error)) then
+         status = write_failed(write_error, output)
+         return
+      end if
+      if (allocated(finish_error)) then
+         status = write_failed(finish_error, output)
+         return
+      end if
+      if (summary%status == status_complete .or. summary%status == status_diverged) &
+         & call remove_file(checkpoint_path(output))
       write (output_unit, '(a)') summary_line(scene, summary)
       if (summary%status == status_diverged) then
          write (error_unit, '(a)') 'beamstops: error: '//output//': run diverged: '//summary%message
-         call quit(exit_diverged)
+         status = exit_diverged
       else if (summary%status /= status_complete) then
          write (error_unit, '(a)') 'beamstops: error: '//output//': run '//summary%status//': '// &
-            & summary%message//'; '//output//' is left as it was, the run so far is in '//partial
-         call quit(exit_diverged)
+            & summary%message//'; '//output//' is left as it was, the run so far is in '//partial_path(output)
+         status = exit_diverged
       end if
-   end subroutine run_to_file
+   end function run_outcome
 
    !> A write failed: one message, exit status 4; the output is untouched.
-   subroutine stop_on_write(failure, output)
+   integer function write_failed(failure, output) result(status)
       type(error_type), intent(in) :: failure
       character(len=*), intent(in) :: output
       write (error_unit, '(a)') 'beamstops: error: '//failure%message//'; '//output//' is left as it was'
-      call quit(exit_output)
-   end subroutine stop_on_write
+      status = exit_output
+   end function write_failed
+
+   !> Whether there is an error; if so, it is told on stderr and `status` becomes `code`.
+   logical function reported(error, code, status)
+      type(error_type), allocatable, intent(in) :: error
+      integer, intent(in) :: code
+      integer, intent(inout) :: status
+      reported = allocated(error)
+      if (.not. reported) return
+      write (error_unit, '(a)') 'beamstops: error: '//error%message
+      status = code
+   end function reported
+
+   !> `beamstops run A.nml B.nml ...`: every file read, every scene prepared and every output
+   !> path checked before anything runs (one bad file: its message, nothing runs, exit status 1
+   !> or 4). The scenes are partitioned into lockstep groups by the engine's rule
+   !> (lockstep_groups); a group runs in lockstep, a scene that joins no other runs alone (as
+   !> `beamstops run FILE.nml`), and each writes its own output exactly as it would alone, with
+   !> its summary line. Exit status: 0 when every scene completed, else the largest of the
+   !> scenes' statuses (3 diverged or failed, 4 an output could not be written).
+   subroutine run_several(paths, restart)
+      type(path_type), intent(in) :: paths(:)
+      logical, intent(in) :: restart
+      type(scene_type), allocatable :: scenes(:)
+      type(model_type), allocatable :: models(:)
+      type(error_type), allocatable :: error
+      integer, allocatable :: group(:), status(:), members(:)
+      logical, allocatable :: alone(:)
+      character(len=:), allocatable :: output
+      integer :: i, j, n, g
+      logical :: progress
+      n = size(paths)
+      allocate (scenes(n), models(n), status(n), alone(n))
+      do i = 1, n
+         call read_scene(paths(i)%text, scenes(i), error)
+         if (.not. allocated(error)) call prepare_run(scenes(i), paths(i)%text, models(i), error)
+         call refuse_all(error, exit_input, n)
+      end do
+      do i = 1, n
+         output = scenes(i)%output_file
+         call check_output_path(output, paths(i)%text, error)
+         do j = 1, n
+            if (allocated(error)) exit
+            if (j /= i .and. same_file(output, paths(j)%text)) call fatal_error(error, output//': is the input '// &
+               & 'file '//paths(j)%text//'; writing the output of '//paths(i)%text//' there would destroy it')
+            if (j < i .and. scenes(j)%output_file == output) call fatal_error(error, output//': is the output of '// &
+               & 'both '//paths(j)%text//' and '//paths(i)%text//'; give each scene its own (&output file)')
+         end do
+         if (.not. allocated(error)) call check_checkpoint_path(checkpoint_path(output), error)
+         call refuse_all(error, exit_output, n)
+         alone(i) = restart .and. file_exists(checkpoint_path(output)) .and. file_exists(partial_path(output))
+      end do
+      call lockstep_groups(scenes, models, group, alone)
+      block
+         integer, allocatable :: sizes(:)
+         sizes = [(count(group == g), g=1, maxval(group))]
+         write (error_unit, '(a,i0,a,i0,a,i0,a,i0,a)') 'beamstops: ', n, ' scenes: ', sum(sizes, sizes > 1), &
+            & ' in ', count(sizes > 1), ' lockstep group(s), ', count(sizes == 1), ' alone'
+      end block
+      progress = c_isatty(2_c_int) == 1
+      status = 0
+      do g = 1, maxval(group)
+         members = pack([(i, i=1, n)], group == g)
+         if (size(members) == 1) then
+            i = members(1)
+            status(i) = run_to_file(scenes(i), models(i), paths(i)%text, restart, progress)
+         else
+            call run_group_to_files(scenes, models, paths, members, progress, status)
+         end if
+      end do
+      if (any(status /= 0)) write (error_unit, '(a,i0,a,i0,a)') 'beamstops: ', count(status /= 0), ' of ', n, &
+         & ' scenes did not complete (messages above)'
+      call quit(maxval(status))
+   end subroutine run_several
+
+   !> One of n inputs cannot run: its message, and nothing runs.
+   subroutine refuse_all(error, code, n)
+      type(error_type), allocatable, intent(in) :: error
+      integer, intent(in) :: code, n
+      if (.not. allocated(error)) return
+      write (error_unit, '(a)') 'beamstops: error: '//error%message
+      write (error_unit, '(a,i0,a)') 'beamstops: none of the ', n, ' scenes was run'
+      call quit(code)
+   end subroutine refuse_all
+
+   !> Run the scenes `members` (one lockstep group) into their outputs; status(i) gets scene i's
+   !> exit status. A scene whose output cannot be opened fails (4) and the others run; a group
+   !> that cannot start runs its scenes one at a time instead.
+   subroutine run_group_to_files(scenes, models, paths, members, progress, status)
+      type(scene_type), intent(in) :: scenes(:)
+      type(model_type), intent(in) :: models(:)
+      type(path_type), intent(in) :: paths(:)
+      integer, intent(in) :: members(:)
+      logical, intent(in) :: progress
+      integer, intent(inout) :: status(:)
+      type(hdf5_recorder), allocatable :: recorders(:)
+      type(run_summary), allocatable :: summaries(:)
+      type(error_type), allocatable :: failures(:)
+      type(error_type), allocatable :: error, start_error, write_error, finish_error
+      logical, allocatable :: opened(:)
+      integer, allocatable :: ids(:)
+      integer :: k, i
+      allocate (recorders(size(members)), opened(size(members)))
+      do k = 1, size(members)
+         i = members(k)
+         call remove_file(checkpoint_path(scenes(i)%output_file))
+         call recorders(k)%open(scenes(i)%output_file, scenes(i), models(i), error)
+         opened(k) = .not. reported(error, exit_output, status(i))
+      end do
+      ids = pack(members, opened)
+      if (size(ids) == 0) return
+      if (.not. all(opened)) recorders = pack(recorders, opened)
+      recorders(1)%show_progress = progress
+      allocate (summaries(size(ids)), failures(size(ids)))
+      call simulate_group(scenes(ids), models(ids), recorders, summaries, failures, error)
+      if (allocated(error)) then
+         write (error_unit, '(a)') 'beamstops: note: '//error%message//'; running these scenes one at a time'
+         do k = 1, size(ids)
+            summaries(k)%status = status_failed
+            summaries(k)%message = error%message
+            call recorders(k)%finish(summaries(k), finish_error)
+            status(ids(k)) = run_to_file(scenes(ids(k)), models(ids(k)), paths(ids(k))%text, .false., progress)
+         end do
+         return
+      end if
+      do k = 1, size(ids)
+         i = ids(k)
+         if (allocated(write_error)) deallocate (write_error)
+         if (allocated(failures(k)%message)) call fatal_error(write_error, failures(k)%message)
+         call recorders(k)%finish(summaries(k), finish_error)
+         status(i) = run_outcome(scenes(i), summaries(k), start_error, write_error, finish_error)
+      end do
+   end subroutine run_group_to_files
 
    function summary_line(scene, summary) result(line)
       type(scene_type), intent(in) :: scene

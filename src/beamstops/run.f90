@@ -18,7 +18,7 @@ module beamstops_run
    use beamstops_reduced_scheme, only: simulate_reduced
    implicit none
    private
-   public :: prepare_run, simulate, continue_run
+   public :: prepare_run, simulate, continue_run, close_run
 
 contains
 
@@ -105,6 +105,23 @@ contains
             return
          end if
       end do
+      call close_run(scene, model, recorder, summary, error)
+   end subroutine continue_run
+
+   !> What follows the time loop of a run (continue_run's, or a lockstep group's for each of its
+   !> members): a complete run of an &ensemble runs its members 2..K; a recorder that could not
+   !> write makes the run 'failed' with the recorder's message.
+   subroutine close_run(scene, model, recorder, summary, error)
+      !> Validated scene.
+      type(scene_type), intent(in) :: scene
+      !> Its model.
+      type(model_type), intent(in) :: model
+      !> The run's recorder.
+      class(recorder_type), intent(inout) :: recorder
+      !> Outcome of the time loop; gains the ensemble's table, or status 'failed'.
+      type(run_summary), intent(inout) :: summary
+      !> Set when the ensemble's members cannot run or the recorder could not write.
+      type(error_type), allocatable, intent(out) :: error
       if (summary%status == status_complete .and. scene%members > 1 .and. scene%statistics .and. &
          & .not. recorder%failed) then
          call run_members(scene, model, summary, error)
@@ -119,5 +136,5 @@ contains
          summary%status = status_failed
          summary%message = error%message
       end if
-   end subroutine continue_run
+   end subroutine close_run
 end module beamstops_run
