@@ -420,6 +420,10 @@ def main() -> int:
                    "beamstops wall s", "paper / beamstops"], rows))
         if quick:
             say("\n(--quick: figures 2 and 4 only.)")
+    import bench_sweep  # noqa: E402  (its own module: python scripts/bench_sweep.py runs it alone)
+
+    say("")
+    out.extend(bench_sweep.section(str(program), quick))
     text = "\n".join(out) + "\n"
     print(text)
     if args.out:

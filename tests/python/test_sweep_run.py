@@ -160,7 +160,10 @@ def test_resume_skips_finished_points_and_reruns_interrupted_ones(tmp_path: Path
 def test_resume_after_a_real_interruption_gives_the_uninterrupted_results(tmp_path: Path,
                                                                           write_spec: Callable[..., Path],
                                                                           without_timing: Callable[..., Any]) -> None:
+    # batches of 2 points (lockstep) on one worker: the kill comes while a later batch runs
     text = """
+[sweep]
+lockstep = 2
 [scene]
 elements = 10
 dt = 2e-5

@@ -4,7 +4,8 @@ The folder of a sweep (``-o DIR``)::
 
     DIR/sweep.json       the manifest: the specification's hash, file, overrides, axes, reductions
     DIR/spec.toml        the specification's text, as given
-    DIR/points/NNNNN.nml the point's scene (Scene.to_namelist), run as `beamstops run NNNNN.nml -o NNNNN.h5`
+    DIR/points/NNNNN.nml the point's scene (Scene.to_namelist), run as `beamstops run NNNNN.nml -o NNNNN.h5`,
+                         or with others of its batch as `beamstops run NNNNN.nml MMMMM.nml ...`
     DIR/points/NNNNN.h5  the program's own output
     DIR/points/NNNNN.json the point's record: parameters, status, message, figures, reductions
     DIR/summary.csv      one row per point (also summary.json, with full lists)
@@ -43,7 +44,7 @@ from typing import Any, Optional, TextIO
 
 from .reductions import columns as reduction_columns
 from .spec import Spec
-from .worker import FINISHED, read_status, run_point
+from .worker import FINISHED, read_status, run_batch
 
 __all__ = ["run_sweep", "read_summary", "find_program", "make_executor", "Outcome", "FolderLock", "MANIFEST",
            "LOCK", "EXECUTORS"]
@@ -71,6 +72,8 @@ class Outcome:
     """Points finished by an earlier call."""
     wall_seconds: float
     executor: str
+    lockstep: int = 0
+    """Points the engine ran in lockstep groups in this call (batches of ``[sweep] lockstep``)."""
 
     @property
     def summary(self) -> Path:
@@ -329,6 +332,17 @@ def plan(spec: Spec, folder: Path, program: str, timeout: Optional[float]
     return done, tasks
 
 
+def batches(tasks: list[dict[str, Any]], lockstep: int, workers: int) -> list[list[dict[str, Any]]]:
+    """The tasks in batches of `beamstops run` processes: consecutive runs (in the order of
+    ``plan``), at most ``lockstep`` per batch and no more than keep every worker busy; a point
+    only to reduce again goes alone. Which points of a batch share A the engine decides."""
+    runs = [t for t in tasks if not t.get("reduce_only")]
+    out: list[list[dict[str, Any]]] = [[t] for t in tasks if t.get("reduce_only")]
+    size = max(1, min(lockstep, math.ceil(len(runs) / max(1, workers))))
+    out.extend(runs[i:i + size] for i in range(0, len(runs), size))
+    return out
+
+
 def _read_record(path: Path) -> Optional[dict[str, Any]]:
     try:
         record = json.loads(path.read_text(encoding="utf-8"))
@@ -556,11 +570,15 @@ def _run_sweep(spec: Spec, out: Path, *, executor: str, jobs: Optional[int], pro
 
     start = time.perf_counter()
     description = "nothing to run"
+    in_lockstep = 0
     if tasks:
-        pool, description, _ = make_executor(executor, jobs)
+        pool, description, workers = make_executor(executor, jobs)
         refused, first = _refusals(spec)
+        work = batches(tasks, spec.lockstep, workers)
+        grouped = (f" in {len(work)} batches of up to {max(len(b) for b in work)} (lockstep = {spec.lockstep})"
+                   if len(work) < len(tasks) else "")
         say(f"sweep: {len(spec.points)} points in {folder} (spec {spec.hash[:12]}): {len(done)} done before, "
-            f"{len(tasks)} to run on {description}")
+            f"{len(tasks)} to run on {description}{grouped}")
         if note:
             say(f"sweep: note: {note}")
         if refused:
@@ -573,23 +591,30 @@ def _run_sweep(spec: Spec, out: Path, *, executor: str, jobs: Optional[int], pro
             previous = signal.signal(signal.SIGTERM, _on_term)
         except ValueError:  # not the main thread
             pass
-        futures: dict[Future[dict[str, Any]], dict[str, Any]] = {}
+        futures: dict[Future[dict[str, Any]], list[dict[str, Any]]] = {}
         last_summary = time.perf_counter()
         try:
-            for task in tasks:
-                futures[pool.submit(run_point, task)] = task
+            for batch in work:
+                futures[pool.submit(run_batch, batch)] = batch
             for future in as_completed(futures):
-                task = futures[future]
+                batch = futures[future]
                 try:
-                    record = future.result()
-                except Exception as exc:  # the worker itself died; the point fails, the sweep goes on
-                    record = {"point": task["index"], "params": task["params"], "status": "failed",
-                              "message": f"worker failed: {type(exc).__name__}: {exc}", "reductions": {}}
-                records[task["index"]] = record
-                if record.get("status") == "failed":
-                    progress.say(f"sweep: point {task['index']} ({_params(task['params'])}) failed: "
-                                 f"{record.get('message', '')}")
-                progress.update(record, costs[task["index"]])
+                    result = future.result()
+                    got = result["records"]
+                    in_lockstep += int(result.get("lockstep", 0))
+                except Exception as exc:  # the worker itself died; its points fail, the sweep goes on
+                    got = [{"point": task["index"], "params": task["params"], "status": "failed",
+                            "message": f"worker failed: {type(exc).__name__}: {exc}", "reductions": {}}
+                           for task in batch]
+                for task in batch:
+                    record = next((r for r in got if r.get("point") == task["index"]), None) or {
+                        "point": task["index"], "params": task["params"], "status": "failed",
+                        "message": "the worker returned no record", "reductions": {}}
+                    records[task["index"]] = record
+                    if record.get("status") == "failed":
+                        progress.say(f"sweep: point {task['index']} ({_params(task['params'])}) failed: "
+                                     f"{record.get('message', '')}")
+                    progress.update(record, costs[task["index"]])
                 if time.perf_counter() - last_summary > 60:
                     write_summary(spec, folder, records)
                     last_summary = time.perf_counter()
@@ -609,11 +634,13 @@ def _run_sweep(spec: Spec, out: Path, *, executor: str, jobs: Optional[int], pro
     statuses = [r.get("status") for r in records.values()]
     outcome = Outcome(folder=folder, total=len(spec.points), complete=statuses.count("complete"),
                       diverged=statuses.count("diverged"), failed=statuses.count("failed"), ran=len(tasks),
-                      skipped=len(done), wall_seconds=time.perf_counter() - start, executor=description)
+                      skipped=len(done), wall_seconds=time.perf_counter() - start, executor=description,
+                      lockstep=in_lockstep)
     cpu = sum(r.get("cpu_seconds") or 0.0 for i, r in records.items() if i not in done)
     say(f"sweep: {outcome.total} points: {outcome.complete} complete, {outcome.diverged} diverged, "
         f"{outcome.failed} failed ({outcome.ran} run now, {outcome.skipped} before; {_clock(outcome.wall_seconds)} "
-        f"wall, {cpu:.1f} s engine CPU); summary: {outcome.summary}")
+        f"wall, {cpu:.1f} s engine CPU{f'; {in_lockstep} ran in lockstep' if in_lockstep else ''}); "
+        f"summary: {outcome.summary}")
     return outcome
 
 

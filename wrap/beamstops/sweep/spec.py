@@ -8,6 +8,7 @@ A specification (``input/sweeps/*.toml``)::
     zip = [["omega", "amplitude"]]  # product mode only: groups of axes that vary together
     max_points = 10000            # refuse larger sweeps (default 10000)
     timeout = 600                 # wall-time limit of one point (s; default none)
+    lockstep = 8                  # points per `beamstops run` process (default 8; 1: one process per point)
     description = "free text"
 
     [scene]                       # fixed changes to the base scene: namelist keys, flat
@@ -23,6 +24,7 @@ A specification (``input/sweeps/*.toml``)::
     [periods]                     # optional: lengths in forcing periods T = 2π/ω (needs ω > 0)
     t_end = 100                   # t_end = 100 T at every point
     records_per_period = 16       # lock the time grid to the forcing (see below)
+    # shared_grid = true          # or: one dt and one t_end for every point (see below)
 
     [reductions.strobe]           # user-chosen reductions, each a column of the summary
     kind = "strobe"               # tip displacement at t = k T (+ phase T), k >= transient_periods
@@ -42,6 +44,17 @@ scene's dt) and ``record_every = m``: the records fall every T/r exactly, so the
 stroboscopic times k·T are record times (to round-off). Without it, dt and
 ``record_every`` are kept and a strobe takes the record nearest to each k·T; the summary
 then says how far off it was (``<name>_offset``, s).
+
+**One time grid for every point** (``shared_grid = true``, not with ``records_per_period``):
+every point keeps the scene's dt and runs the same t_end, the longest of the points' t_end
+periods (t_end · 2π/ω at the lowest ω), so each point covers at least t_end periods. Points
+that differ only in the forcing (ω, amplitude) or the tip stops then share A = M + dt²βS and
+the number of steps: the engine runs them in lockstep (the common ω sweep at one fixed Δt).
+
+**Lockstep batches** (``[sweep] lockstep = K``, default 8): the runner hands the points to
+the engine K at a time, as one ``beamstops run p1.nml ... pK.nml``; the engine runs those that
+share A in lockstep and the others alone (its rule, not the sweep's), each into its own file,
+identical to the point run alone. ``lockstep = 1`` runs one process per point.
 
 Any mistake ends in :class:`SpecError`, a ValueError whose message starts with the
 file's name: unknown tables or keys, unknown scene keys, empty axes, zip axes of
@@ -69,7 +82,7 @@ import numpy as np
 from ..scene import GROUPS, Scene
 
 __all__ = ["Spec", "Point", "SpecError", "load_spec", "parse_spec", "QUANTITIES", "REDUCTION_KINDS",
-           "DEFAULT_MAX_POINTS", "SCENE_KEYS"]
+           "DEFAULT_MAX_POINTS", "DEFAULT_LOCKSTEP", "SCENE_KEYS"]
 
 #: Version of the specification's resolved form (part of its hash).
 FORMAT = 1
@@ -93,8 +106,10 @@ _KIND.update({"lower": "real", "upper": "real"})
 _KIND.update({"ratio": "real"})
 
 _TABLES = ("sweep", "scene", "axes", "periods", "reductions")
-_SWEEP_KEYS = ("base", "mode", "zip", "max_points", "timeout", "description")
-_PERIOD_KEYS = ("t_end", "records_per_period")
+_SWEEP_KEYS = ("base", "mode", "zip", "max_points", "timeout", "description", "lockstep")
+_PERIOD_KEYS = ("t_end", "records_per_period", "shared_grid")
+#: Points per `beamstops run` process unless [sweep] lockstep says otherwise.
+DEFAULT_LOCKSTEP = 8
 _RANGE_KEYS = ("start", "stop", "num", "step", "spacing")
 _MODES = ("product", "zip")
 
@@ -156,6 +171,8 @@ class Spec:
     points: list[Point] = field(repr=False)
     hash: str = ""
     overrides: tuple[str, ...] = ()
+    lockstep: int = DEFAULT_LOCKSTEP
+    """Points per `beamstops run` process (the engine runs those that share A in lockstep)."""
 
     def resolved(self) -> dict[str, Any]:
         """What the hash covers: every point's scene and axis values, and the reductions."""
@@ -219,6 +236,10 @@ def _parse(data: Mapping[str, Any], path: str, base_dir: Path, text: str, overri
     timeout = sweep.get("timeout")
     if timeout is not None and not (_is_real(timeout) and math.isfinite(timeout) and timeout > 0):
         raise fail(f"[sweep] timeout = {_show(timeout)}; allowed: a number of seconds > 0")
+    lockstep = sweep.get("lockstep", DEFAULT_LOCKSTEP)
+    if not _is_int(lockstep) or not 1 <= lockstep <= 1024:
+        raise fail(f"[sweep] lockstep = {_show(lockstep)}; allowed: an integer 1 ... 1024 (points per process; "
+                   "1: one process per point)")
     description = sweep.get("description", "")
     if not isinstance(description, str):
         raise fail(f"[sweep] description must be a string, not {_show(description)}")
@@ -270,6 +291,13 @@ def _parse(data: Mapping[str, Any], path: str, base_dir: Path, text: str, overri
     axes = {key: _axis_values(key, value, fail) for key, value in raw_axes.items()}
 
     periods = _periods(data.get("periods"), fixed, axes, fail)
+    if periods is not None and periods["shared_grid"]:
+        omegas = [float(params.get("omega", fixed.get("omega", base_scene.omega)))
+                  for params in _combinations(axes, groups)]
+        if not min(omegas) > 0:
+            raise fail("[periods] needs omega > 0; the sweep has omega = "
+                       f"{min(omegas)!r}")
+        periods["shared_t_end"] = periods["t_end"] * 2 * math.pi / min(omegas)
     reductions = _reductions(data.get("reductions", {}), list(axes), fail)
 
     points = []
@@ -288,7 +316,7 @@ def _parse(data: Mapping[str, Any], path: str, base_dir: Path, text: str, overri
     return Spec(path=path, text=text, data=data, base=base_path, axes=axes, mode=mode, zip_groups=groups,
                 periods=periods, reductions=reductions, max_points=int(max_points),
                 timeout=float(timeout) if timeout is not None else None, description=description,
-                points=points, hash=digest, overrides=overrides)
+                points=points, hash=digest, overrides=overrides, lockstep=int(lockstep))
 
 
 # ---------------------------------------------------------------------- pieces
@@ -506,7 +534,14 @@ def _periods(table: Any, fixed: dict[str, Any], axes: dict[str, list[Any]], fail
             raise fail(f"[periods] records_per_period = {_show(records)}; allowed: an integer 1 ... 1000000")
         if "record_every" in fixed or "record_every" in axes:
             raise fail("[periods] records_per_period sets record_every; remove record_every from [scene] and [axes]")
-    return {"t_end": float(t_end), "records_per_period": int(records) if records is not None else None}
+    shared = table.get("shared_grid", False)
+    if not isinstance(shared, bool):
+        raise fail(f"[periods] shared_grid = {_show(shared)}; allowed: true or false")
+    if shared and records is not None:
+        raise fail("[periods] shared_grid = true keeps one dt for every point; records_per_period changes dt "
+                   "with omega: give one of the two")
+    return {"t_end": float(t_end), "records_per_period": int(records) if records is not None else None,
+            "shared_grid": shared}
 
 
 def _reductions(table: Any, axes: list[str], fail: Any) -> dict[str, dict[str, Any]]:
@@ -557,6 +592,8 @@ def _scene(base: Scene, fixed: dict[str, Any], params: dict[str, Any], periods: 
     if periods is None or not scene.omega > 0:
         return scene
     period = 2 * math.pi / scene.omega
+    if periods["shared_grid"]:
+        return dataclasses.replace(scene, t_end=periods["shared_t_end"])
     changes: dict[str, Any] = {"t_end": periods["t_end"] * period}
     records = periods["records_per_period"]
     if records is not None:

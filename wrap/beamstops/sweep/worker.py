@@ -1,7 +1,11 @@
-"""One point of a sweep, as an executor's task: write its namelist, run the program, reduce.
+"""Points of a sweep, as an executor's tasks: write their namelists, run the program, reduce.
 
-The point runs as ``beamstops run NAME.nml -o NAME.h5`` in a child process, so a crash
-or a hang (``timeout``) fails that point only. The program writes ``NAME.h5.partial`` and
+A point runs as ``beamstops run NAME.nml -o NAME.h5`` in a child process, so a crash
+or a hang (``timeout``) fails that point only. A batch of points runs as one
+``beamstops run P1.nml P2.nml ...`` (each namelist names its own output): the engine runs
+those that share A in lockstep, each into its own file as if alone; every point of the batch
+that did not end with a finished file (the batch crashed, hung, or was refused as a whole)
+runs again alone, so a batch never fails a point that would succeed alone. The program writes ``NAME.h5.partial`` and
 renames it onto ``NAME.h5`` only when the run went to its end (complete or diverged), so an
 existing ``NAME.h5`` is always a finished run. Its record (parameters, status, message,
 the run's figures and the reductions) is written next to its HDF5 file as ``NAME.json``
@@ -14,12 +18,13 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import subprocess
 import time
 from pathlib import Path
 from typing import Any, Optional
 
-__all__ = ["run_point", "read_status", "FINISHED"]
+__all__ = ["run_point", "run_batch", "read_status", "FINISHED"]
 
 #: HDF5 statuses of a run that has gone to its end (rerunning it gives the same file).
 FINISHED = ("complete", "diverged")
@@ -97,13 +102,7 @@ def run_point(task: dict[str, Any]) -> dict[str, Any]:
     folder = Path(task["folder"])
     name = task["name"]
     nml, h5, record_path = folder / f"{name}.nml", folder / f"{name}.h5", folder / f"{name}.json"
-    record: dict[str, Any] = {
-        "point": task["index"], "params": task["params"], "spec_hash": task["spec_hash"],
-        "status": "failed", "message": "", "cpu_seconds": None, "wall_seconds": None, "steps": None,
-        "impacts": None, "max_violation": None, "dissipated": None,
-        "dt": task["scene"]["dt"], "t_end": task["scene"]["t_end"], "record_every": task["scene"]["record_every"],
-        "file": f"{folder.name}/{h5.name}", "reductions": {},
-    }
+    record = _base_record(task, folder, h5)
     start = time.perf_counter()
     try:
         if not task.get("reduce_only"):
@@ -152,6 +151,82 @@ def _run_program(task: dict[str, Any], nml: Path, h5: Path, record: dict[str, An
         record["message"] = _message(done.stderr, done.stdout, done.returncode)
     else:
         record["message"] = _message(done.stderr, done.stdout, done.returncode)
+
+
+def _base_record(task: dict[str, Any], folder: Path, h5: Path) -> dict[str, Any]:
+    return {
+        "point": task["index"], "params": task["params"], "spec_hash": task["spec_hash"],
+        "status": "failed", "message": "", "cpu_seconds": None, "wall_seconds": None, "steps": None,
+        "impacts": None, "max_violation": None, "dissipated": None,
+        "dt": task["scene"]["dt"], "t_end": task["scene"]["t_end"], "record_every": task["scene"]["record_every"],
+        "file": f"{folder.name}/{h5.name}", "reductions": {},
+    }
+
+
+#: The program's line on stderr that says how it grouped the scenes of a batch.
+_GROUPS = re.compile(r"^beamstops: (\d+) scenes: (\d+) in (\d+) lockstep group")
+
+
+def run_batch(tasks: list[dict[str, Any]]) -> dict[str, Any]:
+    """Run points together as one ``beamstops run P1.nml P2.nml ...`` (the engine runs those
+    that share A in lockstep), then reduce each; the points that did not end with a finished
+    output run again one at a time (run_point). Returns ``{"records": [...], "lockstep": n}``
+    with n the points the engine ran in lockstep groups. Never raises an Exception."""
+    _arm()
+    if len(tasks) == 1:
+        return {"records": [run_point(tasks[0])], "lockstep": 0}
+    lockstep = 0
+    records: list[dict[str, Any]] = []
+    again: list[dict[str, Any]] = []
+    start = time.perf_counter()
+    try:
+        from ..scene import Scene
+
+        paths = []
+        for task in tasks:
+            folder = Path(task["folder"])
+            nml, h5 = folder / f"{task['name']}.nml", folder / f"{task['name']}.h5"
+            for stale in (h5, nml.with_suffix(".json")):
+                if stale.exists():
+                    stale.unlink()
+            Scene(**{**task["scene"], "file": str(h5)}).to_namelist(nml)
+            paths.append(str(nml))
+        timeout = tasks[0].get("timeout")
+        try:
+            done = subprocess.run([tasks[0]["program"], "run", *paths], capture_output=True, text=True,
+                                  timeout=timeout * len(tasks) if timeout else None, stdin=subprocess.DEVNULL)
+            for line in done.stderr.splitlines():
+                match = _GROUPS.match(line)
+                if match:
+                    lockstep = int(match.group(2))
+        except subprocess.TimeoutExpired:
+            pass  # the points not finished run again alone, each with its own time limit
+        wall = (time.perf_counter() - start) / len(tasks)
+        for task in tasks:
+            folder = Path(task["folder"])
+            h5 = folder / f"{task['name']}.h5"
+            if read_status(h5) not in FINISHED:
+                again.append(task)
+                continue
+            record = _base_record(task, folder, h5)
+            record["wall_seconds"] = wall
+            try:
+                _read(task, h5, record)
+            except Exception as exc:
+                record["status"] = "failed"
+                record["message"] = f"{type(exc).__name__}: {exc}"
+            try:
+                _write_json(folder / f"{task['name']}.json", record)
+            except OSError as exc:
+                record["status"] = "failed"
+                record["message"] = f"cannot write {task['name']}.json: {exc}"
+            records.append(record)
+    except Exception:  # anything else (e.g. the program cannot start): every point not done runs alone
+        done_points = {r["point"] for r in records}
+        again = [t for t in tasks if t["index"] not in done_points]
+    for task in again:
+        records.append(run_point(task))
+    return {"records": records, "lockstep": lockstep}
 
 
 def _read(task: dict[str, Any], h5: Path, record: dict[str, Any]) -> None:
