@@ -280,6 +280,8 @@ def test_progress_bar_on_a_terminal_is_tqdm(tmp_path: Path, write_spec: Callable
 
 
 LONG = """
+[sweep]
+lockstep = 1   # one process per point: long enough for the other sweeps to try
 [scene]
 elements = 10
 dt = 2e-5

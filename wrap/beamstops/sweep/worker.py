@@ -229,11 +229,37 @@ def run_batch(tasks: list[dict[str, Any]]) -> dict[str, Any]:
     return {"records": records, "lockstep": lockstep}
 
 
+#: The record series a point's reductions may read (the names of beamstops.Result).
+_SERIES = ("t", "tip_u", "tip_v", "reaction", "energy", "work", "dissipated", "damped")
+#: The root attributes they read.
+_ATTRS = ("status", "message", "cpu_seconds", "max_violation", "steps", "impacts", "omega")
+
+
+def _load_series(h5: Path) -> Any:
+    """What a point's record and reductions read of the program's output: the root attributes they
+    use and the record series, as :func:`beamstops.load` gives them (without the shock log,
+    statistics, snapshots and the other attributes, which the summary does not use and which cost
+    most of a full load)."""
+    from types import SimpleNamespace
+
+    import h5py
+    import numpy as np
+
+    from ..result import ARRAYS, _plain
+
+    with h5py.File(h5, "r") as f:
+        attrs = {name: _plain(f.attrs[name]) for name in _ATTRS if name in f.attrs}
+        series = {name: np.asarray(f[ARRAYS[name]][()], dtype=np.float64) if ARRAYS[name] in f else np.empty(0)
+                  for name in _SERIES}
+    if "status" not in attrs:
+        raise ValueError(f"{h5}: not a beamstops output (no status attribute)")
+    return SimpleNamespace(attrs=attrs, **series)
+
+
 def _read(task: dict[str, Any], h5: Path, record: dict[str, Any]) -> None:
-    from ..result import load
     from .reductions import reduce
 
-    result = load(h5, allow_incomplete=True)
+    result = _load_series(h5)
     attrs = result.attrs
     status = str(attrs.get("status"))
     if status not in FINISHED:
