@@ -2,7 +2,7 @@
 """A sweep over ω at one fixed Δt: wall time one point per process against lockstep batches.
 
     python scripts/bench_sweep.py                # 300 points, damped and undamped beam (a few minutes)
-    python scripts/bench_sweep.py --quick        # 40 points, shorter runs
+    python scripts/bench_sweep.py --quick        # 40 points, shorter runs, one repeat
     python scripts/bench_sweep.py --program build/bench/beamstops --jobs 2 --out sweep.md
 
 The paper's scene (J = 19, β = 1/2, Signorini tip stops ±0.1 m, a = 0.2 m), Δt = 1e-5 s,
@@ -70,9 +70,13 @@ def run_one(program: str, folder: Path, points: int, t_end: float, damped: bool,
 
 
 def section(program: str, quick: bool = False, *, jobs: int | None = None, batch: int = 8,
-            scenes: tuple[str, ...] = ("damped", "undamped"), points: int | None = None) -> list[str]:
+            scenes: tuple[str, ...] = ("damped", "undamped"), points: int | None = None,
+            repeats: int | None = None) -> list[str]:
     """The markdown of the benchmark (a heading, a sentence, a table)."""
+    import statistics
+
     points = points or (40 if quick else 300)
+    repeats = repeats or (1 if quick else 3)
     t_end = 0.2 if quick else 0.5
     workers = jobs or os.cpu_count() or 1
     lines = [f"### A sweep over ω at one Δt (scripts/bench_sweep.py{' --quick' if quick else ''})\n",
@@ -80,19 +84,25 @@ def section(program: str, quick: bool = False, *, jobs: int | None = None, batch
              f"t_end = {t_end:g} s ({round(t_end / 1e-5):,} steps), tip recorded every 10 steps; "
              f"{workers} worker process{'es' if workers > 1 else ''}. Wall time of the whole sweep "
              f"(`python -m beamstops sweep`), one `beamstops run` per point (`lockstep = 1`) against batches "
-             f"of {batch} (`lockstep = {batch}`: the engine runs the points that share A in lockstep).\n",
+             f"of {batch} (`lockstep = {batch}`: the engine runs the points that share A in lockstep); "
+             f"medians of {repeats} repeat{'s' if repeats > 1 else ''}, the two runs alternating; load average "
+             f"before: {os.getloadavg()[0]:.1f}.\n",
              "| beam | wall, one per point (s) | wall, batches (s) | speed-up | engine CPU, one per point (s) "
              "| engine CPU, batches (s) | points in lockstep | same summary |",
              "|---|---|---|---|---|---|---|---|"]
     with tempfile.TemporaryDirectory() as tmp:
         for label in scenes:
             damped = label == "damped"
-            alone = run_one(program, Path(tmp), points, t_end, damped, 1, jobs)
-            batched = run_one(program, Path(tmp), points, t_end, damped, batch, jobs)
-            same = "yes" if alone["rows"] == batched["rows"] else "**NO**"
-            lines.append(f"| {label} | {alone['wall']:.2f} | {batched['wall']:.2f} | "
-                         f"{alone['wall'] / batched['wall']:.2f}× | {alone['cpu']:.2f} | {batched['cpu']:.2f} | "
-                         f"{batched['lockstep']} of {batched['points']} | {same} |")
+            runs: dict[int, list[dict[str, Any]]] = {1: [], batch: []}
+            for _ in range(repeats):
+                for lockstep in (1, batch):
+                    runs[lockstep].append(run_one(program, Path(tmp), points, t_end, damped, lockstep, jobs))
+            alone, batched = runs[1][-1], runs[batch][-1]
+            wall = {k: statistics.median(r["wall"] for r in v) for k, v in runs.items()}
+            cpu = {k: statistics.median(r["cpu"] for r in v) for k, v in runs.items()}
+            same = "yes" if all(r["rows"] == alone["rows"] for r in runs[1] + runs[batch]) else "**NO**"
+            lines.append(f"| {label} | {wall[1]:.2f} | {wall[batch]:.2f} | {wall[1] / wall[batch]:.2f}× | "
+                         f"{cpu[1]:.2f} | {cpu[batch]:.2f} | {batched['lockstep']} of {batched['points']} | {same} |")
     lines.append("\nEngine CPU: the sum of the points' `cpu_seconds` (a lockstep member's is its share of "
                  "its group's loop). Points in lockstep: the engine's own count (`beamstops run` with several "
                  "scenes says how it grouped them); damped points join a group once the lockstep path "
@@ -108,6 +118,7 @@ def main() -> int:
     parser.add_argument("--batch", type=int, default=8, help="points per batch, [sweep] lockstep (default 8)")
     parser.add_argument("--points", type=int, help="values of omega (default 300, quick 40)")
     parser.add_argument("--scene", choices=("damped", "undamped", "both"), default="both")
+    parser.add_argument("--repeats", type=int, help="repeats of each sweep (default 3, quick 1)")
     parser.add_argument("--out", type=Path, help="also write the markdown here")
     args = parser.parse_args()
     from beamstops.sweep.runner import find_program
@@ -115,7 +126,7 @@ def main() -> int:
     program = find_program(args.program)
     scenes = ("damped", "undamped") if args.scene == "both" else (args.scene,)
     text = "\n".join(section(program, args.quick, jobs=args.jobs, batch=args.batch, scenes=scenes,
-                             points=args.points)) + "\n"
+                             points=args.points, repeats=args.repeats)) + "\n"
     print(text)
     if args.out:
         args.out.write_text(text)
