@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import shutil
 import sys
 import tempfile
@@ -59,12 +60,15 @@ def run_one(program: str, folder: Path, points: int, t_end: float, damped: bool,
                        damping="ratio = 0.015" if damped else "")
     spec = parse_spec(tomllib.loads(text), f"bench_sweep ({'damped' if damped else 'undamped'})", text=text)
     out = folder / f"{'damped' if damped else 'free'}-{lockstep}"
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     outcome = run_sweep(spec, out, executor="local", jobs=jobs, program=program, stream=None)
     wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)  # the pool's workers and their programs, waited for
+    processes = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     rows = read_summary(out)
     shutil.rmtree(out, ignore_errors=True)
-    return {"wall": wall, "cpu": sum(r.get("cpu_seconds") or 0.0 for r in rows), "lockstep": outcome.lockstep,
+    return {"wall": wall, "processes": processes, "cpu": sum(r.get("cpu_seconds") or 0.0 for r in rows), "lockstep": outcome.lockstep,
             "complete": outcome.complete, "points": outcome.total,
             "rows": [{k: v for k, v in r.items() if k not in TIMING} for r in rows]}
 
@@ -88,8 +92,9 @@ def section(program: str, quick: bool = False, *, jobs: int | None = None, batch
              f"medians of {repeats} repeat{'s' if repeats > 1 else ''}, the two runs alternating; load average "
              f"before: {os.getloadavg()[0]:.1f}.\n",
              "| beam | wall, one per point (s) | wall, batches (s) | speed-up | engine CPU, one per point (s) "
-             "| engine CPU, batches (s) | points in lockstep | same summary |",
-             "|---|---|---|---|---|---|---|---|"]
+             "| engine CPU, batches (s) | CPU of all processes, one per point (s) | CPU of all processes, "
+             "batches (s) | points in lockstep | same summary |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     with tempfile.TemporaryDirectory() as tmp:
         for label in scenes:
             damped = label == "damped"
@@ -100,11 +105,14 @@ def section(program: str, quick: bool = False, *, jobs: int | None = None, batch
             alone, batched = runs[1][-1], runs[batch][-1]
             wall = {k: statistics.median(r["wall"] for r in v) for k, v in runs.items()}
             cpu = {k: statistics.median(r["cpu"] for r in v) for k, v in runs.items()}
+            total = {k: statistics.median(r["processes"] for r in v) for k, v in runs.items()}
             same = "yes" if all(r["rows"] == alone["rows"] for r in runs[1] + runs[batch]) else "**NO**"
             lines.append(f"| {label} | {wall[1]:.2f} | {wall[batch]:.2f} | {wall[1] / wall[batch]:.2f}× | "
-                         f"{cpu[1]:.2f} | {cpu[batch]:.2f} | {batched['lockstep']} of {batched['points']} | {same} |")
+                         f"{cpu[1]:.2f} | {cpu[batch]:.2f} | {total[1]:.2f} | {total[batch]:.2f} | {batched['lockstep']} of {batched['points']} | {same} |")
     lines.append("\nEngine CPU: the sum of the points' `cpu_seconds` (a lockstep member's is its share of "
-                 "its group's loop). Points in lockstep: the engine's own count (`beamstops run` with several "
+                 "its group's loop). CPU of all processes: user + system time of the sweep's workers and their "
+                 "`beamstops` programs (start-up, HDF5 files, reductions; less sensitive to a loaded machine "
+                 "than the wall time). Points in lockstep: the engine's own count (`beamstops run` with several "
                  "scenes says how it grouped them); damped points join a group once the lockstep path "
                  "accepts damping.")
     return lines

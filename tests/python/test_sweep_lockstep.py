@@ -178,3 +178,25 @@ def test_shared_grid_and_records_per_period_are_exclusive(write_spec: Callable[.
     with pytest.raises(ValueError, match="shared_grid"):
         load_spec(write_spec(SWEEP.format(lockstep=8).replace("shared_grid = true",
                                                               "shared_grid = true\nrecords_per_period = 8")))
+
+
+def test_a_batch_over_its_time_limit_leaves_its_points_to_run_alone(tmp_path: Path, write_spec: Callable[..., Path],
+                                                                    program: str) -> None:
+    # one batch of three points on one worker; the long point holds the batch beyond its limit
+    # (3 x 0.5 s); then every point without a finished output runs alone with its own limit
+    spec = load_spec(write_spec("""
+[sweep]
+timeout = 0.5
+lockstep = 4
+[scene]
+elements = 4
+dt = 1e-6
+record_every = 100000
+[axes]
+t_end = [0.01, 0.02, 1000.0]
+"""))
+    outcome = run_sweep(spec, tmp_path / "out", jobs=1, stream=None, program=program)
+    rows = read_summary(tmp_path / "out")
+    assert [r["status"] for r in rows] == ["complete", "complete", "failed"]
+    assert rows[2]["message"].startswith("timed out after 0.5 s")
+    assert (outcome.complete, outcome.failed) == (2, 1)
