@@ -5,7 +5,8 @@ The folder of a sweep (``-o DIR``)::
     DIR/sweep.json       the manifest: the specification's hash, file, overrides, axes, reductions
     DIR/spec.toml        the specification's text, as given
     DIR/points/NNNNN.nml the point's scene (Scene.to_namelist), run as `beamstops run NNNNN.nml -o NNNNN.h5`,
-                         or with others of its batch as `beamstops run NNNNN.nml MMMMM.nml ...`
+                         or with others of its batch as `beamstops run NNNNN.nml MMMMM.nml ...` (in
+                         DIR/points: then the namelist names its output, file = NNNNN.h5)
     DIR/points/NNNNN.h5  the program's own output
     DIR/points/NNNNN.json the point's record: parameters, status, message, figures, reductions
     DIR/summary.csv      one row per point (also summary.json, with full lists)

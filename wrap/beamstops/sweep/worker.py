@@ -189,11 +189,13 @@ def run_batch(tasks: list[dict[str, Any]]) -> dict[str, Any]:
             for stale in (h5, nml.with_suffix(".json")):
                 if stale.exists():
                     stale.unlink()
-            Scene(**{**task["scene"], "file": str(h5)}).to_namelist(nml)
-            paths.append(str(nml))
+            # the namelist names its output beside it: `beamstops run NNNNN.nml` in the points folder
+            Scene(**{**task["scene"], "file": h5.name}).to_namelist(nml)
+            paths.append(nml.name)
         timeout = tasks[0].get("timeout")
         try:
             done = subprocess.run([tasks[0]["program"], "run", *paths], capture_output=True, text=True,
+                                  cwd=tasks[0]["folder"],
                                   timeout=timeout * len(tasks) if timeout else None, stdin=subprocess.DEVNULL)
             for line in done.stderr.splitlines():
                 match = _GROUPS.match(line)
