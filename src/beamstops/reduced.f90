@@ -146,8 +146,8 @@ contains
    end function stop_unknowns
 
    !> Check &mesh modes of a scene with n = 2J unknowns and m stop unknowns: 0 (the full model)
-   !> or 1 <= modes <= n - m; a reduced run also needs n <= max_reduced_unknowns and takes no
-   !> checkpoints. `source` starts the message.
+   !> or 1 <= modes <= n - m; a reduced run also needs n <= max_reduced_unknowns and a basis of at
+   !> most max_basis_entries values. `source` starts the message.
    pure subroutine validate_reduced(scene, n, m, source, error)
       !> Scene.
       type(scene_type), intent(in) :: scene
@@ -179,12 +179,6 @@ contains
             & fmt_int(int(n/2, ik))//' is out of range; allowed: modes <= '// &
             & fmt_int(int(max_basis_entries/real(n, wp), ik) - m)//' for this mesh (the basis T keeps 2*elements x '// &
             & '(modes + stops) values, at most '//fmt_int(int(max_basis_entries, ik))//')'
-         return
-      end if
-      if (scene%checkpoint_every > 0) then
-         allocate (error)
-         error%message = source//': &output checkpoint_every = '//fmt_int(scene%checkpoint_every)// &
-            & ' is out of range; allowed: checkpoint_every = 0 with &mesh modes > 0 (a reduced run takes no checkpoints)'
       end if
    end subroutine validate_reduced
 

@@ -33,6 +33,7 @@ module beamstops_reduced_scheme
    implicit none
    private
    public :: reduced_state_type, start_reduced, advance_reduced, run_reduced, simulate_reduced, reduced_block_steps
+   public :: resume_reduced
 
    !> Steps between progress reports and divergence checks.
    integer(ik), parameter :: reduced_block_steps = 8192_ik
@@ -124,8 +125,7 @@ contains
       s = reduced%size
       dt = reduced%dt
       pt = tip_coordinate(reduced)
-      allocate (state%q(s), state%d(s), state%sq(s), state%x(s), state%shape(size(reduced%x)))
-      allocate (state%acc(reduced%m), state%multiplier(reduced%m), state%active(reduced%m))
+      call allocate_work(reduced, state)
       state%q = reduced%q0 + dt*reduced%v0
       if (scene%taylor_start) then
          call reduced_stiffness_product(reduced, reduced%q0, state%sq)
@@ -202,6 +202,44 @@ contains
       end if
    end subroutine start_reduced
 
+   !> The work arrays of the loop (q and d allocated too).
+   subroutine allocate_work(reduced, state)
+      type(reduced_model_type), intent(in) :: reduced
+      type(reduced_state_type), intent(inout) :: state
+      integer :: s
+      s = reduced%size
+      if (.not. allocated(state%q)) allocate (state%q(s))
+      if (.not. allocated(state%d)) allocate (state%d(s))
+      allocate (state%sq(s), state%x(s), state%shape(size(reduced%x)))
+      allocate (state%acc(reduced%m), state%multiplier(reduced%m), state%active(reduced%m))
+   end subroutine allocate_work
+
+   !> A state read from a checkpoint (q, d, the scalars, the stops' reactions and the observer
+   !> set) made ready to run: the work arrays, the stops' program, and with damping C_r d^{n-1}
+   !> and d^{n-1}.C_r d^{n-1}, rebuilt from d by the loop's own operations (so to the bit).
+   subroutine resume_reduced(reduced, state, error)
+      !> Reduced model.
+      type(reduced_model_type), intent(in) :: reduced
+      !> State with q, d and the scalars of a checkpoint; ready to run on return.
+      type(reduced_state_type), intent(inout) :: state
+      !> Set when the stops' program cannot be set up.
+      type(error_type), allocatable, intent(out) :: error
+      call allocate_work(reduced, state)
+      if (reduced%stops%m > 0) then
+         if (.not. allocated(state%stop_reaction)) then
+            allocate (state%stop_reaction(reduced%stops%m))
+            state%stop_reaction = 0
+         end if
+         call new_span_work(state%span, reduced%stops, error)
+         if (allocated(error)) return
+      end if
+      if (reduced%damped) then
+         allocate (state%cd(reduced%size))
+         call reduced_damping_product(reduced, state%d, state%cd)
+         state%dcd_prev = dot_product(state%d, state%cd)
+      end if
+   end subroutine resume_reduced
+
    !> The stops along the span at the start: their work arrays, and q^1 projected on the bounds of
    !> t_1 (the QP on the trial values of q^1 at the stops).
    subroutine start_span(scene, reduced, state, error)
@@ -235,10 +273,11 @@ contains
       state%max_violation = worst
    end subroutine start_span
 
-   !> Run from the state's step to the scene's last step in blocks; between blocks the
-   !> divergence check and progress (no checkpoints: validate_reduced refuses them). Fills the
-   !> summary.
-   subroutine run_reduced(scene, reduced, state, recorder, summary)
+   !> Run from the state's step to the scene's last step (or to step `until`) in blocks; between
+   !> blocks the divergence check and progress. Fills the summary; a call that ends at `until`
+   !> before the last step leaves the status 'running' (the caller saves a checkpoint and
+   !> continues with another call).
+   subroutine run_reduced(scene, reduced, state, recorder, summary, until)
       !> Scene.
       type(scene_type), intent(in) :: scene
       !> Its reduced model.
@@ -249,13 +288,17 @@ contains
       class(recorder_type), intent(inout) :: recorder
       !> Outcome of the run.
       type(run_summary), intent(inout) :: summary
-      integer(ik) :: steps, last, done
+      !> Last step of this call (default: the scene's last).
+      integer(ik), intent(in), optional :: until
+      integer(ik) :: steps, last, done, final
       real(wp) :: t0, kinetic, cap
       steps = steps_of(scene)
+      final = steps
+      if (present(until)) final = min(steps, until)
       summary%status = status_running
       t0 = thread_cpu_seconds() - state%cpu_seconds
-      do while (state%step <= steps)
-         last = min(steps, state%step + reduced_block_steps - 1)
+      do while (state%step <= final)
+         last = min(final, state%step + reduced_block_steps - 1)
          call advance_reduced(scene, reduced, state, recorder, last, done)
          state%cpu_seconds = thread_cpu_seconds() - t0
          if (recorder%failed) then
@@ -287,9 +330,9 @@ contains
       summary%impacts = state%impacts
       summary%contact_phases = state%impacts
       summary%max_violation = state%max_violation
-      if (summary%status == status_running) summary%status = status_complete
+      if (summary%status == status_running .and. state%step > steps) summary%status = status_complete
       call close_ledger(scene, reduced, state, summary)
-      if (state%observer%active) then
+      if (state%observer%active .and. summary%status /= status_running) then
          call state%observer%finish(summary%shocks, summary%statistics)
          summary%impacts = state%observer%shocks%shock_count()
       end if

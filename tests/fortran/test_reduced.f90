@@ -700,16 +700,6 @@ contains
          return
       end if
       deallocate (error)
-      scene%modes = 3
-      scene%checkpoint_every = 100
-      call validate_reduced(scene, 38, 1, 'in.nml', error)
-      if (.not. allocated(error)) then
-         call test_failed(error, 'checkpoints with modes > 0 refused')
-         return
-      end if
-      call note(error%message)
-      deallocate (error)
-      scene%checkpoint_every = 0
       scene%modes = 20000
       call validate_reduced(scene, 40000, 1, 'in.nml', error)
       if (.not. allocated(error)) then

@@ -12,11 +12,13 @@ module test_reduced_physics
    use test_reduced, only: run_reduced_recorded, compare_full
    use physics_support, only: peaks
    use beamstops, only: ik, scene_type, array_recorder, run_summary, law_none, law_signorini, validate_scene, &
-      & steps_of, scene_from_text
+      & steps_of, scene_from_text, record_count, stop_count, status_complete
    use beamstops_forcing, only: load_average
    use beamstops_lapack, only: dsygv
    use beamstops_reduced, only: reduced_model_type, prepare_reduced, reduced_matrices
-   use beamstops_reduced_scheme, only: reduced_state_type, simulate_reduced, start_reduced, advance_reduced
+   use beamstops_reduced_scheme, only: reduced_state_type, simulate_reduced, start_reduced, advance_reduced, run_reduced
+   use beamstops_reduced_checkpoint, only: write_reduced_checkpoint, read_reduced_checkpoint
+   use beamstops_files, only: remove_file
    use beamstops_recorder, only: col_t, col_u, col_energy, col_work, col_dissipated, col_damped
    implicit none
    private
@@ -36,6 +38,8 @@ contains
          & new_unittest('r = 3, damped: log decrement of mode 1 is 2 pi zeta/sqrt(1-zeta^2) to O(dt^2)', test_decrement), &
          & new_unittest('damped, no contact: E - E0 = W - damped to round-off (records and summary)', test_balance), &
          & new_unittest('r = 6, e = 0.5: KKT of the combination every step, in reduced coordinates', test_kkt_restitution), &
+         & new_unittest('a reduced run (damped, restitution, three stops, statistics) resumed from a checkpoint: '// &
+         & 'the same bits', test_resume), &
          & new_unittest('&mesh modes with damping and restitution accepted; what remains refused', test_validate) &
          & ]
    end subroutine collect_reduced_physics
@@ -297,6 +301,63 @@ contains
       if (allocated(error)) return
       call check(error, worst_rows, 0.0_wp, 'residual of the rows off the tip', thr=1e-14_wp)
    end subroutine test_kkt_restitution
+
+   !> The tube (r = 8, damping, e = 0.5, statistics) run to step 6000, checkpointed, read back into
+   !> a new state; both continued to the end: every record after the checkpoint, q, d, the
+   !> energies and the statistics' summary to the bit.
+   subroutine test_resume(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: path = 'test_reduced_resume.checkpoint'
+      type(scene_type) :: scene
+      type(reduced_model_type) :: reduced
+      type(reduced_state_type) :: straight, resumed
+      type(array_recorder) :: a, b
+      type(run_summary) :: sa, sb
+      integer(ik) :: records, snapshots, first
+      scene = tube(0.3_wp)
+      scene%modes = 8
+      scene%damping_mass = 2.0_wp
+      scene%damping_stiffness = 1.0e-5_wp
+      scene%restitution = 0.5_wp
+      scene%statistics = .true.
+      scene%transient = 0.05_wp
+      scene%batches = 4
+      call validate_scene(scene, 'test scene', error)
+      if (allocated(error)) return
+      call prepare_reduced(scene, 'test scene', reduced, error)
+      if (allocated(error)) return
+      call a%reserve(record_count(scene), 0_ik, scene%elements + 1, stop_count(scene))
+      call b%reserve(record_count(scene), 0_ik, scene%elements + 1, stop_count(scene))
+      call start_reduced(scene, reduced, straight, a, error)
+      if (allocated(error)) return
+      call run_reduced(scene, reduced, straight, a, sa, 6000_ik)
+      call check(error, sa%status == 'running' .and. straight%step == 6001, 'stopped at step 6000')
+      if (allocated(error)) return
+      call write_reduced_checkpoint(path, scene, straight, a%filled, 0_ik, error)
+      if (allocated(error)) return
+      call read_reduced_checkpoint(path, scene, reduced, resumed, records, snapshots, error)
+      call remove_file(path)
+      if (allocated(error)) return
+      call check(error, records == a%filled, 'the record count'); if (allocated(error)) return
+      first = a%filled + 1
+      b%filled = a%filled
+      b%stops_filled = a%stops_filled
+      call run_reduced(scene, reduced, straight, a, sa)
+      call run_reduced(scene, reduced, resumed, b, sb)
+      call check(error, sa%status == status_complete .and. sb%status == status_complete, 'both complete')
+      if (allocated(error)) return
+      call check(error, all(a%rows(:, first:a%filled) == b%rows(:, first:b%filled)) .and. a%filled == b%filled, &
+         & 'the records after the checkpoint to the bit')
+      if (allocated(error)) return
+      call check(error, all(a%stops_u(:, first:a%filled) == b%stops_u(:, first:b%filled)), 'the stops'' records')
+      if (allocated(error)) return
+      call check(error, all(straight%q == resumed%q) .and. all(straight%d == resumed%d), 'q and d to the bit')
+      if (allocated(error)) return
+      call check(error, sa%damped == sb%damped .and. sa%damped > 0 .and. sa%dissipated == sb%dissipated .and. &
+         & sa%energy_residual == sb%energy_residual, 'the energy ledger to the bit')
+      if (allocated(error)) return
+      call check(error, sa%impacts == sb%impacts .and. sa%impacts > 0, 'the shocks')
+   end subroutine test_resume
 
    !> Read by the one reader (scene_from_text): damping (ratios) and restitution are accepted with
    !> modes > 0; mass redistribution and an ensemble are refused with one message naming the file
