@@ -12,7 +12,6 @@
 !> Records go to the same recorder interface, snapshots expanded to the nodes (u = T q).
 !> The loop allocates nothing and writes nothing itself.
 module beamstops_reduced_scheme
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
    use beamstops_scene, only: scene_type, steps_of, law_none, law_signorini, law_compliance
@@ -26,10 +25,11 @@ module beamstops_reduced_scheme
    use beamstops_contact_compliance, only: spring_force, solve_spring_tip
    use beamstops_contact_span_stops, only: span_work_type, new_span_work, span_contact, span_settle, span_energy
    use beamstops_contact_box_qp, only: qp_solved, qp_message
-   use beamstops_observe_observer, only: observer_type, new_observer
+   use beamstops_observe_observer, only: observer_type, observe_scene
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
       & col_work, col_dissipated, col_damped
-   use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running
+   use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running, &
+      & check_divergence
    implicit none
    private
    public :: reduced_state_type, start_reduced, advance_reduced, run_reduced, simulate_reduced, reduced_block_steps
@@ -184,20 +184,14 @@ contains
       state%step = 1
       if (scene%statistics) then
          if (reduced%stops%m > 0) then
-            call new_observer(state%observer, reduced%stops%m, reduced%q0(reduced%r + 1:) + reduced%stops%lift* &
-               & support_position(0.0_wp, scene%amplitude, scene%omega), scene%mass_per_length, reduced%dt, &
-               & scene%rest_time, scene%transient, scene%t_end, scene%batches, scene%bins, scene%histogram_lower, &
-               & scene%histogram_upper, 0.0_wp, error)
-            if (allocated(error)) return
-            call state%observer%span(reduced%dt, state%q(reduced%r + 1:) + reduced%stops%lift* &
-               & support_position(reduced%dt, scene%amplitude, scene%omega), state%stop_reaction, &
-               & dot_product(reduced%tip_row, state%q), state%dissipated)
+            call observe_scene(state%observer, scene, dt, .true., reduced%q0(reduced%r + 1:) + reduced%stops%lift* &
+               & support_position(0.0_wp, scene%amplitude, scene%omega), state%q(reduced%r + 1:) + &
+               & reduced%stops%lift*support_position(dt, scene%amplitude, scene%omega), state%stop_reaction, &
+               & dot_product(reduced%tip_row, state%q), state%dissipated, error)
          else
-            call new_observer(state%observer, 1, [dot_product(reduced%tip_row, reduced%q0)], scene%mass_per_length, &
-               & reduced%dt, scene%rest_time, scene%transient, scene%t_end, scene%batches, scene%bins, &
-               & scene%histogram_lower, scene%histogram_upper, 0.0_wp, error)
-            if (allocated(error)) return
-            call state%observer%tip(reduced%dt, dot_product(reduced%tip_row, state%q), state%reaction, state%dissipated)
+            call observe_scene(state%observer, scene, dt, .false., [dot_product(reduced%tip_row, reduced%q0)], &
+               & [dot_product(reduced%tip_row, state%q)], [state%reaction], dot_product(reduced%tip_row, state%q), &
+               & state%dissipated, error)
          end if
       end if
    end subroutine start_reduced
@@ -291,7 +285,7 @@ contains
       !> Last step of this call (default: the scene's last).
       integer(ik), intent(in), optional :: until
       integer(ik) :: steps, last, done, final
-      real(wp) :: t0, kinetic, cap
+      real(wp) :: t0, kinetic
       steps = steps_of(scene)
       final = steps
       if (present(until)) final = min(steps, until)
@@ -313,14 +307,9 @@ contains
             exit
          end if
          kinetic = 0.5_wp*reduced_mass_product(reduced, state%d)/reduced%dt2
-         cap = 1.0e8_wp*(0.5_wp*scene%length*(scene%amplitude*scene%omega)**2 + abs(state%energy0) &
-            & + abs(state%work) + abs(state%dissipated))
-         if (.not. ieee_is_finite(kinetic) .or. kinetic > cap) then
-            summary%status = status_diverged
-            summary%message = 'the solution blew up (kinetic energy beyond 1e8 times the energy supplied) '// &
-               & 'before t = '//trim(real_text(real(state%step - 1, wp)*reduced%dt))//' s'
-            exit
-         end if
+         call check_divergence(scene, kinetic, state%energy0, state%work, state%dissipated, &
+            & real(state%step - 1, wp)*reduced%dt, summary)
+         if (summary%status == status_diverged) exit
          if (state%observer%active) call state%observer%drain()
          call recorder%progress(state%step - 1, steps)
       end do
