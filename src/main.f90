@@ -14,8 +14,11 @@ program beamstops_main
    use beamstops_checkpoint, only: checkpoint_path, read_checkpoint, is_checkpoint
    use beamstops_files, only: file_exists, remove_file, same_file
    use beamstops_recorder_hdf5, only: partial_path, check_output_path
-   use beamstops_run, only: continue_run
+   use beamstops_run, only: continue_run, continue_reduced
    use beamstops_batch, only: lockstep_groups, simulate_group
+   use beamstops_reduced, only: reduced_model_type, build_reduced, check_stability_reduced
+   use beamstops_reduced_scheme, only: reduced_state_type, start_reduced
+   use beamstops_reduced_checkpoint, only: read_reduced_checkpoint
    implicit none
 
    interface
@@ -329,11 +332,20 @@ contains
       type(hdf5_recorder) :: recorder
       type(run_summary) :: summary
       type(state_type) :: state
+      type(reduced_model_type) :: reduced
+      type(reduced_state_type) :: reduced_state
       type(error_type), allocatable :: error, write_error, finish_error
       character(len=:), allocatable :: output, partial, checkpoint
       integer(ik) :: records, snapshots
       logical :: resume
       status = 0
+      if (scene%modes > 0) then
+         ! The reduced (Craig-Bampton) model, before anything is written.
+         call build_reduced(scene, model, reduced, error)
+         if (reported(error, exit_input, status)) return
+         call check_stability_reduced(scene, reduced, input, error)
+         if (reported(error, exit_input, status)) return
+      end if
       output = scene%output_file
       partial = partial_path(output)
       checkpoint = checkpoint_path(output)
@@ -353,7 +365,11 @@ contains
          end if
       end if
       if (resume) then
-         call read_checkpoint(checkpoint, scene, model, state, records, snapshots, error)
+         if (scene%modes > 0) then
+            call read_reduced_checkpoint(checkpoint, scene, reduced, reduced_state, records, snapshots, error)
+         else
+            call read_checkpoint(checkpoint, scene, model, state, records, snapshots, error)
+         end if
          if (reported(error, exit_input, status)) return
          call recorder%reopen(output, scene, model, records, snapshots, error)
          if (reported(error, exit_output, status)) return
@@ -363,15 +379,19 @@ contains
          if (reported(error, exit_output, status)) return
       end if
       recorder%show_progress = progress
-      if (scene%modes > 0) then
-         call simulate(scene, model, recorder, summary, error)
-      else if (.not. resume) then
-         call start_state(scene, model, state, recorder, error)
+      if (.not. resume) then
+         if (scene%modes > 0) then
+            call start_reduced(scene, reduced, reduced_state, recorder, error)
+         else
+            call start_state(scene, model, state, recorder, error)
+         end if
       end if
       if (allocated(error)) then
          summary%status = status_failed
          summary%message = error%message
-      else if (scene%modes == 0) then
+      else if (scene%modes > 0) then
+         call continue_reduced(scene, reduced, reduced_state, recorder, summary, write_error, checkpoint)
+      else
          call continue_run(scene, model, state, recorder, summary, write_error, checkpoint)
       end if
       call recorder%finish(summary, finish_error)

@@ -14,6 +14,8 @@ module beamstops_checkpoint
    implicit none
    private
    public :: write_checkpoint, read_checkpoint, checkpoint_path, scene_signature, is_checkpoint
+   ! (the reduced model's checkpoints, beamstops_reduced_checkpoint, share the file's frame)
+   public :: create_checkpoint, commit_checkpoint, open_checkpoint, close_checkpoint
 
    integer, parameter :: n_scalars = 16
 
@@ -85,19 +87,11 @@ contains
       integer(ik), intent(in) :: records, snapshots
       !> Set when the file cannot be written.
       type(error_type), allocatable, intent(out) :: error
-      character(len=:), allocatable :: temporary
       real(wp), allocatable :: observer(:)
       integer(hid_t) :: file
-      integer :: hdferr
-      logical :: ok(6), moved
-      temporary = path//'.tmp'
-      call h5open_f(hdferr)
-      call h5eset_auto_f(0, hdferr)
-      call h5fcreate_f(temporary, H5F_ACC_TRUNC_F, file, hdferr)
-      if (hdferr /= 0) then
-         call fatal_error(error, path//': cannot create the checkpoint')
-         return
-      end if
+      logical :: ok(6)
+      call create_checkpoint(path, file, error)
+      if (allocated(error)) return
       call write_vector(file, 'signature', scene_signature(scene), ok(1))
       call write_vector(file, 'scalars', scalars_of(state, records, snapshots), ok(2))
       call write_vector(file, 'u', state%u, ok(3))
@@ -112,15 +106,89 @@ contains
          call write_vector(file, 'observer_length', [real(size(observer), wp)], ok(6))
          if (ok(6)) call write_vector(file, 'observer', observer, ok(6))
       end if
+      call commit_checkpoint(path, file, all(ok), error)
+   end subroutine write_checkpoint
+
+   !> Create the temporary file of the checkpoint `path` (path.tmp), to be written and then
+   !> moved in place by commit_checkpoint.
+   subroutine create_checkpoint(path, file, error)
+      !> Checkpoint file.
+      character(len=*), intent(in) :: path
+      !> The temporary file, open.
+      integer(hid_t), intent(out) :: file
+      !> Set when it cannot be created.
+      type(error_type), allocatable, intent(out) :: error
+      integer :: hdferr
+      call h5open_f(hdferr)
+      call h5eset_auto_f(0, hdferr)
+      call h5fcreate_f(path//'.tmp', H5F_ACC_TRUNC_F, file, hdferr)
+      if (hdferr /= 0) call fatal_error(error, path//': cannot create the checkpoint')
+   end subroutine create_checkpoint
+
+   !> Close the temporary file of create_checkpoint and, when every write went well (`ok`),
+   !> rename it onto `path` (atomic); otherwise remove it.
+   subroutine commit_checkpoint(path, file, ok, error)
+      !> Checkpoint file.
+      character(len=*), intent(in) :: path
+      !> The temporary file.
+      integer(hid_t), intent(in) :: file
+      !> Whether every write succeeded.
+      logical, intent(in) :: ok
+      !> Set when the checkpoint could not be written or moved.
+      type(error_type), allocatable, intent(out) :: error
+      integer :: hdferr
+      logical :: moved
       call h5fclose_f(file, hdferr)
-      if (.not. all(ok) .or. hdferr /= 0) then
-         call remove_file(temporary)
+      if (.not. ok .or. hdferr /= 0) then
+         call remove_file(path//'.tmp')
          call fatal_error(error, path//': cannot write the checkpoint (disk full, or beyond the file-size limit?)')
          return
       end if
-      call rename_file(temporary, path, moved)
+      call rename_file(path//'.tmp', path, moved)
       if (.not. moved) call fatal_error(error, path//': cannot move the new checkpoint in place')
-   end subroutine write_checkpoint
+   end subroutine commit_checkpoint
+
+   !> Open the checkpoint `path` for reading.
+   subroutine open_checkpoint(path, file, error)
+      !> Checkpoint file.
+      character(len=*), intent(in) :: path
+      !> The file, open.
+      integer(hid_t), intent(out) :: file
+      !> Set when it cannot be read.
+      type(error_type), allocatable, intent(out) :: error
+      integer :: hdferr
+      call h5open_f(hdferr)
+      call h5eset_auto_f(0, hdferr)
+      call h5fopen_f(path, H5F_ACC_RDONLY_F, file, hdferr)
+      if (hdferr /= 0) call fatal_error(error, path//': cannot read the checkpoint')
+   end subroutine open_checkpoint
+
+   !> Close a checkpoint read with open_checkpoint: an error when a read failed (`ok` false) or
+   !> when the `signature` read from it is not the scene's.
+   subroutine close_checkpoint(path, file, ok, signature, scene, error)
+      !> Checkpoint file.
+      character(len=*), intent(in) :: path
+      !> The file.
+      integer(hid_t), intent(in) :: file
+      !> Whether every read succeeded.
+      logical, intent(in) :: ok
+      !> The signature read from the file.
+      real(wp), intent(in) :: signature(:)
+      !> Scene of the run to resume.
+      type(scene_type), intent(in) :: scene
+      !> Set when the checkpoint cannot be used.
+      type(error_type), allocatable, intent(out) :: error
+      integer :: hdferr
+      call h5fclose_f(file, hdferr)
+      if (.not. ok) then
+         call fatal_error(error, path//': the checkpoint is damaged or of another mesh')
+         return
+      end if
+      if (any(signature /= scene_signature(scene))) then
+         call fatal_error(error, path//': the checkpoint belongs to another scene; allowed: the same '// &
+            & 'namelist values as the interrupted run (or run without --restart)')
+      end if
+   end subroutine close_checkpoint
 
    !> Read the checkpoint `path` of a run of `scene`: the state (with its work arrays) and
    !> the records and snapshots the output held at that moment.
@@ -141,7 +209,7 @@ contains
       type(error_type), allocatable :: failure
       real(wp) :: scalars(n_scalars), damped(1)
       integer(hid_t) :: file
-      integer :: hdferr, n
+      integer :: n
       logical :: ok(6)
       records = 0
       snapshots = 0
@@ -149,13 +217,8 @@ contains
       signature = scene_signature(scene)
       allocate (state%u(n), state%d(n), state%su(n), state%rhs(n), state%scratch(n), state%shape(size(model%x)))
       if (stop_count(scene) > 0) allocate (state%stop_reaction(stop_count(scene)))
-      call h5open_f(hdferr)
-      call h5eset_auto_f(0, hdferr)
-      call h5fopen_f(path, H5F_ACC_RDONLY_F, file, hdferr)
-      if (hdferr /= 0) then
-         call fatal_error(error, path//': cannot read the checkpoint')
-         return
-      end if
+      call open_checkpoint(path, file, error)
+      if (allocated(error)) return
       call read_vector(file, 'signature', signature, ok(1))
       call read_vector(file, 'scalars', scalars, ok(2))
       call read_vector(file, 'u', state%u, ok(3))
@@ -178,16 +241,8 @@ contains
             ok(6) = .not. allocated(failure)
          end if
       end if
-      call h5fclose_f(file, hdferr)
-      if (.not. all(ok)) then
-         call fatal_error(error, path//': the checkpoint is damaged or of another mesh')
-         return
-      end if
-      if (any(signature /= scene_signature(scene))) then
-         call fatal_error(error, path//': the checkpoint belongs to another scene; allowed: the same '// &
-            & 'namelist values as the interrupted run (or run without --restart)')
-         return
-      end if
+      call close_checkpoint(path, file, all(ok), signature, scene, error)
+      if (allocated(error)) return
       call restore_scalars(scalars, state, records, snapshots)
    end subroutine read_checkpoint
 

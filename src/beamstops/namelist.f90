@@ -262,12 +262,9 @@ contains
       if (allocated(error)) return
       call validate_reduced(scene, 2*scene%elements, stop_unknowns(scene), source, error)
       if (allocated(error)) return
-      if (scene%modes > 0 .and. (scene%damping_mass /= 0 .or. scene%damping_stiffness /= 0 .or. &
-         & scene%damping_by_ratio .or. scene%restitution /= 0 .or. scene%redistributed_mass .or. &
-         & scene%members > 1)) then
-         call fatal_error(error, source//': &mesh modes = '//itoa(scene%modes)//' with damping, restitution, '// &
-            & "mass = 'redistributed' or an ensemble is not supported; allowed: modes = 0 (the full model) "// &
-            & 'for those')
+      if (scene%modes > 0 .and. (scene%redistributed_mass .or. scene%members > 1)) then
+         call fatal_error(error, source//': &mesh modes = '//itoa(scene%modes)//" with &stops mass = 'redistributed' "// &
+            & 'or an ensemble (&ensemble members > 1) is not supported; allowed: modes = 0 (the full model) for those')
          return
       end if
       if (.not. (ieee_is_finite(scene%perturbation) .and. scene%perturbation >= 0 .and. &

@@ -55,7 +55,7 @@ module beamstops_reduced
    private
    public :: reduced_model_type, block_solver_type, build_reduced, prepare_reduced, validate_reduced
    public :: check_stability_reduced, block_solve, reduced_stiffness_product, reduced_mass_product
-   public :: reduced_matrices, expand, stop_unknowns, max_reduced_unknowns
+   public :: reduced_matrices, expand, stop_unknowns, max_reduced_unknowns, reduced_damping_product
 
    !> Largest number of full unknowns n = 2J for which a reduced basis is built (the eigenvalues
    !> by dsbgvx cost O(n^2)).
@@ -97,6 +97,10 @@ module beamstops_reduced
       integer, allocatable :: b(:)
       !> Time step, its square, Newmark beta.
       real(wp) :: dt = 0, dt2 = 0, beta = 0
+      !> Rayleigh damping on (SPEC 8): C_r = T^T C T = a M_r + b S_r, a and b the full model's.
+      logical :: damped = .false.
+      !> The coefficients a (1/s) and b (s) of C_r (the full model's, from its own spectrum).
+      real(wp) :: damping_a = 0, damping_b = 0
       !> Squared frequencies omega_k^2 of the fixed-interface modes, ascending (r) (1/s^2).
       real(wp), allocatable :: lambda(:)
       !> Basis T = [Phi Psi] (n, r + m): u = T q.
@@ -109,7 +113,7 @@ module beamstops_reduced
       real(wp), allocatable :: load(:)
       !> Reduced initial displacement and velocity (r + m).
       real(wp), allocatable :: q0(:), v0(:)
-      !> Solver of A_r = M_r + dt^2 beta S_r.
+      !> Solver of A_r = M_r + dt/2 C_r + dt^2 beta S_r = (1 + dt a/2) M_r + (dt b/2 + dt^2 beta) S_r.
       type(block_solver_type) :: a_solver
       !> Solver of M_r (the Taylor start).
       type(block_solver_type) :: m_solver
@@ -142,8 +146,8 @@ contains
    end function stop_unknowns
 
    !> Check &mesh modes of a scene with n = 2J unknowns and m stop unknowns: 0 (the full model)
-   !> or 1 <= modes <= n - m; a reduced run also needs n <= max_reduced_unknowns and takes no
-   !> checkpoints. `source` starts the message.
+   !> or 1 <= modes <= n - m; a reduced run also needs n <= max_reduced_unknowns and a basis of at
+   !> most max_basis_entries values. `source` starts the message.
    pure subroutine validate_reduced(scene, n, m, source, error)
       !> Scene.
       type(scene_type), intent(in) :: scene
@@ -175,12 +179,6 @@ contains
             & fmt_int(int(n/2, ik))//' is out of range; allowed: modes <= '// &
             & fmt_int(int(max_basis_entries/real(n, wp), ik) - m)//' for this mesh (the basis T keeps 2*elements x '// &
             & '(modes + stops) values, at most '//fmt_int(int(max_basis_entries, ik))//')'
-         return
-      end if
-      if (scene%checkpoint_every > 0) then
-         allocate (error)
-         error%message = source//': &output checkpoint_every = '//fmt_int(scene%checkpoint_every)// &
-            & ' is out of range; allowed: checkpoint_every = 0 with &mesh modes > 0 (a reduced run takes no checkpoints)'
       end if
    end subroutine validate_reduced
 
@@ -301,8 +299,21 @@ contains
       call project_initial(reduced, model%mass, model%u0, reduced%q0)
       call project_initial(reduced, model%mass, model%v0, reduced%v0)
 
-      call new_block_solver(reduced%a_solver, 1 + reduced%dt2*reduced%beta*reduced%lambda, reduced%coupling, &
-         & reduced%mass_pp + reduced%dt2*reduced%beta*reduced%stiffness_pp, 'A_r = M_r + dt^2 beta S_r', error)
+      reduced%damped = model%damped
+      reduced%damping_a = model%damping_a
+      reduced%damping_b = model%damping_b
+      if (reduced%damped) then
+         ! A_r = mass_scale M_r + stiffness_scale S_r: its modal block stays diagonal.
+         associate (mass_scale => 1 + 0.5_wp*reduced%dt*reduced%damping_a, &
+            & stiffness_scale => 0.5_wp*reduced%dt*reduced%damping_b + reduced%dt2*reduced%beta)
+            call new_block_solver(reduced%a_solver, mass_scale + stiffness_scale*reduced%lambda, &
+               & mass_scale*reduced%coupling, mass_scale*reduced%mass_pp + stiffness_scale*reduced%stiffness_pp, &
+               & 'A_r = M_r + dt/2 C_r + dt^2 beta S_r', error)
+         end associate
+      else
+         call new_block_solver(reduced%a_solver, 1 + reduced%dt2*reduced%beta*reduced%lambda, reduced%coupling, &
+            & reduced%mass_pp + reduced%dt2*reduced%beta*reduced%stiffness_pp, 'A_r = M_r + dt^2 beta S_r', error)
+      end if
       if (allocated(error)) return
       allocate (w(r))
       w = 1
@@ -630,6 +641,42 @@ contains
          dmd = dmd + d(r + j)*acc
       end do
    end function reduced_mass_product
+
+   !> y = C_r d = a M_r d + b S_r d = (a (d_a + B d_p) + b Lambda d_a, a (B^T d_a + M_pp d_p) + b K_pp d_p),
+   !> O(r m + m^2), allocation-free (the damped loop's product, once a step).
+   pure subroutine reduced_damping_product(reduced, d, y)
+      !> Reduced model (damped).
+      type(reduced_model_type), intent(in) :: reduced
+      !> Reduced vector (r + m).
+      real(wp), intent(in) :: d(:)
+      !> C_r d (r + m).
+      real(wp), intent(out) :: y(:)
+      integer :: r, i, j
+      real(wp) :: a, b, acc, dp
+      r = reduced%r
+      a = reduced%damping_a
+      b = reduced%damping_b
+      do i = 1, r
+         y(i) = a*d(i) + b*reduced%lambda(i)*d(i)
+      end do
+      do j = 1, reduced%m
+         dp = d(r + j)
+         acc = 0
+         do i = 1, r
+            y(i) = y(i) + a*reduced%coupling(i, j)*dp
+            acc = acc + reduced%coupling(i, j)*d(i)
+         end do
+         do i = 1, reduced%m
+            acc = acc + reduced%mass_pp(i, j)*d(r + i)
+         end do
+         y(r + j) = a*acc
+         acc = 0
+         do i = 1, reduced%m
+            acc = acc + reduced%stiffness_pp(i, j)*d(r + i)
+         end do
+         y(r + j) = y(r + j) + b*acc
+      end do
+   end subroutine reduced_damping_product
 
    !> Dense M_r and S_r (r + m)^2 from the stored blocks (tests, spectra).
    pure subroutine reduced_matrices(reduced, mass, stiffness)

@@ -12,12 +12,11 @@
 !> Records go to the same recorder interface, snapshots expanded to the nodes (u = T q).
 !> The loop allocates nothing and writes nothing itself.
 module beamstops_reduced_scheme
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
    use beamstops_scene, only: scene_type, steps_of, law_none, law_signorini, law_compliance
    use beamstops_reduced, only: reduced_model_type, block_solver_type, block_solve, reduced_stiffness_product, &
-      & reduced_mass_product
+      & reduced_mass_product, reduced_damping_product
    use beamstops_clock, only: thread_cpu_seconds
    use beamstops_ledger, only: first_events
    use beamstops_forcing, only: load_average, support_position, load_rotation, start_loads, next_load
@@ -26,13 +25,15 @@ module beamstops_reduced_scheme
    use beamstops_contact_compliance, only: spring_force, solve_spring_tip
    use beamstops_contact_span_stops, only: span_work_type, new_span_work, span_contact, span_settle, span_energy
    use beamstops_contact_box_qp, only: qp_solved, qp_message
-   use beamstops_observe_observer, only: observer_type, new_observer
+   use beamstops_observe_observer, only: observer_type, observe_scene
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
-      & col_work, col_dissipated
-   use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running
+      & col_work, col_dissipated, col_damped
+   use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running, &
+      & check_divergence
    implicit none
    private
    public :: reduced_state_type, start_reduced, advance_reduced, run_reduced, simulate_reduced, reduced_block_steps
+   public :: resume_reduced
 
    !> Steps between progress reports and divergence checks.
    integer(ik), parameter :: reduced_block_steps = 8192_ik
@@ -59,8 +60,11 @@ module beamstops_reduced_scheme
       real(wp) :: gd_prev = 0
       !> Spring forces p(u^{n-1}), p(u^n) at the tip (compliance).
       real(wp) :: p_prev = 0, p_now = 0
-      !> Work of the load and energy taken by the stops so far, per unit mass.
-      real(wp) :: work = 0, dissipated = 0
+      !> Work of the load, energy taken by the stops and by the damping so far, per unit mass.
+      real(wp) :: work = 0, dissipated = 0, damped = 0
+      !> With damping: C_r d^{n-1} (r + m; unallocated without damping) and d^{n-1}.C_r d^{n-1}.
+      real(wp), allocatable :: cd(:)
+      real(wp) :: dcd_prev = 0
       !> E^{1/2} per unit mass (reference of the divergence check).
       real(wp) :: energy0 = 0
       !> Reaction per unit mass at the tip of the step that gave q^n.
@@ -121,14 +125,17 @@ contains
       s = reduced%size
       dt = reduced%dt
       pt = tip_coordinate(reduced)
-      allocate (state%q(s), state%d(s), state%sq(s), state%x(s), state%shape(size(reduced%x)))
-      allocate (state%acc(reduced%m), state%multiplier(reduced%m), state%active(reduced%m))
+      call allocate_work(reduced, state)
       state%q = reduced%q0 + dt*reduced%v0
       if (scene%taylor_start) then
          call reduced_stiffness_product(reduced, reduced%q0, state%sq)
          state%x = support_position(0.0_wp, 1.0_wp, scene%omega)*reduced%load - state%sq
          if (scene%law == law_compliance .and. pt > 0) state%x(pt) = state%x(pt) + &
             & spring_force(reduced%q0(pt), scene%lower, scene%upper, scene%stiffness_per_mass)
+         if (reduced%damped) then
+            call reduced_damping_product(reduced, reduced%v0, state%sq)
+            state%x = state%x - state%sq
+         end if
          call block_solve(reduced%m_solver, state%x)
          state%q = state%q + 0.5_wp*reduced%dt2*state%x
       end if
@@ -149,6 +156,12 @@ contains
          state%p_now = spring_force(state%q(pt), scene%lower, scene%upper, scene%stiffness_per_mass)
       end if
       if (scene%law /= law_none .and. reduced%stops%m == 0) state%max_violation = violation(state%q(pt), scene)
+      if (reduced%damped) then
+         allocate (state%cd(s))
+         call reduced_damping_product(reduced, state%d, state%cd)
+         state%dcd_prev = dot_product(state%d, state%cd)
+         state%damped = 0
+      end if
       call reduced_stiffness_product(reduced, reduced%q0, state%x)
       call reduced_stiffness_product(reduced, state%q, state%sq)
       state%energy0 = energy(reduced, reduced_mass_product(reduced, state%d), dot_product(state%q, state%sq), &
@@ -171,23 +184,55 @@ contains
       state%step = 1
       if (scene%statistics) then
          if (reduced%stops%m > 0) then
-            call new_observer(state%observer, reduced%stops%m, reduced%q0(reduced%r + 1:) + reduced%stops%lift* &
-               & support_position(0.0_wp, scene%amplitude, scene%omega), scene%mass_per_length, reduced%dt, &
-               & scene%rest_time, scene%transient, scene%t_end, scene%batches, scene%bins, scene%histogram_lower, &
-               & scene%histogram_upper, 0.0_wp, error)
-            if (allocated(error)) return
-            call state%observer%span(reduced%dt, state%q(reduced%r + 1:) + reduced%stops%lift* &
-               & support_position(reduced%dt, scene%amplitude, scene%omega), state%stop_reaction, &
-               & dot_product(reduced%tip_row, state%q), state%dissipated)
+            call observe_scene(state%observer, scene, dt, .true., reduced%q0(reduced%r + 1:) + reduced%stops%lift* &
+               & support_position(0.0_wp, scene%amplitude, scene%omega), state%q(reduced%r + 1:) + &
+               & reduced%stops%lift*support_position(dt, scene%amplitude, scene%omega), state%stop_reaction, &
+               & dot_product(reduced%tip_row, state%q), state%dissipated, error)
          else
-            call new_observer(state%observer, 1, [dot_product(reduced%tip_row, reduced%q0)], scene%mass_per_length, &
-               & reduced%dt, scene%rest_time, scene%transient, scene%t_end, scene%batches, scene%bins, &
-               & scene%histogram_lower, scene%histogram_upper, 0.0_wp, error)
-            if (allocated(error)) return
-            call state%observer%tip(reduced%dt, dot_product(reduced%tip_row, state%q), state%reaction, state%dissipated)
+            call observe_scene(state%observer, scene, dt, .false., [dot_product(reduced%tip_row, reduced%q0)], &
+               & [dot_product(reduced%tip_row, state%q)], [state%reaction], dot_product(reduced%tip_row, state%q), &
+               & state%dissipated, error)
          end if
       end if
    end subroutine start_reduced
+
+   !> The work arrays of the loop (q and d allocated too).
+   subroutine allocate_work(reduced, state)
+      type(reduced_model_type), intent(in) :: reduced
+      type(reduced_state_type), intent(inout) :: state
+      integer :: s
+      s = reduced%size
+      if (.not. allocated(state%q)) allocate (state%q(s))
+      if (.not. allocated(state%d)) allocate (state%d(s))
+      allocate (state%sq(s), state%x(s), state%shape(size(reduced%x)))
+      allocate (state%acc(reduced%m), state%multiplier(reduced%m), state%active(reduced%m))
+   end subroutine allocate_work
+
+   !> A state read from a checkpoint (q, d, the scalars, the stops' reactions and the observer
+   !> set) made ready to run: the work arrays, the stops' program, and with damping C_r d^{n-1}
+   !> and d^{n-1}.C_r d^{n-1}, rebuilt from d by the loop's own operations (so to the bit).
+   subroutine resume_reduced(reduced, state, error)
+      !> Reduced model.
+      type(reduced_model_type), intent(in) :: reduced
+      !> State with q, d and the scalars of a checkpoint; ready to run on return.
+      type(reduced_state_type), intent(inout) :: state
+      !> Set when the stops' program cannot be set up.
+      type(error_type), allocatable, intent(out) :: error
+      call allocate_work(reduced, state)
+      if (reduced%stops%m > 0) then
+         if (.not. allocated(state%stop_reaction)) then
+            allocate (state%stop_reaction(reduced%stops%m))
+            state%stop_reaction = 0
+         end if
+         call new_span_work(state%span, reduced%stops, error)
+         if (allocated(error)) return
+      end if
+      if (reduced%damped) then
+         allocate (state%cd(reduced%size))
+         call reduced_damping_product(reduced, state%d, state%cd)
+         state%dcd_prev = dot_product(state%d, state%cd)
+      end if
+   end subroutine resume_reduced
 
    !> The stops along the span at the start: their work arrays, and q^1 projected on the bounds of
    !> t_1 (the QP on the trial values of q^1 at the stops).
@@ -222,10 +267,11 @@ contains
       state%max_violation = worst
    end subroutine start_span
 
-   !> Run from the state's step to the scene's last step in blocks; between blocks the
-   !> divergence check and progress (no checkpoints: validate_reduced refuses them). Fills the
-   !> summary.
-   subroutine run_reduced(scene, reduced, state, recorder, summary)
+   !> Run from the state's step to the scene's last step (or to step `until`) in blocks; between
+   !> blocks the divergence check and progress. Fills the summary; a call that ends at `until`
+   !> before the last step leaves the status 'running' (the caller saves a checkpoint and
+   !> continues with another call).
+   subroutine run_reduced(scene, reduced, state, recorder, summary, until)
       !> Scene.
       type(scene_type), intent(in) :: scene
       !> Its reduced model.
@@ -236,13 +282,17 @@ contains
       class(recorder_type), intent(inout) :: recorder
       !> Outcome of the run.
       type(run_summary), intent(inout) :: summary
-      integer(ik) :: steps, last, done
-      real(wp) :: t0, kinetic, cap
+      !> Last step of this call (default: the scene's last).
+      integer(ik), intent(in), optional :: until
+      integer(ik) :: steps, last, done, final
+      real(wp) :: t0, kinetic
       steps = steps_of(scene)
+      final = steps
+      if (present(until)) final = min(steps, until)
       summary%status = status_running
       t0 = thread_cpu_seconds() - state%cpu_seconds
-      do while (state%step <= steps)
-         last = min(steps, state%step + reduced_block_steps - 1)
+      do while (state%step <= final)
+         last = min(final, state%step + reduced_block_steps - 1)
          call advance_reduced(scene, reduced, state, recorder, last, done)
          state%cpu_seconds = thread_cpu_seconds() - t0
          if (recorder%failed) then
@@ -257,14 +307,9 @@ contains
             exit
          end if
          kinetic = 0.5_wp*reduced_mass_product(reduced, state%d)/reduced%dt2
-         cap = 1.0e8_wp*(0.5_wp*scene%length*(scene%amplitude*scene%omega)**2 + abs(state%energy0) &
-            & + abs(state%work) + abs(state%dissipated))
-         if (.not. ieee_is_finite(kinetic) .or. kinetic > cap) then
-            summary%status = status_diverged
-            summary%message = 'the solution blew up (kinetic energy beyond 1e8 times the energy supplied) '// &
-               & 'before t = '//trim(real_text(real(state%step - 1, wp)*reduced%dt))//' s'
-            exit
-         end if
+         call check_divergence(scene, kinetic, state%energy0, state%work, state%dissipated, &
+            & real(state%step - 1, wp)*reduced%dt, summary)
+         if (summary%status == status_diverged) exit
          if (state%observer%active) call state%observer%drain()
          call recorder%progress(state%step - 1, steps)
       end do
@@ -274,12 +319,34 @@ contains
       summary%impacts = state%impacts
       summary%contact_phases = state%impacts
       summary%max_violation = state%max_violation
-      if (summary%status == status_running) summary%status = status_complete
-      if (state%observer%active) then
+      if (summary%status == status_running .and. state%step > steps) summary%status = status_complete
+      call close_ledger(scene, reduced, state, summary)
+      if (state%observer%active .and. summary%status /= status_running) then
          call state%observer%finish(summary%shocks, summary%statistics)
          summary%impacts = state%observer%shocks%shock_count()
       end if
    end subroutine run_reduced
+
+   !> The energy ledger of the summary (J): work, the stops' and the damping's losses and the
+   !> balance residual E^{N+1/2} - E^{1/2} - (work - dissipated - damped) (as the full loop's).
+   subroutine close_ledger(scene, reduced, state, summary)
+      type(scene_type), intent(in) :: scene
+      type(reduced_model_type), intent(in) :: reduced
+      type(reduced_state_type), intent(inout) :: state
+      type(run_summary), intent(inout) :: summary
+      real(wp) :: usu, dsu, e_end
+      if (.not. allocated(state%d)) return
+      call reduced_stiffness_product(reduced, state%q, state%sq)
+      usu = dot_product(state%q, state%sq)
+      dsu = dot_product(state%d, state%sq)
+      e_end = energy(reduced, reduced_mass_product(reduced, state%d), usu, dsu, &
+         & usu - 2*dsu + stiffness_norm2(reduced, state%d))
+      summary%work = scene%mass_per_length*state%work
+      summary%dissipated = scene%mass_per_length*state%dissipated
+      summary%damped = scene%mass_per_length*state%damped
+      summary%energy_residual = scene%mass_per_length*((e_end - state%energy0) &
+         & - (state%work - state%dissipated - state%damped))
+   end subroutine close_ledger
 
    !> Advance from state%step through step `last` (computing q^{last+1}), recording on the way.
    !> `done` is the last step done: `last`, unless the QP of a step fails (state%span%info).
@@ -301,13 +368,14 @@ contains
       real(wp) :: sigma_next, weight, c, gd, tip_value, r_step, r_prev, old_tip, old_dtip
       real(wp) :: u_tip_prev, d_tip_prev, u_old_su, phi_prev, phi_now, phi_next, dt2, row(n_columns)
       real(wp) :: usu, dsu, dmd
-      logical :: contact, recording, span, enforce
+      logical :: contact, recording, span, enforce, damped
       type(load_rotation) :: loads
 
       dt2 = reduced%dt2
       pt = tip_coordinate(reduced)
       span = reduced%stops%m > 0
       enforce = scene%law == law_signorini
+      damped = reduced%damped
       call first_events(scene, state%step, next_record, next_snapshot)
       done = state%step - 1
       u_old_su = 0
@@ -329,16 +397,24 @@ contains
          ! x = A_r^{-1} dt^2 (weight l_r - S_r q): the modal part left as D^{-1} y_a (modal_rhs), the
          ! stop part complete; the modal part is finished by modal_update with the contact's
          ! correction.
-         call modal_rhs(reduced%r, reduced%m, reduced%a_solver%dinv, reduced%a_solver%b, reduced%lambda, &
-            & reduced%load, state%q, dt2, weight, state%x, state%acc)
-         call stop_rhs(reduced, state%q, dt2, weight, state%acc, state%x)
+         if (damped) then
+            ! The damped variant: y_a gains -dt (C_r d^{n-1})_a, the stop rows -dt (C_r d^{n-1})_p.
+            call modal_rhs_damped(reduced%r, reduced%m, reduced%a_solver%dinv, reduced%a_solver%b, reduced%lambda, &
+               & reduced%load, state%q, state%cd, dt2, reduced%dt, weight, state%x, state%acc)
+            call stop_rhs(reduced, state%q, dt2, weight, state%acc, state%x)
+            call damp_stop_rhs(reduced%r, reduced%m, reduced%dt, state%cd, state%x)
+         else
+            call modal_rhs(reduced%r, reduced%m, reduced%a_solver%dinv, reduced%a_solver%b, reduced%lambda, &
+               & reduced%load, state%q, dt2, weight, state%x, state%acc)
+            call stop_rhs(reduced, state%q, dt2, weight, state%acc, state%x)
+         end if
          r_prev = state%reaction
          if (span) then
             phi_next = support_position(real(step + 1, wp)*reduced%dt, scene%amplitude, scene%omega)
             call stop_solve(reduced%a_solver, state%x)
-            ! The paper's law (no restitution in a reduced run): span_contact with e = 0.
+            ! The box QP on u^{n+1}, or on (u^{n+1} + e u^{n-1})/(1 + e) with restitution (SPEC 9).
             call span_contact(reduced%stops, state%span, state%q, state%d, state%x, phi_next, enforce, &
-               & state%span%info, 0.0_wp, 0.0_wp)
+               & state%span%info, scene%restitution, phi_prev)
             if (state%span%info /= qp_solved) exit
             state%n_active = 0
             if (state%span%contact) then
@@ -357,6 +433,7 @@ contains
             state%work = state%work + 0.5_wp*weight*(gd + state%gd_prev)
             call span_energy(reduced%stops, state%span, state%d, dt2, phi_next - phi_prev, state%dissipated, &
                & state%work)
+            if (damped) call damping_loss(reduced, state)
             state%reaction = r_step
             if (recording) then
                state%span%record_u = state%span%u_prev + reduced%stops%lift*phi_now
@@ -393,6 +470,7 @@ contains
             state%in_contact = contact
             state%work = state%work + 0.5_wp*weight*(gd + state%gd_prev)
             state%dissipated = state%dissipated - 0.5_wp*r_step*(state%d(pt) + old_dtip)
+            if (damped) call damping_loss(reduced, state)
             state%reaction = r_step
             if (state%observer%active) call state%observer%tip(real(step + 1, wp)*reduced%dt, state%q(pt), r_step, &
                & state%dissipated)
@@ -409,7 +487,8 @@ contains
             row(col_reaction) = scene%mass_per_length*r_prev
             row(col_work) = scene%mass_per_length*state%work
             row(col_dissipated) = scene%mass_per_length*state%dissipated
-            call energy_terms(reduced%r, reduced%m, reduced%lambda, reduced%a_solver%b, state%q, state%d, state%acc, &
+            row(col_damped) = scene%mass_per_length*state%damped
+            call energy_terms(reduced%r, reduced%m, reduced%lambda, reduced%coupling, state%q, state%d, state%acc, &
                & usu, dsu, dmd)
             call stop_energy_terms(reduced, state%q, state%d, usu, dsu, dmd)
             row(col_energy) = scene%mass_per_length*energy(reduced, dmd, usu, dsu, u_old_su)
@@ -558,6 +637,53 @@ contains
       end do
    end subroutine stop_rhs
 
+   !> modal_rhs with damping: x_a = D^{-1} (dt^2 (weight l_a - Lambda a) - dt (C_r d^{n-1})_a) and
+   !> acc = B^T x_a (B the coupling block of A_r), in one sweep (O(r m)).
+   pure subroutine modal_rhs_damped(r, m, dinv, b, lambda, load, q, cd, dt2, dt, weight, x, acc)
+      integer, intent(in) :: r, m
+      real(wp), intent(in) :: dinv(r), b(r, m), lambda(r), load(r + m), q(r + m), cd(r + m), dt2, dt, weight
+      real(wp), intent(inout) :: x(r + m)
+      real(wp), intent(out) :: acc(m)
+      integer :: i, j
+      real(wp) :: a1
+      do i = 1, r
+         x(i) = dinv(i)*(dt2*(weight*load(i) - lambda(i)*q(i)) - dt*cd(i))
+      end do
+      do j = 1, m
+         a1 = 0
+         do i = 1, r
+            a1 = a1 + b(i, j)*x(i)
+         end do
+         acc(j) = a1
+      end do
+   end subroutine modal_rhs_damped
+
+   !> The stop rows of the damped right-hand side: x_p = x_p - dt (C_r d^{n-1})_p.
+   pure subroutine damp_stop_rhs(r, m, dt, cd, x)
+      integer, intent(in) :: r, m
+      real(wp), intent(in) :: dt, cd(r + m)
+      real(wp), intent(inout) :: x(r + m)
+      integer :: j
+      do j = r + 1, r + m
+         x(j) = x(j) - dt*cd(j)
+      end do
+   end subroutine damp_stop_rhs
+
+   !> The energy the Rayleigh damping takes in step n (SPEC 8), once d^n is final:
+   !> (d^n.C_r d^n + 2 d^n.C_r d^{n-1} + d^{n-1}.C_r d^{n-1})/(4 dt) >= 0, added to state%damped;
+   !> state%cd becomes C_r d^n (the next step's right-hand side term). As beamstops_ledger's
+   !> damping_loss for the full model.
+   pure subroutine damping_loss(reduced, state)
+      type(reduced_model_type), intent(in) :: reduced
+      type(reduced_state_type), intent(inout) :: state
+      real(wp) :: cross, dcd
+      cross = dot_product(state%d, state%cd)
+      call reduced_damping_product(reduced, state%d, state%cd)
+      dcd = dot_product(state%d, state%cd)
+      state%damped = state%damped + (dcd + 2*cross + state%dcd_prev)/(4*reduced%dt)
+      state%dcd_prev = dcd
+   end subroutine damping_loss
+
    !> x_p = H^{-1} x_p (R^T R = H) in place.
    pure subroutine stop_solve(solver, x)
       type(block_solver_type), intent(in) :: solver
@@ -684,16 +810,28 @@ contains
       real(wp), intent(in) :: trial
       real(wp), intent(out) :: c, tip_value, r_step
       logical, intent(out) :: contact
-      real(wp) :: p_next, z_tip
-      z_tip = reduced%z(tip_coordinate(reduced), reduced%tip_stop)
+      real(wp) :: p_next, z_tip, lower, upper, e, u_old
+      integer :: pt
+      pt = tip_coordinate(reduced)
+      z_tip = reduced%z(pt, reduced%tip_stop)
       select case (scene%law)
       case (law_signorini)
-         if (trial >= scene%lower .and. trial <= scene%upper) then
+         lower = scene%lower
+         upper = scene%upper
+         if (scene%restitution > 0) then
+            ! (u^{n+1}_tip + e u^{n-1}_tip)/(1+e) in [g1, g2] (SPEC 9): the projection of u^{n+1}_tip on
+            ! the bounds (1+e) g - e u^{n-1}_tip (u^{n-1} = q^n - d^{n-1}: the state is still at step n).
+            e = scene%restitution
+            u_old = state%q(pt) - state%d(pt)
+            lower = (1 + e)*scene%lower - e*u_old
+            upper = (1 + e)*scene%upper - e*u_old
+         end if
+         if (trial >= lower .and. trial <= upper) then
             ! Between the stops: project_tip's c = 0 and tip value = trial, without its division.
             c = 0
             tip_value = trial
          else
-            call project_tip(trial, scene%lower, scene%upper, z_tip, c, tip_value)
+            call project_tip(trial, lower, upper, z_tip, c, tip_value)
          end if
          contact = c /= 0
          r_step = c/reduced%dt2

@@ -15,10 +15,11 @@ module beamstops_run
    use beamstops_summary, only: run_summary, status_running, status_failed, status_complete
    use beamstops_ensemble, only: run_members
    use beamstops_reduced, only: reduced_model_type, build_reduced, check_stability_reduced
-   use beamstops_reduced_scheme, only: simulate_reduced
+   use beamstops_reduced_scheme, only: simulate_reduced, reduced_state_type, run_reduced
+   use beamstops_reduced_checkpoint, only: write_reduced_checkpoint
    implicit none
    private
-   public :: prepare_run, simulate, continue_run, close_run
+   public :: prepare_run, simulate, continue_run, close_run, continue_reduced
 
 contains
 
@@ -127,6 +128,54 @@ contains
          call run_members(scene, model, summary, error)
          if (allocated(error)) return
       end if
+      call recorder_outcome(recorder, summary, error)
+   end subroutine close_run
+
+   !> continue_run for a reduced model (scene%modes > 0): from the state's step (start_reduced's,
+   !> or a checkpoint's) to t_end, with `checkpoint` every checkpoint_every steps (the recorder
+   !> flushed, then the state saved atomically).
+   subroutine continue_reduced(scene, reduced, state, recorder, summary, error, checkpoint)
+      !> Validated scene.
+      type(scene_type), intent(in) :: scene
+      !> Its reduced model.
+      type(reduced_model_type), intent(in) :: reduced
+      !> State, advanced to the end of the run (or to where it stopped).
+      type(reduced_state_type), intent(inout) :: state
+      !> Receives records and snapshots.
+      class(recorder_type), intent(inout) :: recorder
+      !> Outcome: 'complete', 'diverged' or 'failed' (with a message).
+      type(run_summary), intent(inout) :: summary
+      !> Set when the recorder or a checkpoint could not be written (the run stopped there,
+      !> with status 'failed' and the same message in the summary).
+      type(error_type), allocatable, intent(out) :: error
+      !> Checkpoint file (none without it).
+      character(len=*), intent(in), optional :: checkpoint
+      integer(ik) :: steps, every, until, records, snapshots
+      steps = steps_of(scene)
+      every = 0
+      if (present(checkpoint)) every = scene%checkpoint_every
+      do
+         until = steps
+         if (every > 0) until = min(steps, ((state%step - 1)/every + 1)*every)
+         call run_reduced(scene, reduced, state, recorder, summary, until)
+         if (summary%status /= status_running .or. recorder%failed) exit
+         call recorder%flush(records, snapshots)
+         if (recorder%failed) exit
+         call write_reduced_checkpoint(checkpoint, scene, state, records, snapshots, error)
+         if (allocated(error)) then
+            summary%status = status_failed
+            summary%message = error%message
+            return
+         end if
+      end do
+      call recorder_outcome(recorder, summary, error)
+   end subroutine continue_reduced
+
+   !> A recorder that could not write makes the run 'failed' with the recorder's message.
+   subroutine recorder_outcome(recorder, summary, error)
+      class(recorder_type), intent(in) :: recorder
+      type(run_summary), intent(inout) :: summary
+      type(error_type), allocatable, intent(inout) :: error
       if (recorder%failed) then
          if (allocated(recorder%message)) then
             call fatal_error(error, recorder%message)
@@ -136,5 +185,5 @@ contains
          summary%status = status_failed
          summary%message = error%message
       end if
-   end subroutine close_run
+   end subroutine recorder_outcome
 end module beamstops_run

@@ -8,7 +8,6 @@
 !> stops along the span. The start is beamstops_start's; the tip's contact law is in
 !> contact/tip_contact.f90. The loop allocates nothing and writes nothing: records go to a recorder.
 module beamstops_scheme
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_kinds, only: wp, ik
    use beamstops_scene, only: scene_type, steps_of, law_signorini
    use beamstops_model, only: model_type
@@ -27,7 +26,8 @@ module beamstops_scheme
    use beamstops_ledger, only: energy, move_on, damping_loss, fill_row, take_snapshot, first_events
    use beamstops_contact_mass_redistribution, only: equilibrium_rows, massless_reaction
    use beamstops_start, only: start_state
-   use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running
+   use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running, &
+      & check_divergence
    implicit none
    private
    public :: state_type, start_state, advance, run_scheme, block_steps
@@ -54,7 +54,7 @@ contains
       !> Last step of this call (default: the scene's last).
       integer(ik), intent(in), optional :: until
       integer(ik) :: steps, last, final
-      real(wp) :: t0, kinetic, cap
+      real(wp) :: t0, kinetic
       steps = steps_of(scene)
       final = steps
       if (present(until)) final = min(steps, until)
@@ -77,14 +77,9 @@ contains
          end if
          call band_matvec(model%mass, state%d, state%scratch)
          kinetic = 0.5_wp*dot_product(state%d, state%scratch)/model%dt2
-         cap = 1.0e8_wp*(0.5_wp*scene%length*(scene%amplitude*scene%omega)**2 + abs(state%energy0) &
-            & + abs(state%work) + abs(state%dissipated))
-         if (.not. ieee_is_finite(kinetic) .or. kinetic > cap) then
-            summary%status = status_diverged
-            summary%message = 'the solution blew up (kinetic energy beyond 1e8 times the energy supplied) '// &
-               & 'before t = '//trim(real_text(real(state%step - 1, wp)*model%dt))//' s'
-            exit
-         end if
+         call check_divergence(scene, kinetic, state%energy0, state%work, state%dissipated, &
+            & real(state%step - 1, wp)*model%dt, summary)
+         if (summary%status == status_diverged) exit
          if (state%observer%active) call state%observer%drain()
          call recorder%progress(state%step - 1, steps)
       end do

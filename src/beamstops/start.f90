@@ -16,7 +16,7 @@ module beamstops_start
    use beamstops_contact_box_qp, only: qp_solved, qp_message
    use beamstops_recorder, only: recorder_type, n_columns, col_u, col_v, col_energy
    use beamstops_ledger, only: energy, physical_shape
-   use beamstops_observe_observer, only: new_observer
+   use beamstops_observe_observer, only: observe_scene
    implicit none
    private
    public :: start_state
@@ -125,18 +125,12 @@ contains
       phi0 = support_position(0.0_wp, scene%amplitude, scene%omega)
       phi1 = support_position(model%dt, scene%amplitude, scene%omega)
       if (model%stops%m > 0) then
-         call new_observer(state%observer, model%stops%m, model%u0(model%stops%unknown) + model%stops%lift*phi0, &
-            & scene%mass_per_length, model%dt, scene%rest_time, scene%transient, scene%t_end, scene%batches, &
-            & scene%bins, scene%histogram_lower, scene%histogram_upper, 0.0_wp, error)
-         if (allocated(error)) return
-         call state%observer%span(model%dt, state%u(model%stops%unknown) + model%stops%lift*phi1, &
-            & state%stop_reaction, state%u(model%tip), state%dissipated)
+         call observe_scene(state%observer, scene, model%dt, .true., model%u0(model%stops%unknown) + &
+            & model%stops%lift*phi0, state%u(model%stops%unknown) + model%stops%lift*phi1, state%stop_reaction, &
+            & state%u(model%tip), state%dissipated, error)
       else
-         call new_observer(state%observer, 1, [model%u0(model%tip)], scene%mass_per_length, model%dt, &
-            & scene%rest_time, scene%transient, scene%t_end, scene%batches, scene%bins, scene%histogram_lower, &
-            & scene%histogram_upper, 0.0_wp, error)
-         if (allocated(error)) return
-         call state%observer%tip(model%dt, state%u(model%tip), state%reaction, state%dissipated)
+         call observe_scene(state%observer, scene, model%dt, .false., [model%u0(model%tip)], [state%u(model%tip)], &
+            & [state%reaction], state%u(model%tip), state%dissipated, error)
       end if
    end subroutine start_observer
 

@@ -1,10 +1,12 @@
 !> What a run reports when it ends: status, counts, extremes and cost.
 module beamstops_summary
    use beamstops_kinds, only: wp, ik
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_observe_statistics, only: statistics_table
+   use beamstops_scene, only: scene_type
    implicit none
    private
-   public :: run_summary, status_complete, status_diverged, status_running, status_failed
+   public :: run_summary, status_complete, status_diverged, status_running, status_failed, check_divergence
 
    !> Status texts written to the output's `status` attribute.
    character(len=*), parameter :: status_complete = 'complete', status_diverged = 'diverged', &
@@ -44,4 +46,27 @@ module beamstops_summary
       !> Records and snapshots written.
       integer(ik) :: records = 0, snapshots = 0
    end type run_summary
+contains
+
+   !> The divergence check of the time loops (full and reduced), between blocks: status
+   !> 'diverged' with its message when the kinetic energy is not finite or beyond 1e8 times the
+   !> energy the run has seen (the support's scale, E^{1/2}, the work, the stops' energy).
+   subroutine check_divergence(scene, kinetic, energy0, work, dissipated, t, summary)
+      !> Scene (length, support amplitude and frequency).
+      type(scene_type), intent(in) :: scene
+      !> Kinetic energy 1/2 d.M d/dt^2, E^{1/2}, work and stops' energy so far, per unit mass.
+      real(wp), intent(in) :: kinetic, energy0, work, dissipated
+      !> Time reached (s), for the message.
+      real(wp), intent(in) :: t
+      !> Set to 'diverged' when the solution blew up.
+      type(run_summary), intent(inout) :: summary
+      real(wp) :: cap
+      character(len=32) :: text
+      cap = 1.0e8_wp*(0.5_wp*scene%length*(scene%amplitude*scene%omega)**2 + abs(energy0) + abs(work) + abs(dissipated))
+      if (ieee_is_finite(kinetic) .and. kinetic <= cap) return
+      write (text, '(g0.6)') t
+      summary%status = status_diverged
+      summary%message = 'the solution blew up (kinetic energy beyond 1e8 times the energy supplied) before t = '// &
+         & trim(text)//' s'
+   end subroutine check_divergence
 end module beamstops_summary

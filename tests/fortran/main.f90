@@ -27,6 +27,7 @@ program tester
    use test_lockstep, only: collect_lockstep
    use test_batch, only: collect_batch
    use test_reduced, only: collect_reduced
+   use test_reduced_physics, only: collect_reduced_physics
    implicit none
 
    abstract interface
@@ -70,6 +71,7 @@ program tester
       & new_testsuite('redistribution', collect_redistribution), &
       & new_testsuite('physics_checks', collect_physics_checks), &
       & new_testsuite('reduced', collect_reduced), &
+      & new_testsuite('reduced_physics', collect_reduced_physics), &
       & new_testsuite('lockstep', collect_lockstep), &
       & new_testsuite('batch', collect_batch) &
       & ]

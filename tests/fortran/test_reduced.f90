@@ -16,10 +16,13 @@ module test_reduced
    use beamstops_reduced, only: reduced_model_type, prepare_reduced, build_reduced, validate_reduced, &
       & reduced_matrices, expand, stop_unknowns
    use beamstops_reduced_scheme, only: reduced_state_type, simulate_reduced, start_reduced, advance_reduced
-   use beamstops_recorder, only: col_t, col_u, col_v, col_reaction, col_energy, col_work, col_dissipated, n_columns
+   use beamstops_recorder, only: col_t, col_u, col_v, col_reaction, col_energy, col_work, col_dissipated, col_damped, &
+      & n_columns
    implicit none
    private
    public :: collect_reduced
+   ! (for the suite reduced_physics)
+   public :: run_reduced_recorded, compare_full
 
 contains
 
@@ -112,8 +115,8 @@ contains
       type(scene_type) :: reduced_scene
       type(array_recorder) :: full, red
       type(run_summary) :: sf, sr
-      character(len=*), parameter :: names(7) = [character(len=10) :: 't', 'u', 'v', 'reaction', 'energy', &
-         & 'work', 'dissipated']
+      character(len=*), parameter :: names(n_columns) = [character(len=10) :: 't', 'u', 'v', 'reaction', 'energy', &
+         & 'work', 'dissipated', 'damped']
       real(wp) :: diff, clean
       integer(ik) :: last
       integer :: c
@@ -126,7 +129,7 @@ contains
       call check(error, red%filled == full%filled, 'as many records'); if (allocated(error)) return
       call divergence_report(full, red)
       last = count(full%rows(col_t, :full%filled) <= t_clean, kind=ik)
-      do c = 1, 7
+      do c = 1, n_columns
          clean = column_difference(full, red, c, last)
          diff = column_difference(full, red, c, full%filled)
          call note(trim(names(c))//': largest difference / scale up to t = '//real_text(t_clean)//' s '// &
@@ -135,7 +138,7 @@ contains
             & real_text(t_clean), thr=thr_clean)
          if (allocated(error)) return
          ! Velocities, reactions and the stops' energy jump at impacts: compared before them only.
-         if (thr_all > 0 .and. any(c == [col_u, col_energy, col_work])) call check(error, diff, 0.0_wp, &
+         if (thr_all > 0 .and. any(c == [col_u, col_energy, col_work, col_damped])) call check(error, diff, 0.0_wp, &
             & trim(names(c))//' of the full and the reduced run', thr=thr_all)
          if (allocated(error)) return
       end do
@@ -697,16 +700,6 @@ contains
          return
       end if
       deallocate (error)
-      scene%modes = 3
-      scene%checkpoint_every = 100
-      call validate_reduced(scene, 38, 1, 'in.nml', error)
-      if (.not. allocated(error)) then
-         call test_failed(error, 'checkpoints with modes > 0 refused')
-         return
-      end if
-      call note(error%message)
-      deallocate (error)
-      scene%checkpoint_every = 0
       scene%modes = 20000
       call validate_reduced(scene, 40000, 1, 'in.nml', error)
       if (.not. allocated(error)) then

@@ -80,6 +80,44 @@ def test_killed_runs_resume_bit_for_bit(tmp_path: Path) -> None:
     assert_identical(tmp_path / "killed.h5", tmp_path / "reference.h5")
 
 
+REDUCED = """&mesh modes=8 /
+&damping ratio=0.02 /
+&stops restitution=0.5 /
+&statistics enabled=.true., transient=0.2 /
+"""
+
+
+def test_killed_reduced_runs_resume_bit_for_bit(tmp_path: Path) -> None:
+    """A reduced run (modes = 8, damped, with restitution and statistics) killed after each of
+    its first checkpoints and resumed gives the uninterrupted run's output bit for bit."""
+    reference = write_scene(tmp_path, "reference")
+    reference.write_text(reference.read_text() + REDUCED)
+    assert run("run", reference, cwd=tmp_path).returncode == 0
+    scene = write_scene(tmp_path, "killed")
+    scene.write_text(scene.read_text() + REDUCED)
+    checkpoint = tmp_path / "killed.h5.checkpoint"
+    args: list[str | Path] = ["run", scene]
+    kills = 0
+    for _ in range(3):
+        process = subprocess.Popen([PROGRAM, *map(str, args)], cwd=tmp_path, stdout=subprocess.DEVNULL,
+                                   stderr=subprocess.DEVNULL)
+        seen = checkpoint.stat().st_mtime_ns if checkpoint.exists() else 0
+        deadline = time.time() + 60
+        while process.poll() is None and time.time() < deadline and \
+                (not checkpoint.exists() or checkpoint.stat().st_mtime_ns == seen):
+            time.sleep(0.005)
+        if process.poll() is None:
+            process.send_signal(signal.SIGKILL)
+            kills += 1
+        process.wait()
+        args = ["run", scene, "--restart"]
+    done = run(*args, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert kills > 0, "the run was never killed: make it longer"
+    assert not checkpoint.exists() and not (tmp_path / "killed.h5.partial").exists()
+    assert_identical(tmp_path / "killed.h5", tmp_path / "reference.h5")
+
+
 def test_interrupted_file_says_so_and_keeps_its_records(tmp_path: Path) -> None:
     scene = write_scene(tmp_path, "cut", t_end=4.0)
     process = subprocess.Popen([PROGRAM, "run", str(scene)], cwd=tmp_path, stdout=subprocess.DEVNULL,

@@ -8,9 +8,10 @@ module beamstops_observe_observer
    use beamstops_error, only: error_type, fatal_error
    use beamstops_observe_shocks, only: shock_log, shock_row, new_shock_log, shock_row_values, n_shock_columns
    use beamstops_observe_statistics, only: statistics_type, statistics_table, new_statistics
+   use beamstops_scene, only: scene_type
    implicit none
    private
-   public :: observer_type, new_observer
+   public :: observer_type, new_observer, observe_scene
 
    !> Shock log and statistics of a run, fed by the loop.
    type :: observer_type
@@ -83,6 +84,36 @@ contains
       if (allocated(error)) return
       self%active = .true.
    end subroutine new_observer
+
+   !> The observer of a run of `scene` from t = 0 (the scene's window, batches, bins, rest time;
+   !> the full and the reduced loops alike): new_observer with the stops' physical values at t = 0,
+   !> then the start's sample at t_1 = dt (the stops along the span, or the tip alone).
+   subroutine observe_scene(self, scene, dt, span, u0, u1, reaction, tip1, dissipated, error)
+      !> The observer, active on return.
+      type(observer_type), intent(out) :: self
+      !> Scene (&statistics settings, mass per length).
+      type(scene_type), intent(in) :: scene
+      !> Time step (s).
+      real(wp), intent(in) :: dt
+      !> Stops along the span (.true.) or the tip alone.
+      logical, intent(in) :: span
+      !> Physical values of the stops (or of the tip) at t = 0 and t_1 (m) (m, or 1).
+      real(wp), intent(in) :: u0(:), u1(:)
+      !> Reactions per unit mass of the start (m, or 1).
+      real(wp), intent(in) :: reaction(:)
+      !> Tip value at t_1 (m) and the stops' energy of the start per unit mass.
+      real(wp), intent(in) :: tip1, dissipated
+      !> Set on a value out of range.
+      type(error_type), allocatable, intent(out) :: error
+      call new_observer(self, size(u0), u0, scene%mass_per_length, dt, scene%rest_time, scene%transient, &
+         & scene%t_end, scene%batches, scene%bins, scene%histogram_lower, scene%histogram_upper, 0.0_wp, error)
+      if (allocated(error)) return
+      if (span) then
+         call self%span(dt, u1, reaction, tip1, dissipated)
+      else
+         call self%tip(dt, u1(1), reaction(1), dissipated)
+      end if
+   end subroutine observe_scene
 
    !> The sample of step n of the tip-only scene: t_{n+1}, u^{n+1}_tip (physical: the lifting is 0
    !> at the tip), the reaction of step n and the stops' energy so far, both per unit mass.

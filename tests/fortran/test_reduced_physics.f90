@@ -1,0 +1,390 @@
+!> The physics of SPEC 8-9 in the reduced (modal) models (beamstops_reduced_scheme): Rayleigh
+!> damping C_r = T^T C T = a M_r + b S_r and the Paoli-Schatzman restitution, against
+!> mathematics: with all r = n - m modes the reduced run is the full damped (restitution) run in
+!> another basis (the full engine's records to round-off through the impacts of the paper's scene,
+!> tip-only and with stops along the span); the free decay of the reduced model's mode 1 has the
+!> logarithmic decrement of its damping ratio to O(dt^2); without contact the balance
+!> E - E0 = W - damped closes to round-off; with restitution the combination
+!> (u^{n+1} + e u^{n-1})/(1 + e) satisfies the KKT conditions every step in reduced coordinates.
+module test_reduced_physics
+   use testing
+   use test_support, only: int_text
+   use test_reduced, only: run_reduced_recorded, compare_full
+   use physics_support, only: peaks
+   use beamstops, only: ik, scene_type, array_recorder, run_summary, law_none, law_signorini, validate_scene, &
+      & steps_of, scene_from_text, record_count, stop_count, status_complete
+   use beamstops_forcing, only: load_average
+   use beamstops_lapack, only: dsygv
+   use beamstops_reduced, only: reduced_model_type, prepare_reduced, reduced_matrices
+   use beamstops_reduced_scheme, only: reduced_state_type, simulate_reduced, start_reduced, advance_reduced, run_reduced
+   use beamstops_reduced_checkpoint, only: write_reduced_checkpoint, read_reduced_checkpoint
+   use beamstops_files, only: remove_file
+   use beamstops_recorder, only: col_t, col_u, col_energy, col_work, col_dissipated, col_damped
+   implicit none
+   private
+   public :: collect_reduced_physics
+
+contains
+
+   !> Tests of the suite.
+   subroutine collect_reduced_physics(tests)
+      !> The suite's tests.
+      type(unittest_type), allocatable, intent(out) :: tests(:)
+      tests = [ &
+         & new_unittest('all modes, damped (2 %), tip stops: the full engine to round-off up to 0.2 s', test_full_damped), &
+         & new_unittest('all modes, damped tube (three stops): the full engine to round-off', test_full_damped_span), &
+         & new_unittest('all modes, restitution e = 0.5, tip stops: the full engine up to 0.17 s', test_full_restitution), &
+         & new_unittest('all modes, restitution e = 0.5, tube: the full engine to round-off', test_full_restitution_span), &
+         & new_unittest('r = 3, damped: log decrement of mode 1 is 2 pi zeta/sqrt(1-zeta^2) to O(dt^2)', test_decrement), &
+         & new_unittest('damped, no contact: E - E0 = W - damped to round-off (records and summary)', test_balance), &
+         & new_unittest('r = 6, e = 0.5: KKT of the combination every step, in reduced coordinates', test_kkt_restitution), &
+         & new_unittest('a reduced run (damped, restitution, three stops, statistics) resumed from a checkpoint: '// &
+         & 'the same bits', test_resume), &
+         & new_unittest('&mesh modes with damping and restitution accepted; what remains refused', test_validate) &
+         & ]
+   end subroutine collect_reduced_physics
+
+   !> The tube of input/tube_supports.nml (supports at 1/3, 2/3, stops at the tip), J = 30.
+   function tube(t_end) result(scene)
+      real(wp), intent(in) :: t_end
+      type(scene_type) :: scene
+      scene%law = law_signorini
+      scene%beta = 0.25_wp
+      scene%elements = 30
+      scene%dt = 2e-5_wp
+      scene%t_end = t_end
+      scene%length = 1.5_wp
+      scene%amplitude = 0.002_wp
+      scene%omega = 40.0_wp
+      scene%stop_nodes = [10, 20, 30]
+      scene%stop_lower = [-0.002_wp, -0.002_wp, -0.004_wp]
+      scene%stop_upper = [0.002_wp, 0.002_wp, 0.004_wp]
+   end function tube
+
+   !> The paper's scene with the tip stops, beta = 1/2, dt = 1e-5, 0.2 s.
+   function paper_tip() result(scene)
+      type(scene_type) :: scene
+      scene%law = law_signorini
+      scene%beta = 0.5_wp
+      scene%dt = 1e-5_wp
+      scene%t_end = 0.2_wp
+   end function paper_tip
+
+   subroutine test_full_damped(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      scene = paper_tip()
+      scene%damping_by_ratio = .true.
+      scene%damping_ratio = [0.02_wp, 0.02_wp]
+      call compare_full(scene, 0.085_wp, 1e-10_wp, 1e-6_wp, error)
+   end subroutine test_full_damped
+
+   subroutine test_full_damped_span(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      scene = tube(0.2_wp)
+      scene%damping_mass = 2.0_wp
+      scene%damping_stiffness = 1.0e-5_wp
+      call compare_full(scene, 0.05_wp, 1e-10_wp, 1e-6_wp, error)
+   end subroutine test_full_damped_span
+
+   subroutine test_full_restitution(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      scene = paper_tip()
+      ! Up to t = 0.17 s (impacts amplify round-off: measured 1e-9 of the tip's scale at 0.17 s,
+      ! 4e-6 by 0.2 s).
+      scene%t_end = 0.17_wp
+      scene%restitution = 0.5_wp
+      call compare_full(scene, 0.085_wp, 1e-10_wp, 1e-6_wp, error)
+   end subroutine test_full_restitution
+
+   subroutine test_full_restitution_span(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      scene = tube(0.2_wp)
+      scene%restitution = 0.5_wp
+      call compare_full(scene, 0.05_wp, 1e-10_wp, 1e-6_wp, error)
+   end subroutine test_full_restitution_span
+
+   !> Free decay (no support motion, no stops, J = 8, r = 3, zeta_1 = zeta_2 = 0.02 on the full
+   !> model's modes) from the reduced model's own mode 1 (lowest eigenvector of (S_r, M_r), tip
+   !> 0.01 m): the decrement of the tip's peaks against 2 pi zeta_r/sqrt(1 - zeta_r^2),
+   !> zeta_r = a/(2 omega_r) + b omega_r/2 at the reduced mode's frequency omega_r.
+   subroutine decay(dt, decrement, expected, error)
+      real(wp), intent(in) :: dt
+      real(wp), intent(out) :: decrement, expected
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), parameter :: pi = acos(-1.0_wp)
+      type(scene_type) :: scene
+      type(reduced_model_type) :: reduced
+      type(array_recorder) :: rec
+      type(run_summary) :: summary
+      real(wp), allocatable :: mr(:, :), sr(:, :), w(:), work(:), tp(:), yp(:)
+      real(wp) :: omega, zeta
+      integer :: s, info, k
+      decrement = 0
+      expected = 0
+      scene%elements = 8
+      scene%dt = dt
+      scene%t_end = 1.2_wp
+      scene%beta = 0.25_wp
+      scene%amplitude = 0
+      scene%law = law_none
+      scene%modes = 3
+      scene%damping_by_ratio = .true.
+      scene%damping_ratio = [0.02_wp, 0.02_wp]
+      call validate_scene(scene, 'test scene', error)
+      if (allocated(error)) return
+      call prepare_reduced(scene, 'test scene', reduced, error)
+      if (allocated(error)) return
+      call reduced_matrices(reduced, mr, sr)
+      s = reduced%size
+      allocate (w(s), work(3*s))
+      call dsygv(1, 'V', 'U', s, sr, s, mr, s, w, work, size(work), info)
+      if (info /= 0) then
+         call test_failed(error, 'dsygv info = '//int_text(info))
+         return
+      end if
+      reduced%q0 = 0.01_wp*sr(:, 1)/dot_product(reduced%tip_row, sr(:, 1))
+      reduced%v0 = 0
+      omega = sqrt(w(1))
+      zeta = reduced%damping_a/(2*omega) + reduced%damping_b*omega/2
+      expected = 2*pi*zeta/sqrt(1 - zeta**2)
+      call rec%reserve(steps_of(scene) + 1, 0_ik, scene%elements + 1)
+      call simulate_reduced(scene, reduced, rec, summary, error)
+      if (allocated(error)) return
+      call peaks(rec%rows(col_t, 1:rec%filled), rec%rows(col_u, 1:rec%filled), tp, yp)
+      k = size(yp)
+      if (k < 3) then
+         call test_failed(error, 'fewer than 3 peaks')
+         return
+      end if
+      decrement = log(yp(1)/yp(k))/(k - 1)
+   end subroutine decay
+
+   subroutine test_decrement(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: d1, d2, x1, x2, e1, e2
+      call decay(2.0e-3_wp, d1, x1, error)
+      if (allocated(error)) return
+      call decay(1.0e-3_wp, d2, x2, error)
+      if (allocated(error)) return
+      e1 = abs(d1/x1 - 1)
+      e2 = abs(d2/x2 - 1)
+      call note('log decrement '//real_text(d2)//' (expected '//real_text(x2)//'); relative error '// &
+         & real_text(e1)//' at dt = 2e-3, '//real_text(e2)//' at dt = 1e-3, order '//real_text(log(e1/e2)/log(2.0_wp)))
+      call check(error, abs(x2/(2*acos(-1.0_wp)*0.02_wp) - 1) < 1e-3_wp, &
+         & 'the reduced mode 1 has (nearly) the full model''s damping ratio')
+      if (allocated(error)) return
+      call check(error, e2 < 1.0e-3_wp, 'decrement within 1e-3 at dt = 1e-3')
+      if (allocated(error)) return
+      call check(error, log(e1/e2)/log(2.0_wp) > 1.7_wp, 'second order in dt')
+   end subroutine test_decrement
+
+   !> Law none, support moving, r = 5 and 30, beta = 1/4 and 1/2, damping a = 3, b = 2e-5 (about
+   !> 1-5 % on the first modes), 1 s: max |(E_n - E_0) - (W_n - damped_n)| / max |E| in the records,
+   !> the summary's residual likewise, and the damping's loss growing.
+   subroutine test_balance(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(array_recorder) :: rec
+      type(run_summary) :: summary
+      real(wp), parameter :: betas(2) = [0.25_wp, 0.5_wp]
+      integer, parameter :: rs(2) = [5, 30]
+      integer :: i, k
+      integer(ik) :: j
+      real(wp) :: worst, escale
+      do k = 1, 2
+         do i = 1, 2
+            scene = scene_type()
+            scene%law = law_none
+            scene%beta = betas(k)
+            scene%dt = 1e-4_wp
+            scene%t_end = 1.0_wp
+            scene%modes = rs(i)
+            scene%damping_mass = 3.0_wp
+            scene%damping_stiffness = 2.0e-5_wp
+            call run_reduced_recorded(scene, rec, summary, error)
+            if (allocated(error)) return
+            escale = maxval(abs(rec%rows(col_energy, :rec%filled)))
+            worst = 0
+            do j = 1, rec%filled
+               worst = max(worst, abs((rec%rows(col_energy, j) - rec%rows(col_energy, 1)) &
+                  & - (rec%rows(col_work, j) - rec%rows(col_damped, j))))
+            end do
+            call note('beta = '//real_text(betas(k))//', r = '//int_text(rs(i))//': damped '// &
+               & real_text(summary%damped)//' J, balance defect / max |E| '//real_text(worst/escale)// &
+               & ', summary residual / max |E| '//real_text(summary%energy_residual/escale))
+            call check(error, rec%rows(col_dissipated, rec%filled), 0.0_wp, 'no energy taken by stops', thr=0.0_wp)
+            if (allocated(error)) return
+            call check(error, summary%damped > 0.01_wp*escale, 'the damping takes energy')
+            if (allocated(error)) return
+            call check(error, all(rec%rows(col_damped, 2:rec%filled) >= rec%rows(col_damped, 1:rec%filled - 1)), &
+               & 'the damping loss never decreases')
+            if (allocated(error)) return
+            call check(error, summary%damped, rec%rows(col_damped, rec%filled), 'summary damped = last record', &
+               & thr=0.0_wp)
+            if (allocated(error)) return
+            call check(error, worst/escale, 0.0_wp, 'balance defect', thr=1e-12_wp)
+            if (allocated(error)) return
+            call check(error, summary%energy_residual/escale, 0.0_wp, 'summary residual', thr=1e-12_wp)
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine test_balance
+
+   !> Step by step (r = 6, paper's scene, beta = 1/2, e = 0.5, t <= 0.15 s): the residual
+   !> rho = A_r (d^n - d^{n-1}) - dt^2 (G^n l_r - S_r q^n) vanishes in every row but the tip's,
+   !> where rho/dt^2 is the reaction; the combination w = (q_tip^{n+1} + e q_tip^{n-1})/(1 + e)
+   !> within the stops, the reaction zero unless w is on a stop, and pushing away from it.
+   subroutine test_kkt_restitution(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), parameter :: e = 0.5_wp
+      type(scene_type) :: scene
+      type(reduced_model_type) :: reduced
+      type(reduced_state_type) :: state
+      type(array_recorder) :: rec
+      real(wp), allocatable :: mr(:, :), sr(:, :), ar(:, :), q_old(:), d_old(:), rho(:)
+      real(wp) :: weight, scale, worst_rows, w, reaction, tol_u
+      integer(ik) :: step, done, steps, contacts
+      integer :: pt
+      scene%law = law_signorini
+      scene%beta = 0.5_wp
+      scene%dt = 1e-5_wp
+      scene%t_end = 0.15_wp
+      scene%modes = 6
+      scene%restitution = e
+      call validate_scene(scene, 'test scene', error)
+      if (allocated(error)) return
+      call prepare_reduced(scene, 'test scene', reduced, error)
+      if (allocated(error)) return
+      call reduced_matrices(reduced, mr, sr)
+      ar = mr + scene%dt**2*scene%beta*sr
+      pt = reduced%r + reduced%tip_stop
+      steps = steps_of(scene)
+      call rec%reserve(steps + 1, 0_ik, scene%elements + 1)
+      call start_reduced(scene, reduced, state, rec, error)
+      if (allocated(error)) return
+      worst_rows = 0
+      contacts = 0
+      tol_u = 8*epsilon(1.0_wp)*scene%upper
+      do step = 1, steps
+         q_old = state%q
+         d_old = state%d
+         call advance_reduced(scene, reduced, state, rec, step, done)
+         weight = scene%beta*load_average(step + 1, scene%dt, scene%omega, .true.) &
+            & + (1 - 2*scene%beta)*load_average(step, scene%dt, scene%omega, .true.) &
+            & + scene%beta*load_average(step - 1, scene%dt, scene%omega, .true.)
+         rho = matmul(ar, state%d - d_old) - scene%dt**2*(weight*reduced%load - matmul(sr, q_old))
+         scale = maxval(matmul(abs(ar), abs(state%d) + abs(d_old) + abs(state%q)) + scene%dt**2*(matmul(abs(sr), &
+            & abs(q_old)) + abs(weight*reduced%load)))
+         worst_rows = max(worst_rows, maxval(abs(rho(:pt - 1)))/scale)
+         w = (state%q(pt) + e*(q_old(pt) - d_old(pt)))/(1 + e)
+         reaction = rho(pt)/scene%dt**2
+         call check(error, w >= scene%lower - tol_u .and. w <= scene%upper + tol_u, 'step '//int_text(step)// &
+            & ': combination '//real_text(w)//' within the stops')
+         if (allocated(error)) return
+         if (abs(rho(pt)) > 1e-12_wp*scale) then
+            contacts = contacts + 1
+            call check(error, (reaction > 0 .and. abs(w - scene%lower) <= tol_u) .or. &
+               & (reaction < 0 .and. abs(w - scene%upper) <= tol_u), 'step '//int_text(step)//': reaction '// &
+               & real_text(reaction)//' only with the combination on a stop, pushing away from it (w = '// &
+               & real_text(w)//')')
+            if (allocated(error)) return
+         end if
+      end do
+      call note('contact steps '//int_text(contacts)//', largest residual off the tip row / scale '// &
+         & real_text(worst_rows)//', largest violation of u^{n+1} '//real_text(state%max_violation)//' m')
+      call check(error, contacts > 10, 'the tip meets the stops'); if (allocated(error)) return
+      call check(error, state%max_violation > 0, 'u^{n+1} itself passes the stop (reported, not hidden)')
+      if (allocated(error)) return
+      call check(error, worst_rows, 0.0_wp, 'residual of the rows off the tip', thr=1e-14_wp)
+   end subroutine test_kkt_restitution
+
+   !> The tube (r = 8, damping, e = 0.5, statistics) run to step 6000, checkpointed, read back into
+   !> a new state; both continued to the end: every record after the checkpoint, q, d, the
+   !> energies and the statistics' summary to the bit.
+   subroutine test_resume(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: path = 'test_reduced_resume.checkpoint'
+      type(scene_type) :: scene
+      type(reduced_model_type) :: reduced
+      type(reduced_state_type) :: straight, resumed
+      type(array_recorder) :: a, b
+      type(run_summary) :: sa, sb
+      integer(ik) :: records, snapshots, first
+      scene = tube(0.3_wp)
+      scene%modes = 8
+      scene%damping_mass = 2.0_wp
+      scene%damping_stiffness = 1.0e-5_wp
+      scene%restitution = 0.5_wp
+      scene%statistics = .true.
+      scene%transient = 0.05_wp
+      scene%batches = 4
+      call validate_scene(scene, 'test scene', error)
+      if (allocated(error)) return
+      call prepare_reduced(scene, 'test scene', reduced, error)
+      if (allocated(error)) return
+      call a%reserve(record_count(scene), 0_ik, scene%elements + 1, stop_count(scene))
+      call b%reserve(record_count(scene), 0_ik, scene%elements + 1, stop_count(scene))
+      call start_reduced(scene, reduced, straight, a, error)
+      if (allocated(error)) return
+      call run_reduced(scene, reduced, straight, a, sa, 6000_ik)
+      call check(error, sa%status == 'running' .and. straight%step == 6001, 'stopped at step 6000')
+      if (allocated(error)) return
+      call write_reduced_checkpoint(path, scene, straight, a%filled, 0_ik, error)
+      if (allocated(error)) return
+      call read_reduced_checkpoint(path, scene, reduced, resumed, records, snapshots, error)
+      call remove_file(path)
+      if (allocated(error)) return
+      call check(error, records == a%filled, 'the record count'); if (allocated(error)) return
+      first = a%filled + 1
+      b%filled = a%filled
+      b%stops_filled = a%stops_filled
+      call run_reduced(scene, reduced, straight, a, sa)
+      call run_reduced(scene, reduced, resumed, b, sb)
+      call check(error, sa%status == status_complete .and. sb%status == status_complete, 'both complete')
+      if (allocated(error)) return
+      call check(error, all(a%rows(:, first:a%filled) == b%rows(:, first:b%filled)) .and. a%filled == b%filled, &
+         & 'the records after the checkpoint to the bit')
+      if (allocated(error)) return
+      call check(error, all(a%stops_u(:, first:a%filled) == b%stops_u(:, first:b%filled)), 'the stops'' records')
+      if (allocated(error)) return
+      call check(error, all(straight%q == resumed%q) .and. all(straight%d == resumed%d), 'q and d to the bit')
+      if (allocated(error)) return
+      call check(error, sa%damped == sb%damped .and. sa%damped > 0 .and. sa%dissipated == sb%dissipated .and. &
+         & sa%energy_residual == sb%energy_residual, 'the energy ledger to the bit')
+      if (allocated(error)) return
+      call check(error, sa%impacts == sb%impacts .and. sa%impacts > 0, 'the shocks')
+   end subroutine test_resume
+
+   !> Read by the one reader (scene_from_text): damping (ratios) and restitution are accepted with
+   !> modes > 0; mass redistribution and an ensemble are refused with one message naming the file
+   !> and the keys.
+   subroutine test_validate(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: nl = new_line('a'), &
+         & base = '&mesh modes = 5 /'//nl//'&damping ratio = 0.02 /'//nl//'&stops restitution = 0.7'
+      type(scene_type) :: scene
+      type(error_type), allocatable :: failure
+      logical :: named
+      call scene_from_text(base//' /', 'in.nml', scene, failure)
+      if (allocated(failure)) then
+         call test_failed(error, 'damping and restitution with modes > 0 refused: '//failure%message)
+         return
+      end if
+      call check(error, scene%modes == 5 .and. scene%damping_by_ratio .and. scene%restitution == 0.7_wp, &
+         & 'the scene read')
+      if (allocated(error)) return
+      call scene_from_text('&mesh modes = 5 /'//nl//"&stops mass = 'redistributed' /", 'in.nml', scene, failure)
+      if (.not. allocated(failure)) then
+         call test_failed(error, 'mass redistribution with modes > 0 refused')
+         return
+      end if
+      call note(failure%message)
+      named = index(failure%message, 'in.nml: &mesh modes = 5') == 1 .and. &
+         & index(failure%message, "mass = 'redistributed'") > 0
+      call check(error, named, 'the message names the file and the keys: '//failure%message)
+   end subroutine test_validate
+end module test_reduced_physics
