@@ -45,8 +45,8 @@ build's ``beamstops``, else ``beamstops`` on PATH.
 from __future__ import annotations
 
 import argparse
-import math
 import json
+import math
 import os
 import platform
 import re
