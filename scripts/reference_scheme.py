@@ -15,7 +15,6 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from scipy.linalg import cho_solve_banded, cholesky_banded
 
 KD = 3  # half-bandwidth of the Hermite-cubic matrices
 
@@ -91,6 +90,8 @@ def run_reference(J: int = 19, L: float = 1.501, k2: float = 282.84, amplitude: 
                   contact: bool = True) -> dict[str, np.ndarray | float | int]:
     """Run the scheme; return time series (length N+1) of t, tip_u, tip_v, reaction [N],
     energy, work, dissipated [J] plus cpu_seconds (loop only) and steps = N."""
+    from scipy.linalg import cho_solve_banded, cholesky_banded  # here: assemble needs numpy only (bench_peer.py)
+
     if load_rule not in ("paper", "centered") or start not in ("euler", "taylor"):
         raise ValueError(f"bad load_rule={load_rule!r} or start={start!r}")
     M, S, bh, b1 = assemble(J, L, k2)

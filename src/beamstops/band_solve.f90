@@ -119,7 +119,7 @@ contains
       real(wp), intent(inout), contiguous :: b(:)
       !> u.su, d.su and d.M d.
       real(wp), intent(out) :: usu, dsu, dmd
-      real(wp) :: xa, xb, xc, da, db, dc, d1, d2, d3
+      real(wp) :: xa, xb, xc
       integer :: i, j, n
       n = solver%n
       associate (off => solver%off, inv_d2 => solver%inv_d2, m => mass%a)
@@ -142,33 +142,8 @@ contains
          dsu = d(1)*su(1) + d(2)*su(2) + d(3)*su(3)
          dmd = d(1)*m(1, 0)*d(1) + d(2)*(m(2, 0)*d(2) + 2*m(2, 1)*d(1)) &
             & + d(3)*(m(3, 0)*d(3) + 2*(m(3, 1)*d(2) + m(3, 2)*d(1)))
-         da = d(1)
-         db = d(2)
-         dc = d(3)
-         do j = kd + 1, n - 2, 3
-            xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
-            b(j) = xa*inv_d2(j)
-            xb = row(b(j + 1), off(1, j + 1), off(2, j + 1), off(3, j + 1), xb, xc, xa)
-            b(j + 1) = xb*inv_d2(j + 1)
-            xc = row(b(j + 2), off(1, j + 2), off(2, j + 2), off(3, j + 2), xc, xa, xb)
-            b(j + 2) = xc*inv_d2(j + 2)
-            ! the sums, d_{j-3..j+2} loaded once (da, db, dc: the three before row j)
-            d1 = d(j)
-            d2 = d(j + 1)
-            d3 = d(j + 2)
-            usu = usu + u(j)*su(j)
-            dsu = dsu + d1*su(j)
-            dmd = dmd + d1*(m(j, 0)*d1 + 2*(m(j, 1)*dc + m(j, 2)*db + m(j, 3)*da))
-            usu = usu + u(j + 1)*su(j + 1)
-            dsu = dsu + d2*su(j + 1)
-            dmd = dmd + d2*(m(j + 1, 0)*d2 + 2*(m(j + 1, 1)*d1 + m(j + 1, 2)*dc + m(j + 1, 3)*db))
-            usu = usu + u(j + 2)*su(j + 2)
-            dsu = dsu + d3*su(j + 2)
-            dmd = dmd + d3*(m(j + 2, 0)*d3 + 2*(m(j + 2, 1)*d2 + m(j + 2, 2)*d1 + m(j + 2, 3)*dc))
-            da = d1
-            db = d2
-            dc = d3
-         end do
+         j = kd + 1
+         call energy_rows(n, off, inv_d2, m, u, d, su, b, j, xa, xb, xc, usu, dsu, dmd)
          call last_rows(off, inv_d2, j, n, b, xa, xb, xc)
          do i = j, n
             usu = usu + u(i)*su(i)
@@ -177,6 +152,62 @@ contains
          end do
       end associate
    end subroutine forward_substitution_energy
+
+   !> The loop of forward_substitution_energy, three rows a turn from row j (= kd + 1) while
+   !> a whole turn fits; on return j is the first row left. Explicit-shape arrays and local sums
+   !> and values, so that the compiler keeps every running value in a register and every array
+   !> at a fixed stride (inlined in the caller, with its dummies and descriptors, gfortran stored
+   !> the three sums and reloaded a dozen array addresses from the stack at every turn; this
+   !> loop is about 10 % of a recorded step faster, with the same operations: the same bits).
+   pure subroutine energy_rows(n, off, inv_d2, m, u, d, su, b, j, xa, xb, xc, usu, dsu, dmd)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: off(kd, n), inv_d2(n), m(n, 0:kd), u(n), d(n), su(n)
+      real(wp), intent(inout) :: b(n)
+      integer, intent(inout) :: j
+      real(wp), intent(inout) :: xa, xb, xc, usu, dsu, dmd
+      real(wp) :: ra, rb, rc, s_usu, s_dsu, s_dmd, da, db, dc, d1, d2, d3
+      integer :: k
+      ra = xa
+      rb = xb
+      rc = xc
+      s_usu = usu
+      s_dsu = dsu
+      s_dmd = dmd
+      da = d(j - 3)
+      db = d(j - 2)
+      dc = d(j - 1)
+      do k = j, n - 2, 3
+         ra = row(b(k), off(1, k), off(2, k), off(3, k), ra, rb, rc)
+         b(k) = ra*inv_d2(k)
+         rb = row(b(k + 1), off(1, k + 1), off(2, k + 1), off(3, k + 1), rb, rc, ra)
+         b(k + 1) = rb*inv_d2(k + 1)
+         rc = row(b(k + 2), off(1, k + 2), off(2, k + 2), off(3, k + 2), rc, ra, rb)
+         b(k + 2) = rc*inv_d2(k + 2)
+         ! the sums, d_{k-3..k+2} loaded once (da, db, dc: the three before row k)
+         d1 = d(k)
+         d2 = d(k + 1)
+         d3 = d(k + 2)
+         s_usu = s_usu + u(k)*su(k)
+         s_dsu = s_dsu + d1*su(k)
+         s_dmd = s_dmd + d1*(m(k, 0)*d1 + 2*(m(k, 1)*dc + m(k, 2)*db + m(k, 3)*da))
+         s_usu = s_usu + u(k + 1)*su(k + 1)
+         s_dsu = s_dsu + d2*su(k + 1)
+         s_dmd = s_dmd + d2*(m(k + 1, 0)*d2 + 2*(m(k + 1, 1)*d1 + m(k + 1, 2)*dc + m(k + 1, 3)*db))
+         s_usu = s_usu + u(k + 2)*su(k + 2)
+         s_dsu = s_dsu + d3*su(k + 2)
+         s_dmd = s_dmd + d3*(m(k + 2, 0)*d3 + 2*(m(k + 2, 1)*d2 + m(k + 2, 2)*d1 + m(k + 2, 3)*dc))
+         da = d1
+         db = d2
+         dc = d3
+      end do
+      j = k
+      xa = ra
+      xb = rb
+      xc = rc
+      usu = s_usu
+      dsu = s_dsu
+      dmd = s_dmd
+   end subroutine energy_rows
 
    !> The first three rows of the forward substitution (n >= 3): b(1:3) replaced by
    !> D^{-2} w(1:3), and w(1:3) returned in xa, xb, xc for the rows that follow.

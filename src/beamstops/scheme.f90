@@ -445,9 +445,9 @@ contains
             state%stop_reaction = state%span%lambda/model%dt2
          end if
          ! (with massless stops a free stop's row residual is not a contact: only the active ones count)
-         if (state%observer%active) call state%observer%span(real(step + 1, wp)*model%dt, &
-            & state%u(model%stops%unknown) + model%stops%lift*phi_next, &
-            & merge(state%stop_reaction, 0.0_wp, state%span%lambda /= 0), state%u(tip), state%dissipated)
+         if (state%observer%active) call state%observer%span_indexed(real(step + 1, wp)*model%dt, state%u, &
+            & model%stops%unknown, model%stops%lift, phi_next, state%stop_reaction, state%span%lambda, &
+            & state%u(tip), state%dissipated)
          if (step == next_snapshot) then
             next_snapshot = next_snapshot + scene%snapshot_every
             call take_snapshot(scene, model, state, step, recorder)

@@ -40,6 +40,8 @@ module beamstops_observe_observer
       procedure :: tip
       !> The sample of a step with stops along the span.
       procedure :: span
+      !> The same sample from the loop's arrays and the stops' indices (no temporary).
+      procedure :: span_indexed
       !> Take the finished shocks out (into the statistics and the kept rows).
       procedure :: drain
       !> Close the open shocks and the last batch at the end of the run; the table of statistics.
@@ -143,9 +145,47 @@ contains
       real(wp), intent(in) :: u(:), reaction(:)
       !> Tip displacement (m), energy taken so far per unit mass.
       real(wp), intent(in) :: u_tip, dissipated
-      real(wp) :: total, weight
       self%u = u
       self%r = self%rho*reaction
+      call span_sample(self, t, u_tip, dissipated)
+   end subroutine span
+
+   !> span from the loop's own arrays, so that the hot loop passes no array expression (each
+   !> would be a temporary a step): stop i's displacement is u(unknown(i)) + lift(i) phi and its
+   !> reaction reaction(i) where lambda(i) /= 0 (an active stop), else 0.
+   subroutine span_indexed(self, t, u, unknown, lift, phi, reaction, lambda, u_tip, dissipated)
+      !> Observer.
+      class(observer_type), intent(inout) :: self
+      !> t_{n+1} (s).
+      real(wp), intent(in) :: t
+      !> u^{n+1}, all the unknowns (relative to the support).
+      real(wp), intent(in) :: u(:)
+      !> The stops' unknowns (m).
+      integer, intent(in) :: unknown(:)
+      !> The lifting at the stops (m) and the support's position phi(t_{n+1}) (m).
+      real(wp), intent(in) :: lift(:), phi
+      !> The stops' reactions per unit mass (m) and their multipliers (m; 0: the stop is free).
+      real(wp), intent(in) :: reaction(:), lambda(:)
+      !> Tip displacement (m), energy taken so far per unit mass.
+      real(wp), intent(in) :: u_tip, dissipated
+      integer :: i
+      do i = 1, self%m
+         self%u(i) = u(unknown(i)) + lift(i)*phi
+         if (lambda(i) /= 0) then
+            self%r(i) = self%rho*reaction(i)
+         else
+            self%r(i) = 0
+         end if
+      end do
+      call span_sample(self, t, u_tip, dissipated)
+   end subroutine span_indexed
+
+   !> The rest of span: self%u and self%r set, the step's energy shared among the active stops,
+   !> the log and the statistics fed.
+   subroutine span_sample(self, t, u_tip, dissipated)
+      class(observer_type), intent(inout) :: self
+      real(wp), intent(in) :: t, u_tip, dissipated
+      real(wp) :: total, weight
       total = self%rho*(dissipated - self%dissipated_seen)
       self%dissipated_seen = dissipated
       weight = sum(abs(self%r))
@@ -156,7 +196,7 @@ contains
       end if
       call self%shocks%step(t, self%dt, self%u, self%r, self%e)
       call self%stats%step(t, self%dt, u_tip, self%r, self%e)
-   end subroutine span
+   end subroutine span_sample
 
    !> Take the finished shocks out of the log into the statistics and `rows` (grown as needed).
    subroutine drain(self)
