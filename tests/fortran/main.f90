@@ -25,6 +25,7 @@ program tester
    use test_redistribution, only: collect_redistribution
    use test_physics_checks, only: collect_physics_checks
    use test_lockstep, only: collect_lockstep
+   use test_lockstep_general, only: collect_lockstep_general
    use test_reduced, only: collect_reduced
    implicit none
 
@@ -69,7 +70,8 @@ program tester
       & new_testsuite('redistribution', collect_redistribution), &
       & new_testsuite('physics_checks', collect_physics_checks), &
       & new_testsuite('reduced', collect_reduced), &
-      & new_testsuite('lockstep', collect_lockstep) &
+      & new_testsuite('lockstep', collect_lockstep), &
+      & new_testsuite('lockstep_general', collect_lockstep_general) &
       & ]
 
    if (command_argument_count() < 1) call usage()
