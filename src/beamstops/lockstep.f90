@@ -31,11 +31,11 @@ module beamstops_lockstep
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
    use beamstops_strings, only: fmt_real, fmt_int
-   use beamstops_scene, only: scene_type, steps_of, stop_count, law_none, law_signorini, law_compliance, law_name
+   use beamstops_scene, only: scene_type, steps_of, stop_count, law_signorini, law_compliance, law_name
    use beamstops_model, only: model_type, build_model, check_stability
    use beamstops_hermite, only: hermite_basis, gauss_points, gauss_weights
    use beamstops_band, only: band_matvec
-   use beamstops_band_solve, only: band_solver, band_diagonals, prepare_solver, prepare_diagonals, diagonal_matvec, dot
+   use beamstops_band_solve, only: prepare_solver, prepare_diagonals, diagonal_matvec, dot
    use beamstops_band_solve_lockstep, only: lockstep_forward, lockstep_forward_energy, lockstep_back, &
       & lockstep_matvec, lockstep_dot, lockstep_min_unknowns, lockstep_work_columns, &
       & lockstep_lanes, lockstep_matvec_rhs, lockstep_update
@@ -47,8 +47,7 @@ module beamstops_lockstep
    use beamstops_lockstep_members, only: operators_type, members_type, lane, chunk, contact_law, close_steps, &
       & fill_row, take_snapshot, start_loads, next_loads, first_events, energy
    use beamstops_lockstep_general, only: advance_members_general
-   use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
-      & col_work, col_dissipated, col_damped
+   use beamstops_recorder, only: recorder_type, n_columns, col_energy
    use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running
    implicit none
    private
