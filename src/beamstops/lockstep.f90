@@ -1,7 +1,8 @@
 !> Lockstep ensembles (SPEC 13): K members that share A = M + dt/2 C + dt^2 beta S (the same
-!> mesh, beam, time step, beta, damping, mass law, contact law and number of steps) advance together, the member index
-!> innermost (arrays (K, n)), so that each multiply-add of the two substitutions of a step
-!> serves K members and the dependency chain of a step is paid once for all of them.
+!> mesh, beam, time step, beta, damping, mass law, contact law and number of steps) advance
+!> together, the member index innermost (arrays (K, n)), so that each multiply-add of the two
+!> substitutions of a step serves K members and the dependency chain of a step is paid once for
+!> all of them.
 !>
 !> A member may differ from the others in what does not enter A: the support (amplitude,
 !> omega, hence its load vector and initial velocity), the tip stops (lower, upper), the load
@@ -23,8 +24,9 @@
 !> every column, snapshot and summary value to the bit.
 !>
 !> Laws: Signorini and compliance at the tip, or none. Rayleigh damping (SPEC 8), restitution
-!> (SPEC 9) and the massless tip of mass redistribution (SPEC 10) run in the general loop of the
-!> loop of beamstops_lockstep_general (lockstep_general.f90), advance_fused_general per member.
+!> (SPEC 9) and the massless tip of mass redistribution (SPEC 10) run in the general loop of
+!> beamstops_lockstep_general (lockstep_general.f90), advance_fused_general per member; the
+!> members' state and the pieces of a step both loops share are beamstops_lockstep_members'.
 !> Stops along the span (SPEC 7) are refused (their QP per member is not in this path yet).
 module beamstops_lockstep
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite

@@ -34,7 +34,8 @@ contains
          & test_damped_signorini), &
          & new_unittest('damping by ratio: K = 5, compliance 1e8, beta = 1/4', test_damped_compliance), &
          & new_unittest('damping: K = 13, J = 20, Signorini, beta = 1/4 (two chunks)', test_damped_thirteen), &
-         & new_unittest('restitution: K = 5, e = 0 .. 1 per member, Signorini, undamped and damped', test_restitution), &
+         & new_unittest('restitution: K = 5, e = 0 .. 1 per member, Signorini, undamped and damped', &
+         & test_restitution), &
          & new_unittest('mass redistribution: K = 3 undamped, K = 5 damped (a only), Signorini', test_redistribution), &
          & new_unittest('&ensemble members = 6 with damping and restitution: in lockstep, the table of the members '// &
          & 'run one after the other', test_damped_ensemble), &
