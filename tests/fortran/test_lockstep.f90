@@ -26,7 +26,8 @@ module test_lockstep
    private
    public :: collect_lockstep
    ! the helpers of the suite lockstep_general (damping, restitution, mass redistribution)
-   public :: base_scene, members_of, compare_group, expect_refusal, compare_run_members, same_bits
+   public :: base_scene, members_of, compare_group, expect_refusal, compare_run_members, check_failing_member, &
+      & same_bits
 
    !> Columns of a record, for messages.
    character(len=10), parameter :: column_names(n_columns) = [character(len=10) :: 't', 'u', 'v', 'reaction', &
@@ -380,12 +381,18 @@ contains
    !> alone.
    subroutine test_failing_member(error)
       type(error_type), allocatable, intent(out) :: error
-      type(scene_type), allocatable :: scenes(:)
+      call check_failing_member(members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.25_wp), 3, .false.), &
+         & error)
+   end subroutine test_failing_member
+
+   !> test_failing_member on three given members (t_end 0.25 s at dt = 1e-5 s).
+   subroutine check_failing_member(scenes, error)
+      type(scene_type), intent(in) :: scenes(3)
+      type(error_type), allocatable, intent(out) :: error
       type(array_recorder) :: group(3), alone
       type(run_summary) :: summaries(3), summary
       type(model_type) :: model
       integer :: k
-      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.25_wp), 3, .false.)
       call prepare_lockstep(scenes, 'test group', model, error)
       if (allocated(error)) return
       do k = 1, 3
@@ -409,7 +416,7 @@ contains
          call same_records(group(k), alone, 'member '//int_text(k), error)
          if (allocated(error)) return
       end do
-   end subroutine test_failing_member
+   end subroutine check_failing_member
 
    !> The members of an &ensemble (ensemble.f90: model%u0 plus perturbation_of(delta, seed, k)),
    !> in lockstep through the initial displacements, against each run alone on a model with that

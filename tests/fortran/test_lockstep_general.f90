@@ -14,7 +14,8 @@ module test_lockstep_general
    use beamstops_band_solve_lockstep, only: lockstep_lanes
    use beamstops_band_solve_lockstep_general, only: lockstep_row
    use beamstops_model, only: build_model
-   use test_lockstep, only: base_scene, members_of, compare_group, expect_refusal, compare_run_members, same_bits
+   use test_lockstep, only: base_scene, members_of, compare_group, expect_refusal, compare_run_members, &
+      & check_failing_member, same_bits
    implicit none
    private
    public :: collect_lockstep_general
@@ -39,6 +40,8 @@ contains
          & new_unittest('mass redistribution: K = 3 undamped, K = 5 damped (a only), Signorini', test_redistribution), &
          & new_unittest('&ensemble members = 6 with damping and restitution: in lockstep, the table of the members '// &
          & 'run one after the other', test_damped_ensemble), &
+         & new_unittest('damped, with restitution: a member whose recorder fails stops; the others go on, still '// &
+         & 'bit for bit', test_damped_failing_member), &
          & new_unittest('members that do not share C or the mass law are refused', test_refused_physics) &
          & ]
    end subroutine collect_lockstep_general
@@ -147,6 +150,18 @@ contains
       call damp(scenes, 3.0_wp, 0.0_wp)
       call compare_group(scenes, error, contact=.true.)
    end subroutine test_redistribution
+
+   !> A damped group (restitution for some) with a member whose recorder fails after its second
+   !> block: it stops 'failed', its lanes go to rest, the others still equal their runs alone.
+   subroutine test_damped_failing_member(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type), allocatable :: scenes(:)
+      scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.25_wp), 3, .false.)
+      call damp(scenes, 1.0_wp, 1.0e-4_wp)
+      scenes(2)%restitution = 0.6_wp
+      scenes(3)%restitution = 0.3_wp
+      call check_failing_member(scenes, error)
+   end subroutine test_damped_failing_member
 
    !> An &ensemble of a damped scene with restitution: its members 2..K are accepted by
    !> check_lockstep (so run_members runs them in lockstep) and the ensemble table is that of the
