@@ -1,11 +1,14 @@
 !> Lockstep ensembles against one member at a time (SPEC 13), measured in one run; prints a
 !> markdown table and `key value` lines, asserts nothing about time.
 !>
-!>   bench_lockstep [J [steps [repeats [every [observe]]]]]
+!>   bench_lockstep [J [steps [repeats [every [observe [damped]]]]]]
 !>                                                    defaults: 19, 200000 (J = 19) or 3.8e6/J, 5,
 !>                                                    0 (0: nothing recorded), 1 (1: the shock log
 !>                                                    and statistics of every member, the scene's
-!>                                                    default; 0: &statistics off)
+!>                                                    default; 0: &statistics off), 0 (1: also the
+!>                                                    same members with Rayleigh damping, zeta =
+!>                                                    0.01 at modes 1 and 2: the general lockstep
+!>                                                    loop against the plain one, in the same run)
 !>
 !> Members: the paper's scene (Signorini, beta = 1/2, dt = 1e-6 s) with omega and amplitude
 !> varied per member. One at a time: start_state + advance of each member alone (the fused
@@ -30,10 +33,10 @@ program bench_lockstep
    implicit none
 
    integer, parameter :: groups(5) = [1, 2, 4, 8, 16]
-   integer :: elements, steps, repeats, every, observe, rep, g, n
-   real(wp), allocatable :: t_alone(:), t_group(:, :), t_latency(:), t_peak(:)
-   real(wp) :: alone, latency, peak, ns, floor_chain, floor_ops, ops
-   type(scene_type), allocatable :: scenes(:)
+   integer :: elements, steps, repeats, every, observe, damped, rep, g, n
+   real(wp), allocatable :: t_alone(:), t_group(:, :), t_latency(:), t_peak(:), t_alone_damped(:), t_damped(:, :)
+   real(wp) :: alone, latency, peak, ns, floor_chain, floor_ops, ops, alone_damped
+   type(scene_type), allocatable :: scenes(:), damped_scenes(:)
    character(len=160) :: line
 
    elements = int_argument(1, 19)
@@ -41,10 +44,17 @@ program bench_lockstep
    repeats = int_argument(3, 5)
    every = int_argument(4, 0)
    observe = int_argument(5, 1)
+   damped = int_argument(6, 0)
    n = 2*elements
    allocate (t_alone(repeats), t_group(repeats, size(groups)), t_latency(repeats), t_peak(repeats))
+   allocate (t_alone_damped(repeats), t_damped(repeats, size(groups)))
    allocate (scenes(maxval(groups)))
    call members(scenes)
+   damped_scenes = scenes
+   damped_scenes%damping_by_ratio = .true.
+   do g = 1, size(damped_scenes)
+      damped_scenes(g)%damping_ratio = 0.01_wp
+   end do
 
    do rep = 1, repeats
       t_latency(rep) = fma_latency()
@@ -52,6 +62,11 @@ program bench_lockstep
       t_alone(rep) = time_alone(scenes)
       do g = 1, size(groups)
          t_group(rep, g) = time_group(scenes(1:groups(g)))
+      end do
+      if (damped == 0) cycle
+      t_alone_damped(rep) = time_alone(damped_scenes)
+      do g = 1, size(groups)
+         t_damped(rep, g) = time_group(damped_scenes(1:groups(g)))
       end do
    end do
 
@@ -85,8 +100,32 @@ program bench_lockstep
    write (line, '(a,f0.3,a,f0.1,a,f0.0,a)') 'multiply-add latency ', latency, ' ns, peak ', peak, &
       & ' independent multiply-adds per ns; ', ops, ' multiply-adds per member-step'
    print '(a)', trim(line)
+   if (damped /= 0) call damped_table()
 
 contains
+
+   !> The damped members (the general lockstep loop) beside the undamped ones of the same run.
+   subroutine damped_table()
+      character(len=200) :: row
+      alone_damped = median(t_alone_damped)
+      call put('damped_alone_ns_per_member_step', alone_damped)
+      print '(a)', ''
+      write (line, '(a,i0,a)') '| damped (zeta = 0.01, modes 1, 2), J = ', elements, &
+         & ' | ns per member-step | member-steps per s per core | × damped one at a time | × undamped, same K |'
+      print '(a)', trim(line)
+      print '(a)', '|---|---|---|---|---|'
+      write (row, '(a,f0.1,a,es10.3,a,f0.2,a,f0.2,a)') '| one at a time | ', alone_damped, ' | ', &
+         & 1.0e9_wp/alone_damped, ' | 1.00 | ', alone/alone_damped, ' |'
+      print '(a)', trim(row)
+      do g = 1, size(groups)
+         ns = median(t_damped(:, g))
+         write (row, '(a,i0,a,f0.1,a,es10.3,a,f0.2,a,f0.2,a)') '| lockstep K = ', groups(g), ' | ', ns, ' | ', &
+            & 1.0e9_wp/ns, ' | ', alone_damped/ns, ' | ', median(t_group(:, g))/ns, ' |'
+         print '(a)', trim(row)
+         write (line, '(a,i0,a)') 'damped_lockstep_', groups(g), '_ns_per_member_step'
+         call put(trim(line), ns)
+      end do
+   end subroutine damped_table
 
    !> Members: the paper's scene at dt = 1e-6, omega and amplitude varied.
    subroutine members(s)

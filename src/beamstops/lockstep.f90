@@ -1,11 +1,13 @@
-!> Lockstep ensembles (SPEC 13): K members that share A = M + dt^2 beta S (the same mesh,
-!> beam, time step, beta, contact law and number of steps) advance together, the member index
-!> innermost (arrays (K, n)), so that each multiply-add of the two substitutions of a step
-!> serves K members and the dependency chain of a step is paid once for all of them.
+!> Lockstep ensembles (SPEC 13): K members that share A = M + dt/2 C + dt^2 beta S (the same
+!> mesh, beam, time step, beta, damping, mass law, contact law and number of steps) advance
+!> together, the member index innermost (arrays (K, n)), so that each multiply-add of the two
+!> substitutions of a step serves K members and the dependency chain of a step is paid once for
+!> all of them.
 !>
 !> A member may differ from the others in what does not enter A: the support (amplitude,
 !> omega, hence its load vector and initial velocity), the tip stops (lower, upper), the load
-!> rule, the start, what it records (record_every, snapshot_every) and where (its recorder).
+!> rule, the start, the restitution coefficient, what it records (record_every, snapshot_every)
+!> and where (its recorder).
 !> Each member keeps its own load averages, contact state, energy ledger, record cadence and
 !> recorder, and gets its own summary.
 !>
@@ -21,98 +23,47 @@
 !> run_scheme's summary (ledger, shocks, statistics). tests/fortran/test_lockstep.f90 compares
 !> every column, snapshot and summary value to the bit.
 !>
-!> Laws: Signorini and compliance at the tip, or none. Stops along the span (SPEC 7) are
-!> refused (their QP per member is not in this path yet).
+!> Laws: Signorini and compliance at the tip, or none. Rayleigh damping (SPEC 8), restitution
+!> (SPEC 9) and the massless tip of mass redistribution (SPEC 10) run in the general loop of
+!> beamstops_lockstep_general (lockstep_general.f90), advance_fused_general per member; the
+!> members' state and the pieces of a step both loops share are beamstops_lockstep_members'.
+!> Stops along the span (SPEC 7) are refused (their QP per member is not in this path yet).
 module beamstops_lockstep
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
    use beamstops_strings, only: fmt_real, fmt_int
-   use beamstops_scene, only: scene_type, steps_of, stop_count, law_none, law_signorini, law_compliance, law_name
+   use beamstops_scene, only: scene_type, steps_of, stop_count, law_signorini, law_compliance, law_name
    use beamstops_model, only: model_type, build_model, check_stability
    use beamstops_hermite, only: hermite_basis, gauss_points, gauss_weights
    use beamstops_band, only: band_matvec
-   use beamstops_band_solve, only: band_solver, band_diagonals, prepare_solver, prepare_diagonals, diagonal_matvec, dot
+   use beamstops_band_solve, only: prepare_solver, prepare_diagonals, diagonal_matvec, dot
    use beamstops_band_solve_lockstep, only: lockstep_forward, lockstep_forward_energy, lockstep_back, &
       & lockstep_matvec, lockstep_dot, lockstep_min_unknowns, lockstep_work_columns, &
       & lockstep_lanes, lockstep_matvec_rhs, lockstep_update
    use beamstops_state, only: state_type
    use beamstops_scheme, only: start_state, block_steps
    use beamstops_clock, only: thread_cpu_seconds
-   use beamstops_forcing, only: load_average, support_position, lift_shape, lift_slope
-      use beamstops_contact_compliance, only: spring_force, solve_spring_tip
-   use beamstops_observe_observer, only: observer_type
-   use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
-      & col_work, col_dissipated, col_damped
+   use beamstops_forcing, only: lift_shape, lift_slope
+   use beamstops_lockstep_physics, only: check_shared_physics
+   use beamstops_lockstep_members, only: operators_type, members_type, lane, chunk, contact_law, close_steps, &
+      & fill_row, take_snapshot, start_loads, next_loads, first_events, energy
+   use beamstops_lockstep_general, only: advance_members_general
+   use beamstops_recorder, only: recorder_type, n_columns, col_energy
    use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running
    implicit none
    private
    public :: check_lockstep, prepare_lockstep, simulate_lockstep
 
-   !> Steps between two restarts of the load rotation from exact values (beamstops_scheme's
-   !> restart_every: the two must agree for the loads to agree to the bit).
-   integer(ik), parameter :: restart_every = 64
-
-   !> The operators of the fused loop, shared by the members.
-   type :: operators_type
-      !> Factor of A in the form of the fused substitutions.
-      type(band_solver) :: solver
-      !> S and M by diagonals.
-      type(band_diagonals) :: stiffness, mass
-   end type operators_type
-
-   !> The state of K members, the member index first: what advance_fused keeps in a
-   !> state_type and in its local variables, once per member.
-   type :: members_type
-      !> Members K, unknowns n, chunks of lockstep_lanes members, lanes in all (K padded), index
-      !> of the next step (shared).
-      integer :: k = 0, n = 0, chunks = 0, p = 0
-      integer(ik) :: step = 1
-      !> u^n, d^{n-1}, S u^n, right-hand side / solution, load vector g of each member (lanes, n,
-      !> chunks): member k is lane lane(k) of chunk chunk(k); the padding lanes stay zero.
-      real(wp), allocatable :: u(:, :, :), d(:, :, :), su(:, :, :), rhs(:, :, :), g(:, :, :)
-      !> Work array of the kernels (lanes, lockstep_work_columns).
-      real(wp), allocatable :: partial(:, :)
-      !> Per member, padded to p lanes: load averages sigma_{n-1}, sigma_n; g.d^{n-1}; spring forces p(u^{n-1}), p(u^n);
-      !> work, energy taken by the stops, E^{1/2}, reaction of the last step, largest
-      !> violation (K, per unit mass).
-      real(wp), allocatable :: sigma_prev(:), sigma_now(:), gd_prev(:), p_prev(:), p_now(:), work(:), &
-         & dissipated(:), energy0(:), reaction(:), max_violation(:)
-      !> Whether the last step was in contact; whether the member still runs (K).
-      logical, allocatable :: in_contact(:), active(:)
-      !> Impacts so far (K).
-      integer(ik), allocatable :: impacts(:)
-      !> The load rotation of each member (beamstops_scheme's load_rotation): its step index
-      !> (shared), f sin and f cos of omega c_k, cos and sin of omega dt (K).
-      integer(ik) :: load_k = 0
-      real(wp), allocatable :: sigma(:), cosine(:), cos_step(:), sin_step(:)
-      !> Tip stops of each member (padding lanes: -1, 1) (K).
-      real(wp), allocatable :: lower(:), upper(:)
-      !> Tip value and increment after the update (K).
-      real(wp), allocatable :: u_tip(:), d_tip(:)
-      !> Values of the step (K).
-      real(wp), allocatable :: sigma_next(:), weight(:), coef(:), spring(:), trial(:), c(:), tip_value(:), &
-         & r_step(:), u_tip_prev(:), d_tip_prev(:), r_prev(:), usu(:), dsu(:), dmd(:), u_old_su(:), gd(:)
-      !> Contact in the step; a record waiting for its energy (K).
-      logical, allocatable :: contact(:), pending(:)
-      !> Next record and snapshot step of each member (K).
-      integer(ik), allocatable :: next_record(:), next_snapshot(:)
-      !> Record rows waiting for their energy (n_columns, K).
-      real(wp), allocatable :: rows(:, :)
-      !> The shock log and statistics of each member (K; inactive unless its scene asks).
-      type(observer_type), allocatable :: observers(:)
-      !> One member's vectors, contiguous (n), and its snapshot buffer (J+1).
-      real(wp), allocatable :: vec_u(:), vec_d(:), vec_su(:), vec_s(:), shape(:)
-   end type members_type
 
 contains
 
    !> Whether K scenes can run in lockstep with `model` (built from the first of them): the
-   !> same A (mesh, beam, dt, beta), the same law and compliance stiffness, the same number of
-   !> steps, the paper's scheme on the full model (no damping, restitution, mass redistribution
-   !> or reduced model), no stops
-   !> along the span, J >= 4. The message names the
-   !> first member and key that differ.
+   !> same A (mesh, beam, dt, beta, Rayleigh damping, mass law), the same law and compliance
+   !> stiffness, the same number of steps, the full model (no reduced model), no stops along
+   !> the span, J >= 4 (beamstops_lockstep_physics's check_shared_physics for damping and the
+   !> mass law; the restitution coefficient may differ). The message names the first member
+   !> and key that differ.
    subroutine check_lockstep(scenes, model, error)
       !> The members' validated scenes (K >= 1).
       type(scene_type), intent(in) :: scenes(:)
@@ -126,6 +77,15 @@ contains
          return
       end if
       if (model%n /= 2*scenes(1)%elements .or. model%dt /= scenes(1)%dt .or. model%beta /= scenes(1)%beta) then
+         call fatal_error(error, 'lockstep: the model was not built from the first member''s scene')
+         return
+      end if
+      if (model%redistributed .neqv. scenes(1)%redistributed_mass) then
+         call fatal_error(error, 'lockstep: the model was not built from the first member''s scene')
+         return
+      end if
+      if (.not. scenes(1)%damping_by_ratio .and. (model%damping_a /= scenes(1)%damping_mass .or. &
+         & model%damping_b /= scenes(1)%damping_stiffness)) then
          call fatal_error(error, 'lockstep: the model was not built from the first member''s scene')
          return
       end if
@@ -146,13 +106,6 @@ contains
                & fmt_int(int(scenes(k)%modes, ik))//'); the lockstep path runs the full model: run it alone')
             return
          end if
-         if (scenes(k)%restitution /= 0 .or. scenes(k)%damping_mass /= 0 .or. scenes(k)%damping_stiffness /= 0 &
-            & .or. scenes(k)%damping_by_ratio .or. scenes(k)%redistributed_mass) then
-            call fatal_error(error, 'lockstep: member '//fmt_int(int(k, ik))//' asks for damping, restitution or '// &
-               & 'mass redistribution (&damping, &stops restitution or mass); the lockstep path runs the '// &
-               & 'paper''s scheme: run it alone')
-            return
-         end if
          if (k == 1) cycle
          call differ(k, 'mesh', 'elements', real(scenes(k)%elements, wp), real(scenes(1)%elements, wp))
          call differ(k, 'beam', 'length', scenes(k)%length, scenes(1)%length)
@@ -170,6 +123,8 @@ contains
          end if
          if (scenes(1)%law == law_compliance) &
             & call differ(k, 'stops', 'stiffness_per_mass', scenes(k)%stiffness_per_mass, scenes(1)%stiffness_per_mass)
+         if (allocated(error)) return
+         call check_shared_physics(k, scenes(k), scenes(1), error)
          if (allocated(error)) return
       end do
 
@@ -249,6 +204,7 @@ contains
       call prepare_solver(model%factor, ops%solver)
       call prepare_diagonals(model%stiffness, ops%stiffness)
       call prepare_diagonals(model%mass, ops%mass)
+      if (model%damped) call prepare_diagonals(model%damping, ops%damping)
       if (present(initial_displacement)) then
          if (size(initial_displacement, 1) /= model%n .or. size(initial_displacement, 2) /= nk) then
             call fatal_error(error, 'lockstep: the initial displacements must be (n, K) = ('// &
@@ -266,7 +222,11 @@ contains
       t0 = thread_cpu_seconds()
       do while (ms%step <= steps .and. any(ms%active))
          last = min(steps, ms%step + block_steps - 1)
-         call advance_members(scenes, model, ops, ms, recorders, last)
+         if (ms%general) then
+            call advance_members_general(scenes, model, ops, ms, recorders, last)
+         else
+            call advance_members(scenes, model, ops, ms, recorders, last)
+         end if
          ms%step = last + 1
          do k = 1, nk
             if (.not. ms%active(k)) cycle
@@ -314,8 +274,8 @@ contains
       summary%impacts = ms%impacts(k)
       summary%max_violation = ms%max_violation(k)
       summary%contact_phases = ms%impacts(k)
-      ! the ledger (close_ledger): no damping in this path
-      damped = 0
+      ! the ledger (close_ledger)
+      damped = ms%damped(k)
       ms%vec_u = ms%u(lane(k), :, chunk(k))
       ms%vec_d = ms%d(lane(k), :, chunk(k))
       call band_matvec(model%mass, ms%vec_d, ms%vec_s)
@@ -342,6 +302,8 @@ contains
       ms%g(lane(k), :, chunk(k)) = 0
       ms%p_prev(k) = 0
       ms%p_now(k) = 0
+      if (allocated(ms%cd)) ms%cd(lane(k), :, chunk(k)) = 0
+      ms%dcd_prev(k) = 0
    end subroutine finish_member
 
    !> Start every member by the one-scene start (start_state, which hands each recorder its
@@ -385,7 +347,14 @@ contains
       allocate (ms%vec_u(n), ms%vec_d(n), ms%vec_su(n), ms%vec_s(n), ms%shape(size(model%x)))
       allocate (ms%observers(ms%k))
       allocate (ms%lower(nk), ms%upper(nk), ms%u_tip(nk), ms%d_tip(nk))
+      allocate (ms%damped(nk), ms%dcd_prev(nk), ms%cross(nk), ms%dcd(nk), ms%restitution(nk), ms%s_u_tip(nk), &
+         & ms%s_d_prev_tip(nk), ms%bound_lower(nk), ms%bound_upper(nk))
       call zero_members(ms)
+      ms%general = model%damped .or. model%redistributed .or. any(scenes%restitution > 0)
+      if (model%damped) then
+         allocate (ms%cd(lockstep_lanes, n, ms%chunks))
+         ms%cd = 0
+      end if
       ms%lower = -1
       ms%upper = 1
       ms%u_tip = 0
@@ -432,6 +401,12 @@ contains
          ms%impacts(k) = state%impacts
          ms%observers(k) = state%observer
          ms%step = state%step
+         ms%restitution(k) = scenes(k)%restitution
+         if (model%damped) then
+            ms%cd(lane(k), :, chunk(k)) = state%cd
+            ms%dcd_prev(k) = state%dcd_prev
+            ms%damped(k) = state%damped
+         end if
       end do
    end subroutine start_members
 
@@ -474,19 +449,17 @@ contains
       ms%pending = .false.
       ms%next_record = huge(1_ik)
       ms%next_snapshot = huge(1_ik)
+      ms%damped = 0
+      ms%dcd_prev = 0
+      ms%cross = 0
+      ms%dcd = 0
+      ms%restitution = 0
+      ms%s_u_tip = 0
+      ms%s_d_prev_tip = 0
+      ms%bound_lower = -1
+      ms%bound_upper = 1
    end subroutine zero_members
 
-   !> The lane of member k in its chunk.
-   pure integer function lane(k)
-      integer, intent(in) :: k
-      lane = mod(k - 1, lockstep_lanes) + 1
-   end function lane
-
-   !> The chunk of member k.
-   pure integer function chunk(k)
-      integer, intent(in) :: k
-      chunk = (k - 1)/lockstep_lanes + 1
-   end function chunk
 
    !> A member's load vector g = a (omega^2 (h, phi_i) + 8 k^2/L^4 (1, phi_i)), as build_model
    !> forms it.
@@ -656,244 +629,6 @@ contains
       end do
    end subroutine advance_members
 
-   !> The contact law at the tip of every member (beamstops_scheme's contact_law and the
-   !> projection of beamstops_contact_tip_projection, written over the members): from the
-   !> trial tip values, the multiple c of z, the tip value, the reaction of the step, contact.
-   !> Padding lanes: trial 0 between their stops -1 and 1, so c = 0.
-   subroutine contact_law(law, scenes, model, ms)
-      integer, intent(in) :: law
-      type(scene_type), intent(in) :: scenes(:)
-      type(model_type), intent(in) :: model
-      type(members_type), intent(inout) :: ms
-      real(wp) :: p_next, z_tip
-      integer :: k, c, lo, hi
-      z_tip = model%z(model%tip)
-      select case (law)
-      case (law_signorini)
-         do c = 1, ms%chunks
-            lo = (c - 1)*lockstep_lanes + 1
-            hi = c*lockstep_lanes
-            call project_lanes(ms%trial(lo:hi), ms%lower(lo:hi), ms%upper(lo:hi), z_tip, model%dt2, &
-               & ms%tip_value(lo:hi), ms%c(lo:hi), ms%contact(lo:hi), ms%r_step(lo:hi))
-         end do
-      case (law_compliance)
-         do k = 1, ms%k
-            ms%tip_value(k) = solve_spring_tip(ms%trial(k), scenes(k)%lower, scenes(k)%upper, &
-               & scenes(k)%stiffness_per_mass, model%dt2*model%beta*model%z(model%tip))
-            p_next = spring_force(ms%tip_value(k), scenes(k)%lower, scenes(k)%upper, scenes(k)%stiffness_per_mass)
-            ms%c(k) = model%dt2*model%beta*p_next
-            ms%r_step(k) = model%beta*p_next + (1 - 2*model%beta)*ms%p_now(k) + model%beta*ms%p_prev(k)
-            ms%p_prev(k) = ms%p_now(k)
-            ms%p_now(k) = p_next
-            ms%contact(k) = ms%r_step(k) /= 0
-         end do
-      case default
-         ms%c = 0
-         ms%tip_value = ms%trial
-         ms%r_step = 0
-         ms%contact = .false.
-      end select
-   end subroutine contact_law
-
-   !> After the update, for every member (beamstops_scheme's close_step, written over the
-   !> members, on the gathered tip values u_tip, d_tip): the exact tip value (Signorini), the
-   !> violation, impacts, the work of the load and the energy the stops take, the load averages
-   !> moved on.
-   subroutine close_steps(law, ms)
-      integer, intent(in) :: law
-      type(members_type), intent(inout) :: ms
-      integer :: c, lo, hi
-      do c = 1, ms%chunks
-         lo = (c - 1)*lockstep_lanes + 1
-         hi = c*lockstep_lanes
-         call close_lanes(law, ms%contact(lo:hi), ms%tip_value(lo:hi), ms%u_tip_prev(lo:hi), ms%d_tip_prev(lo:hi), &
-            & ms%lower(lo:hi), ms%upper(lo:hi), ms%weight(lo:hi), ms%gd(lo:hi), ms%r_step(lo:hi), &
-            & ms%sigma_next(lo:hi), ms%u_tip(lo:hi), ms%d_tip(lo:hi), ms%max_violation(lo:hi), ms%impacts(lo:hi), &
-            & ms%in_contact(lo:hi), ms%work(lo:hi), ms%dissipated(lo:hi), ms%reaction(lo:hi), ms%gd_prev(lo:hi), &
-            & ms%sigma_prev(lo:hi), ms%sigma_now(lo:hi))
-      end do
-   end subroutine close_steps
-
-   !> The projection of the trial tip values on the stops of a chunk of lanes (beamstops_contact_
-   !> tip_projection's project_tip): tip value, multiple c of z, contact, reaction of the step.
-   pure subroutine project_lanes(trial, lower, upper, z_tip, dt2, tip_value, c, contact, r_step)
-      real(wp), intent(in) :: trial(lockstep_lanes), lower(lockstep_lanes), upper(lockstep_lanes), z_tip, dt2
-      real(wp), intent(out) :: tip_value(lockstep_lanes), c(lockstep_lanes), r_step(lockstep_lanes)
-      logical, intent(out) :: contact(lockstep_lanes)
-      integer :: k
-!GCC$ ivdep
-!GCC$ vector
-      do k = 1, lockstep_lanes
-         tip_value(k) = min(max(trial(k), lower(k)), upper(k))
-         c(k) = (tip_value(k) - trial(k))/z_tip
-         contact(k) = c(k) /= 0
-         r_step(k) = c(k)/dt2
-      end do
-   end subroutine project_lanes
-
-   !> close_steps for a chunk of lanes.
-   pure subroutine close_lanes(law, contact, tip_value, u_tip_prev, d_tip_prev, lower, upper, weight, gd, r_step, &
-      & sigma_next, u_tip, d_tip, max_violation, impacts, in_contact, work, dissipated, reaction, gd_prev, &
-      & sigma_prev, sigma_now)
-      integer, intent(in) :: law
-      logical, intent(in) :: contact(lockstep_lanes)
-      real(wp), intent(in) :: tip_value(lockstep_lanes), u_tip_prev(lockstep_lanes), d_tip_prev(lockstep_lanes), &
-         & lower(lockstep_lanes), upper(lockstep_lanes), weight(lockstep_lanes), gd(lockstep_lanes), &
-         & r_step(lockstep_lanes), sigma_next(lockstep_lanes)
-      real(wp), intent(inout) :: u_tip(lockstep_lanes), d_tip(lockstep_lanes), max_violation(lockstep_lanes), &
-         & work(lockstep_lanes), dissipated(lockstep_lanes), reaction(lockstep_lanes), gd_prev(lockstep_lanes), &
-         & sigma_prev(lockstep_lanes), sigma_now(lockstep_lanes)
-      integer(ik), intent(inout) :: impacts(lockstep_lanes)
-      logical, intent(inout) :: in_contact(lockstep_lanes)
-      integer :: k
-      if (law == law_signorini) then
-!GCC$ ivdep
-!GCC$ vector
-         do k = 1, lockstep_lanes
-            if (contact(k)) then
-               u_tip(k) = tip_value(k)
-               d_tip(k) = tip_value(k) - u_tip_prev(k)
-            end if
-         end do
-      end if
-      if (law /= law_none) then
-!GCC$ ivdep
-!GCC$ vector
-         do k = 1, lockstep_lanes
-            max_violation(k) = max(max_violation(k), max(u_tip(k) - upper(k), lower(k) - u_tip(k), 0.0_wp))
-         end do
-      end if
-!GCC$ ivdep
-!GCC$ vector
-      do k = 1, lockstep_lanes
-         if (contact(k) .and. .not. in_contact(k)) impacts(k) = impacts(k) + 1
-         in_contact(k) = contact(k)
-         work(k) = work(k) + 0.5_wp*weight(k)*(gd(k) + gd_prev(k))
-         dissipated(k) = dissipated(k) - 0.5_wp*r_step(k)*(d_tip(k) + d_tip_prev(k))
-         reaction(k) = r_step(k)
-         gd_prev(k) = gd(k)
-         sigma_prev(k) = sigma_now(k)
-         sigma_now(k) = sigma_next(k)
-      end do
-   end subroutine close_lanes
-
-   !> Member k's record row of step n, the energy column left for later (fill_row).
-   subroutine fill_row(scene, model, ms, k, step, row)
-      type(scene_type), intent(in) :: scene
-      type(model_type), intent(in) :: model
-      type(members_type), intent(in) :: ms
-      integer, intent(in) :: k
-      integer(ik), intent(in) :: step
-      real(wp), intent(out) :: row(n_columns)
-      row(col_t) = real(step, wp)*model%dt
-      row(col_u) = ms%u_tip_prev(k)
-      row(col_v) = (ms%d(lane(k), model%tip, chunk(k)) + ms%d_tip_prev(k))/(2*model%dt)
-      row(col_reaction) = scene%mass_per_length*ms%r_prev(k)
-      row(col_energy) = 0
-      row(col_work) = scene%mass_per_length*ms%work(k)
-      row(col_dissipated) = scene%mass_per_length*ms%dissipated(k)
-      row(col_damped) = scene%mass_per_length*0.0_wp
-   end subroutine fill_row
-
-   !> Snapshot of member k's u^n (= u^{n+1} - d^n) at t_n (take_snapshot, physical_shape).
-   subroutine take_snapshot(scene, model, ms, k, step, recorder)
-      type(scene_type), intent(in) :: scene
-      type(model_type), intent(in) :: model
-      type(members_type), intent(inout) :: ms
-      integer, intent(in) :: k
-      integer(ik), intent(in) :: step
-      class(recorder_type), intent(inout) :: recorder
-      real(wp) :: phi, t
-      ms%vec_s = ms%u(lane(k), :, chunk(k)) - ms%d(lane(k), :, chunk(k))
-      t = real(step, wp)*model%dt
-      phi = support_position(t, scene%amplitude, scene%omega)
-      ms%shape = model%lift*phi
-      ms%shape(2:) = ms%shape(2:) + ms%vec_s(1::2)
-      call recorder%snapshot(real(step, wp)*model%dt, ms%shape)
-   end subroutine take_snapshot
-
-   !> The load rotation of every member at step k (start_loads): from load_average at the last
-   !> multiple of restart_every, then rotated.
-   subroutine start_loads(ms, k, scenes, model)
-      type(members_type), intent(inout) :: ms
-      integer(ik), intent(in) :: k
-      type(scene_type), intent(in) :: scenes(:)
-      type(model_type), intent(in) :: model
-      call restart_loads(ms, (k/restart_every)*restart_every, scenes, model)
-      do while (ms%load_k < k)
-         call next_loads(ms, scenes, model)
-      end do
-   end subroutine start_loads
-
-   !> The load rotation of every member at step k, exact (restart_loads).
-   subroutine restart_loads(ms, k, scenes, model)
-      type(members_type), intent(inout) :: ms
-      integer(ik), intent(in) :: k
-      type(scene_type), intent(in) :: scenes(:)
-      type(model_type), intent(in) :: model
-      real(wp) :: centre, x, factor
-      integer :: m
-      ms%load_k = k
-      do m = 1, ms%k
-         centre = real(k, wp)*model%dt
-         if (.not. scenes(m)%centered_load) centre = (real(k, wp) + 0.5_wp)*model%dt
-         x = 0.5_wp*scenes(m)%omega*model%dt
-         if (abs(x) < 1.0e-8_wp) then
-            factor = 1 - x**2/6
-         else
-            factor = sin(x)/x
-         end if
-         ms%sigma(m) = load_average(k, model%dt, scenes(m)%omega, scenes(m)%centered_load)
-         ms%cosine(m) = factor*cos(scenes(m)%omega*centre)
-         ms%cos_step(m) = cos(scenes(m)%omega*model%dt)
-         ms%sin_step(m) = sin(scenes(m)%omega*model%dt)
-      end do
-   end subroutine restart_loads
-
-   !> The load rotation of every member moved on by one step (next_load).
-   subroutine next_loads(ms, scenes, model)
-      type(members_type), intent(inout) :: ms
-      type(scene_type), intent(in) :: scenes(:)
-      type(model_type), intent(in) :: model
-      real(wp) :: sigma
-      integer :: m
-      if (mod(ms%load_k + 1, restart_every) == 0) then
-         call restart_loads(ms, ms%load_k + 1, scenes, model)
-         return
-      end if
-      do m = 1, ms%p
-         sigma = ms%sigma(m)*ms%cos_step(m) + ms%cosine(m)*ms%sin_step(m)
-         ms%cosine(m) = ms%cosine(m)*ms%cos_step(m) - ms%sigma(m)*ms%sin_step(m)
-         ms%sigma(m) = sigma
-      end do
-      ms%load_k = ms%load_k + 1
-   end subroutine next_loads
-
-   !> The first recorded step and the first snapshot step at or after `step` (first_events).
-   pure subroutine first_events(scene, step, next_record, next_snapshot)
-      type(scene_type), intent(in) :: scene
-      integer(ik), intent(in) :: step
-      integer(ik), intent(out) :: next_record, next_snapshot
-      next_record = next_multiple(step, int(scene%record_every, ik))
-      next_snapshot = huge(step)
-      if (scene%snapshot_every > 0) next_snapshot = next_multiple(step, int(scene%snapshot_every, ik))
-   end subroutine first_events
-
-   !> The first multiple of `every` at or after `step`.
-   pure function next_multiple(step, every) result(m)
-      integer(ik), intent(in) :: step, every
-      integer(ik) :: m
-      m = ((step + every - 1)/every)*every
-   end function next_multiple
-
-   !> Discrete energy E^{n+1/2} per unit mass (beamstops_scheme's energy).
-   pure function energy(model, dmd, usu, dsu, u_old_s_u_old) result(e)
-      type(model_type), intent(in) :: model
-      real(wp), intent(in) :: dmd, usu, dsu, u_old_s_u_old
-      real(wp) :: e
-      e = 0.5_wp*dmd/model%dt2 + 0.5_wp*(model%beta*usu + model%beta*u_old_s_u_old &
-         & + (1 - 2*model%beta)*(usu - dsu))
-   end function energy
 
    !> Text of a real for messages.
    function real_text(x) result(s)

@@ -26,6 +26,7 @@ program tester
    use test_physics_checks, only: collect_physics_checks
    use test_lockstep, only: collect_lockstep
    use test_batch, only: collect_batch
+   use test_lockstep_general, only: collect_lockstep_general
    use test_reduced, only: collect_reduced
    use test_reduced_physics, only: collect_reduced_physics
    implicit none
@@ -73,6 +74,7 @@ program tester
       & new_testsuite('reduced', collect_reduced), &
       & new_testsuite('reduced_physics', collect_reduced_physics), &
       & new_testsuite('lockstep', collect_lockstep), &
+      & new_testsuite('lockstep_general', collect_lockstep_general), &
       & new_testsuite('batch', collect_batch) &
       & ]
 

@@ -113,8 +113,13 @@ def test_disjoint_halves_agree_within_their_intervals() -> None:
         assert abs(float(a) - float(b)) <= a.half_width[0] + b.half_width[0], (name, str(a), str(b))
 
 
-def test_ensembles_identical_members_and_decorrelated_members() -> None:
-    scene = Scene(t_end=3.0, transient=1.0, batches=10, record_every=1000, members=3)
+@pytest.mark.parametrize("physics", [
+    {},
+    # damped, with restitution: the members run in the general lockstep loop (docs/lockstep.md)
+    {"ratio": (0.01,), "restitution": 0.5},
+])
+def test_ensembles_identical_members_and_decorrelated_members(physics: dict[str, object]) -> None:
+    scene = Scene(t_end=3.0, transient=1.0, batches=10, record_every=1000, members=3, **physics)
     same = beamstops.run(scene)
     assert same.ensemble["power"].half_width[0] == 0  # delta = 0: members identical bit for bit
     assert float(same.ensemble["power"]) == float(same.statistics["power"])

@@ -1,0 +1,121 @@
+!> The kernels the general lockstep loop (lockstep_general.f90) adds to those of
+!> beamstops_band_solve_lockstep, for lockstep_lanes members at once, the member index innermost
+!> (arrays (lanes, n)): the right-hand side with the Rayleigh damping term (SPEC 8) and one row of
+!> a product by S (the massless tip of mass redistribution, SPEC 10).
+!>
+!> Bit for bit, as beamstops_band_solve_lockstep: each lane does the floating-point operations of
+!> the one-member code of beamstops_scheme's forward_pass (rhs = a g - b S u - c C d) and of
+!> beamstops_band_solve's diagonal_row, in the same order, with the same expressions (so that the
+!> compiler forms the same multiply-adds); tests/fortran/test_lockstep_general.f90 checks them
+!> lane by lane and in whole runs.
+module beamstops_band_solve_lockstep_general
+   use beamstops_kinds, only: wp
+   use beamstops_band, only: kd
+   use beamstops_band_solve, only: band_diagonals
+   use beamstops_band_solve_lockstep, only: lockstep_lanes
+   implicit none
+   private
+   public :: lockstep_matvec_rhs_damped, lockstep_row
+
+contains
+
+   !> S u and the right-hand sides rhs = a g - b S u - c_scale C d plus `spring` in the tip row n-1
+   !> of every lane in one pass (beamstops_band_solve_lockstep's lockstep_matvec_rhs with the
+   !> damping term of beamstops_scheme's forward_pass).
+   pure subroutine lockstep_matvec_rhs_damped(stiffness, u, a, g, b, spring, cd, c_scale, su, rhs)
+      !> S by diagonals.
+      type(band_diagonals), intent(in) :: stiffness
+      !> u of every lane (lanes, n).
+      real(wp), intent(in) :: u(lockstep_lanes, stiffness%n)
+      !> dt^2 times the load weight of every lane (lanes).
+      real(wp), intent(in) :: a(lockstep_lanes)
+      !> Load vectors (lanes, n).
+      real(wp), intent(in) :: g(lockstep_lanes, stiffness%n)
+      !> dt^2.
+      real(wp), intent(in) :: b
+      !> Force term of the tip row (lanes).
+      real(wp), intent(in) :: spring(lockstep_lanes)
+      !> C d^{n-1} of every lane (lanes, n).
+      real(wp), intent(in) :: cd(lockstep_lanes, stiffness%n)
+      !> Its coefficient (dt).
+      real(wp), intent(in) :: c_scale
+      !> S u (lanes, n).
+      real(wp), intent(out) :: su(lockstep_lanes, stiffness%n)
+      !> Right-hand sides (lanes, n).
+      real(wp), intent(out) :: rhs(lockstep_lanes, stiffness%n)
+      integer :: j, k, n
+      n = stiffness%n
+      associate (s => stiffness%a, x => u, y => su)
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            y(k, 1) = s(1, 0)*x(k, 1) + s(2, 1)*x(k, 2) + s(3, 2)*x(k, 3) + s(4, 3)*x(k, 4)
+            y(k, 2) = s(2, 1)*x(k, 1) + s(2, 0)*x(k, 2) + s(3, 1)*x(k, 3) + s(4, 2)*x(k, 4) + s(5, 3)*x(k, 5)
+            y(k, 3) = s(3, 2)*x(k, 1) + s(3, 1)*x(k, 2) + s(3, 0)*x(k, 3) + s(4, 1)*x(k, 4) + s(5, 2)*x(k, 5) &
+               & + s(6, 3)*x(k, 6)
+            rhs(k, 1) = a(k)*g(k, 1) - b*y(k, 1) - c_scale*cd(k, 1)
+            rhs(k, 2) = a(k)*g(k, 2) - b*y(k, 2) - c_scale*cd(k, 2)
+            rhs(k, 3) = a(k)*g(k, 3) - b*y(k, 3) - c_scale*cd(k, 3)
+         end do
+         do j = kd + 1, n - kd
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               y(k, j) = s(j, 3)*x(k, j - 3) + s(j, 2)*x(k, j - 2) + s(j, 1)*x(k, j - 1) + s(j, 0)*x(k, j) &
+                  & + s(j + 1, 1)*x(k, j + 1) + s(j + 2, 2)*x(k, j + 2) + s(j + 3, 3)*x(k, j + 3)
+               rhs(k, j) = a(k)*g(k, j) - b*y(k, j) - c_scale*cd(k, j)
+            end do
+         end do
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            y(k, n - 2) = s(n - 2, 3)*x(k, n - 5) + s(n - 2, 2)*x(k, n - 4) + s(n - 2, 1)*x(k, n - 3) &
+               & + s(n - 2, 0)*x(k, n - 2) + s(n - 1, 1)*x(k, n - 1) + s(n, 2)*x(k, n)
+            y(k, n - 1) = s(n - 1, 3)*x(k, n - 4) + s(n - 1, 2)*x(k, n - 3) + s(n - 1, 1)*x(k, n - 2) &
+               & + s(n - 1, 0)*x(k, n - 1) + s(n, 1)*x(k, n)
+            y(k, n) = s(n, 3)*x(k, n - 3) + s(n, 2)*x(k, n - 2) + s(n, 1)*x(k, n - 1) + s(n, 0)*x(k, n)
+            rhs(k, n - 2) = a(k)*g(k, n - 2) - b*y(k, n - 2) - c_scale*cd(k, n - 2)
+            rhs(k, n - 1) = a(k)*g(k, n - 1) - b*y(k, n - 1) - c_scale*cd(k, n - 1)
+            rhs(k, n) = a(k)*g(k, n) - b*y(k, n) - c_scale*cd(k, n)
+            rhs(k, n - 1) = rhs(k, n - 1) + spring(k)
+         end do
+      end associate
+   end subroutine lockstep_matvec_rhs_damped
+
+   !> Row `row` of A x of every lane, A symmetric by diagonals (beamstops_band_solve's
+   !> diagonal_row: the diagonal term, then for j = 1..kd the term j below and the term j above).
+   pure subroutine lockstep_row(diagonals, x, row, y)
+      !> Matrix by diagonals.
+      type(band_diagonals), intent(in) :: diagonals
+      !> Vectors (lanes, n).
+      real(wp), intent(in) :: x(lockstep_lanes, diagonals%n)
+      !> The row (1..n).
+      integer, intent(in) :: row
+      !> (A x)_row of every lane (lanes).
+      real(wp), intent(out) :: y(lockstep_lanes)
+      integer :: j, k
+      associate (a => diagonals%a)
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            y(k) = a(row, 0)*x(k, row)
+         end do
+         do j = 1, kd
+            if (row - j >= 1) then
+!GCC$ ivdep
+!GCC$ vector
+               do k = 1, lockstep_lanes
+                  y(k) = y(k) + a(row, j)*x(k, row - j)
+               end do
+            end if
+            if (row + j <= diagonals%n) then
+!GCC$ ivdep
+!GCC$ vector
+               do k = 1, lockstep_lanes
+                  y(k) = y(k) + a(row + j, j)*x(k, row + j)
+               end do
+            end if
+         end do
+      end associate
+   end subroutine lockstep_row
+end module beamstops_band_solve_lockstep_general
