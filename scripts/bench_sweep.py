@@ -113,8 +113,7 @@ def section(program: str, quick: bool = False, *, jobs: int | None = None, batch
                  "its group's loop). CPU of all processes: user + system time of the sweep's workers and their "
                  "`beamstops` programs (start-up, HDF5 files, reductions; less sensitive to a loaded machine "
                  "than the wall time). Points in lockstep: the engine's own count (`beamstops run` with several "
-                 "scenes says how it grouped them); damped points join a group once the lockstep path "
-                 "accepts damping.")
+                 "scenes says how it grouped them).")
     return lines
 
 
