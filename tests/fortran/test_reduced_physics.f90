@@ -8,7 +8,8 @@
 !> (u^{n+1} + e u^{n-1})/(1 + e) satisfies the KKT conditions every step in reduced coordinates.
 module test_reduced_physics
    use testing
-   use test_support, only: int_text, run_recorded
+   use test_support, only: int_text, run_recorded, band_eigenvalues
+   use beamstops_model, only: model_type, build_model
    use test_reduced, only: run_reduced_recorded, compare_full
    use physics_support, only: peaks
    use beamstops, only: ik, scene_type, array_recorder, run_summary, law_none, law_signorini, validate_scene, &
@@ -44,6 +45,8 @@ contains
          & 'first contact period', test_full_massless), &
          & new_unittest('massless boundary, all modes, mass damping: the full redistributed engine', &
          & test_full_massless_damped), &
+         & new_unittest('massless boundary: its frequencies are the full redistributed model''s lowest r for any r; '// &
+         & 'its kappa (beta < 1/4) the full kappa_h', test_massless_frequencies), &
          & new_unittest('massless boundary, no contact: E - E0 = W - damped to round-off', test_massless_balance), &
          & new_unittest('massless boundary, r = 8: KKT of the projection every step; the rows are the scheme''s', &
          & test_massless_kkt), &
@@ -458,6 +461,55 @@ contains
       scene%damping_mass = 3.0_wp
       call compare_massless(scene, error)
    end subroutine test_full_massless_damped
+
+   !> The massless tip's static condensation is exact, so the finite spectrum of (S, M^rho) is that
+   !> of the interior (S_ii - S_ib S_bi/S_bb, M^rho_ii), whose first r modes the basis takes: the
+   !> reduced model's squared frequencies (M_r = diag(I, 0), S_r condensed: Lambda_c) are the full
+   !> redistributed model's r lowest for every r (J = 19: r = 3, 8, 37), to 1e-10; with
+   !> beta = 0.2 the reduced kappa of r = n - 1 is the full kappa_h and the reduced Newmark limit
+   !> at r = 8 is larger than the full one (dt may grow).
+   subroutine test_massless_frequencies(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: rs(3) = [3, 8, 37]
+      type(scene_type) :: scene
+      type(model_type) :: model
+      type(reduced_model_type) :: reduced
+      real(wp), allocatable :: mu(:), kappa_full(:)
+      real(wp) :: worst, dt_full
+      integer :: i, k, n
+      scene = massless_scene(1e-5_wp, 1)
+      scene%beta = 0.2_wp
+      call build_model(scene, model, error)
+      if (allocated(error)) return
+      ! (M^rho, S): mu = 1/kappa, the massless mode at mu = 0 (the smallest).
+      call band_eigenvalues(model%mass, model%stiffness, mu, error)
+      if (allocated(error)) return
+      n = size(mu)
+      kappa_full = [(1/mu(n + 1 - k), k=1, n - 1)]
+      do i = 1, size(rs)
+         scene%modes = rs(i)
+         call prepare_reduced(scene, 'test scene', reduced, error)
+         if (allocated(error)) return
+         worst = maxval(abs(reduced%lambda - kappa_full(:rs(i)))/kappa_full(:rs(i)))
+         call note('r = '//int_text(rs(i))//': largest relative difference of omega^2 from the full model''s '// &
+            & real_text(worst)//'; reduced kappa '//real_text(reduced%kappa)//', full kappa_h '// &
+            & real_text(model%kappa_h)//' 1/s^2')
+         call check(error, worst, 0.0_wp, 'the r lowest frequencies', thr=1e-10_wp)
+         if (allocated(error)) return
+         call check(error, reduced%kappa, kappa_full(rs(i)), 'kappa of the reduced model: its largest', rel=.true., &
+            & thr=1e-10_wp)
+         if (allocated(error)) return
+      end do
+      call check(error, reduced%kappa, model%kappa_h, 'r = n - 1: the full kappa_h', rel=.true., thr=1e-10_wp)
+      if (allocated(error)) return
+      scene%modes = 8
+      call prepare_reduced(scene, 'test scene', reduced, error)
+      if (allocated(error)) return
+      dt_full = 2/sqrt((1 - 4*scene%beta)*model%kappa_h)
+      call note('beta = 0.2: Newmark limit of the full model '//real_text(dt_full)//' s, of r = 8 '// &
+         & real_text(reduced%dt_newmark)//' s')
+      call check(error, reduced%dt_newmark > 10*dt_full, 'r = 8 takes a dt ten times the full model''s')
+   end subroutine test_massless_frequencies
 
    !> No contact (law none, 1 s, dt = 1e-4), beta = 1/4 and 1/2, r = 5 and r = n - 1, with and
    !> without mass damping: max |(E_n - E_0) - (W_n - damped_n)| / max |E| in the records and the
