@@ -35,6 +35,12 @@
 !> z_r = A_r^{-1} e_{r+1} and the span stops' box QP on C_r = P_r^T A_r^{-1} P_r are exact for the
 !> reduced model. The load is l_r = T^T l.
 !>
+!> The massless boundary (mass redistribution, SPEC 10; tip stops): T = [Phi e_tip] with Phi the
+!> modes of (S_ii - S_ib S_bi/S_bb, M^rho_ii), the interior with the massless tip condensed, so
+!> M_r = diag(I, 0), S_r = [[Lambda_c + G G^T/S_bb, G], [G^T, S_bb]] (G = Phi^T S e_tip, stored
+!> in stiffness_coupling, Lambda_c in lambda), A_r solved in closed form (massless_solve); its
+!> frequencies are the full redistributed model's r lowest. See docs/reduced.md.
+!>
 !> Initial data: the stop values exactly, the rest M-orthogonally projected on the
 !> fixed-interface modes: p0 = u0(b), a0 = Phi^T M (u0 - Psi p0) (and the same for v0). With
 !> r = n - m, T is square and invertible, this is q0 = T^{-1} u0 exactly, and the reduced model is
@@ -101,7 +107,8 @@ module beamstops_reduced
       logical :: damped = .false.
       !> The coefficients a (1/s) and b (s) of C_r (the full model's, from its own spectrum).
       real(wp) :: damping_a = 0, damping_b = 0
-      !> Squared frequencies omega_k^2 of the fixed-interface modes, ascending (r) (1/s^2).
+      !> Squared frequencies omega_k^2 of the fixed-interface modes, ascending (r) (1/s^2); with the
+      !> massless boundary those of the condensed interior (Lambda_c).
       real(wp), allocatable :: lambda(:)
       !> Basis T = [Phi Psi] (n, r + m): u = T q.
       real(wp), allocatable :: basis(:, :)

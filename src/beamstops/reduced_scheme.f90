@@ -9,6 +9,8 @@
 !>               + (1 - 2 beta) q^n S_r q^{n+1}]
 !> is the full model's energy of u = T q, and its balance (SPEC 6) holds as in the full loop.
 !> A step costs O(r m + m^2) (the block solve of A_r and S_r q): the modal block is diagonal.
+!> With mass redistribution (reduced%massless) the loop is advance_massless: the massless tip
+!> stepped as the full model's equilibrium row (its kernels in reduced_massless.f90).
 !> Records go to the same recorder interface, snapshots expanded to the nodes (u = T q).
 !> The loop allocates nothing and writes nothing itself.
 module beamstops_reduced_scheme
@@ -26,6 +28,7 @@ module beamstops_reduced_scheme
    use beamstops_contact_span_stops, only: span_work_type, new_span_work, span_contact, span_settle, span_energy
    use beamstops_contact_box_qp, only: qp_solved, qp_message
    use beamstops_contact_mass_redistribution, only: massless_reaction
+   use beamstops_reduced_massless, only: coupling_dots, massless_rhs, massless_update, equilibrium_start
    use beamstops_observe_observer, only: observer_type, observe_scene
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
       & col_work, col_dissipated, col_damped
@@ -616,88 +619,6 @@ contains
       end do
       state%step = done + 1
    end subroutine advance_massless
-
-   !> G.a and G.d_a in one sweep (O(r)).
-   pure subroutine coupling_dots(r, g, q, d, g_q, g_d)
-      integer, intent(in) :: r
-      real(wp), intent(in) :: g(r), q(r + 1), d(r + 1)
-      real(wp), intent(out) :: g_q, g_d
-      integer :: i
-      g_q = 0
-      g_d = 0
-      do i = 1, r
-         g_q = g_q + g(i)*q(i)
-         g_d = g_d + g(i)*d(i)
-      end do
-   end subroutine coupling_dots
-
-   !> The modal rows of the massless boundary's step in one sweep (O(r)), gs = G/S_bb:
-   !> x_a = D^{-1} (dt^2 (weight l_a - Lambda_c a - G s_u/S_bb) [- dt (C_r d^{n-1})_a] - gs y_p)
-   !> and acc = G.x_a.
-   pure subroutine massless_rhs(r, dinv, gs, lambda, g, load, q, dt2, weight, s_u, y_p, x, acc, cd, dt)
-      integer, intent(in) :: r
-      real(wp), intent(in) :: dinv(r), gs(r), lambda(r), g(r), load(r + 1), q(r + 1), dt2, weight, s_u, y_p
-      real(wp), intent(inout) :: x(r + 1)
-      real(wp), intent(out) :: acc
-      !> C_r d^{n-1} and dt, with damping only.
-      real(wp), intent(in), optional :: cd(r + 1), dt
-      integer :: i
-      real(wp) :: xi
-      acc = 0
-      if (present(cd)) then
-         do i = 1, r
-            xi = dinv(i)*((dt2*(weight*load(i) - lambda(i)*q(i) - gs(i)*s_u) - dt*cd(i)) - gs(i)*y_p)
-            x(i) = xi
-            acc = acc + g(i)*xi
-         end do
-      else
-         do i = 1, r
-            xi = dinv(i)*(dt2*(weight*load(i) - lambda(i)*q(i) - gs(i)*s_u) - gs(i)*y_p)
-            x(i) = xi
-            acc = acc + g(i)*xi
-         end do
-      end if
-   end subroutine massless_rhs
-
-   !> The update of the massless boundary's step: d^n = d^{n-1} + x + c z, q^{n+1} = q^n + d^n,
-   !> gd = l_r.d^n and g_d = G.d^n_a, in one sweep (O(r)).
-   pure subroutine massless_update(r, z, load, g, c, x, d, q, gd, g_d)
-      integer, intent(in) :: r
-      real(wp), intent(in) :: z(r + 1), load(r + 1), g(r), c, x(r + 1)
-      real(wp), intent(inout) :: d(r + 1), q(r + 1)
-      real(wp), intent(out) :: gd, g_d
-      integer :: i
-      gd = 0
-      g_d = 0
-      do i = 1, r
-         d(i) = d(i) + (x(i) + c*z(i))
-         q(i) = q(i) + d(i)
-         gd = gd + load(i)*d(i)
-         g_d = g_d + g(i)*d(i)
-      end do
-      d(r + 1) = d(r + 1) + (x(r + 1) + c*z(r + 1))
-      q(r + 1) = q(r + 1) + d(r + 1)
-      gd = gd + load(r + 1)*d(r + 1)
-   end subroutine massless_update
-
-   !> The massless boundary at the start: each stop coordinate of q^1 from the equilibrium of its
-   !> row at t_1, (S_r q^1)_p = sigma_1 l_p, the modal amplitudes fixed (the full model's
-   !> equilibrium_start in the reduced basis).
-   pure subroutine equilibrium_start(reduced, sigma, q)
-      type(reduced_model_type), intent(in) :: reduced
-      real(wp), intent(in) :: sigma
-      real(wp), intent(inout) :: q(:)
-      integer :: r, j, k
-      real(wp) :: others
-      r = reduced%r
-      do k = 1, reduced%m
-         others = dot_product(reduced%stiffness_coupling(:, k), q(1:r))
-         do j = 1, reduced%m
-            if (j /= k) others = others + reduced%stiffness_pp(k, j)*q(r + j)
-         end do
-         q(r + k) = (sigma*reduced%load(r + k) - others)/reduced%stiffness_pp(k, k)
-      end do
-   end subroutine equilibrium_start
 
    !> The tip value of a reduced vector: its tip coordinate when the tip is a stop, else T(tip, :) q.
    pure function tip_value_of(reduced, q) result(u)
