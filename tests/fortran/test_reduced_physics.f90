@@ -12,7 +12,7 @@ module test_reduced_physics
    use beamstops_model, only: model_type, build_model
    use test_reduced, only: run_reduced_recorded, compare_full
    use physics_support, only: peaks
-   use beamstops, only: ik, scene_type, array_recorder, run_summary, law_none, law_signorini, validate_scene, &
+   use beamstops, only: ik, scene_type, array_recorder, run_summary, law_none, law_signorini, law_compliance, validate_scene, &
       & steps_of, scene_from_text, record_count, stop_count, status_complete
    use beamstops_forcing, only: load_average
    use beamstops_lapack, only: dsygv
@@ -45,6 +45,8 @@ contains
          & 'first contact period', test_full_massless), &
          & new_unittest('massless boundary, all modes, mass damping: the full redistributed engine', &
          & test_full_massless_damped), &
+         & new_unittest('massless boundary, all modes, restitution e = 0.5 / compliance: the full redistributed '// &
+         & 'engine', test_full_massless_laws), &
          & new_unittest('massless boundary: its frequencies are the full redistributed model''s lowest r for any r; '// &
          & 'its kappa (beta < 1/4) the full kappa_h', test_massless_frequencies), &
          & new_unittest('massless boundary, no contact: E - E0 = W - damped to round-off', test_massless_balance), &
@@ -510,6 +512,23 @@ contains
          & real_text(reduced%dt_newmark)//' s')
       call check(error, reduced%dt_newmark > 10*dt_full, 'r = 8 takes a dt ten times the full model''s')
    end subroutine test_massless_frequencies
+
+   !> The same with the other laws at the massless tip: restitution e = 0.5 (Euler start) and the
+   !> compliance spring (k = 1e6 N/m per unit mass; the full model overwrites the spring's
+   !> explicit part in the tip's row by its equilibrium, and so does the reduced loop).
+   subroutine test_full_massless_laws(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      scene = massless_scene(1.25e-6_wp, 0)
+      scene%restitution = 0.5_wp
+      scene%taylor_start = .false.
+      call compare_massless(scene, error)
+      if (allocated(error)) return
+      scene = massless_scene(1.25e-6_wp, 0)
+      scene%law = law_compliance
+      scene%stiffness_per_mass = 1.0e6_wp
+      call compare_massless(scene, error)
+   end subroutine test_full_massless_laws
 
    !> No contact (law none, 1 s, dt = 1e-4), beta = 1/4 and 1/2, r = 5 and r = n - 1, with and
    !> without mass damping: max |(E_n - E_0) - (W_n - damped_n)| / max |E| in the records and the
