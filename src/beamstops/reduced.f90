@@ -55,6 +55,7 @@ module beamstops_reduced
    use beamstops_model, only: model_type, build_model
    use beamstops_contact_span_stops, only: span_stops_type
    use beamstops_contact_box_qp, only: box_qp_type, new_box_qp
+   use beamstops_reduced_massless, only: condense_stiffness, massless_condensation
    use beamstops_lapack, only: dsbgvx, dgbtrf, dgbtrs, dpotrf, dsygv, dsbgvx_message, dgbtrf_message, &
       & dpotrf_message, dsygv_message
    implicit none
@@ -229,7 +230,7 @@ contains
       !> The eigenvectors by inverse iteration (.true., the default) or by dsbgvx (.false.; only
       !> up to dense_modes_limit interior unknowns).
       logical, intent(in), optional :: inverse_iteration
-      real(wp), allocatable :: phi_i(:, :), psi_i(:, :), mt(:, :), st(:, :), col(:), w(:)
+      real(wp), allocatable :: phi_i(:, :), psi_i(:, :), mt(:, :), st(:, :), col(:), w(:), sc(:, :)
       integer, allocatable :: interior(:)
       integer :: n, m, r, ni, j, k, stat
       logical :: by_iteration
@@ -278,8 +279,11 @@ contains
       by_iteration = .true.
       if (present(inverse_iteration)) by_iteration = inverse_iteration .or. ni > dense_modes_limit
       if (reduced%massless) then
+         allocate (sc(kd + 1, ni))
+         sc = band_restriction(model%stiffness, interior)
+         call condense_stiffness(model%stiffness, interior, reduced%b(1), sc)
          call fixed_interface_modes(model%stiffness, model%mass, interior, r, by_iteration, reduced%lambda, phi_i, &
-            & error, condensed_stiffness(model%stiffness, interior, reduced%b(1)))
+            & error, sc)
       else
          call fixed_interface_modes(model%stiffness, model%mass, interior, r, by_iteration, reduced%lambda, phi_i, error)
       end if
@@ -393,31 +397,6 @@ contains
       end if
       call reduced_spectrum(scene, reduced, error)
    end subroutine build_reduced
-
-   !> S_ii - S_ib S_ib^T/S_bb in band storage on the interior unknowns (one stop unknown b): the
-   !> stiffness of the interior with the massless stop condensed. The update touches the
-   !> neighbours of b only, within kd of each other once b is removed: the band is kept.
-   pure function condensed_stiffness(stiffness, interior, b) result(sc)
-      real(wp), intent(in) :: stiffness(:, :)
-      integer, intent(in) :: interior(:), b
-      real(wp) :: sc(kd + 1, size(interior))
-      real(wp) :: sib(size(interior)), sbb
-      integer :: ii, jj, i
-      sc = band_restriction(stiffness, interior)
-      sbb = stiffness(kd + 1, b)
-      do ii = 1, size(interior)
-         i = interior(ii)
-         sib(ii) = 0
-         if (i < b .and. b - i <= kd) sib(ii) = stiffness(kd + 1 + i - b, b)
-         if (i > b .and. i - b <= kd) sib(ii) = stiffness(kd + 1 + b - i, i)
-      end do
-      do jj = 1, size(interior)
-         if (sib(jj) == 0) cycle
-         do ii = max(1, jj - kd), jj
-            if (sib(ii) /= 0) sc(kd + 1 + ii - jj, jj) = sc(kd + 1 + ii - jj, jj) - sib(ii)*sib(jj)/sbb
-         end do
-      end do
-   end function condensed_stiffness
 
    !> Solve A_r x = y in place for the massless boundary (m = 1), O(r), allocation-free:
    !> A_r = [D + s G G^T/S_bb, s G; s G^T, s S_bb] (s = dt^2 beta, D diagonal) gives
@@ -899,45 +878,6 @@ contains
       reduced%kappa = w(s)
       reduced%dt_newmark = 2/sqrt((1 - 4*scene%beta)*reduced%kappa)
    end subroutine reduced_spectrum
-
-   !> The finite spectrum of (S_r, M_r) with M_r = diag(I, 0) (the massless boundary): that of
-   !> the modal block with the massless coordinates condensed, Lambda - G S_bb^{-1} G^T (mass I),
-   !> the full model's finite spectrum of (S, M^rho) in the reduced basis. mr and sr become r x r.
-   subroutine massless_condensation(r, m, mr, sr, error)
-      integer, intent(in) :: r, m
-      real(wp), allocatable, intent(inout) :: mr(:, :), sr(:, :)
-      type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: sbb(:, :), g(:, :)
-      integer :: info
-      sbb = sr(r + 1:, r + 1:)
-      g = transpose(sr(1:r, r + 1:))
-      call dpotrf('U', m, sbb, m, info)
-      if (info /= 0) then
-         call fatal_error(error, 'reduced model: '//dpotrf_message(info, 'S_bb (the massless boundary)'))
-         return
-      end if
-      ! g = R^{-T} G^T, so G S_bb^{-1} G^T = g^T g.
-      call solve_upper_transposed(m, r, sbb, g)
-      sr = sr(1:r, 1:r) - matmul(transpose(g), g)
-      sr = 0.5_wp*(sr + transpose(sr))
-      mr = identity(r)
-   end subroutine massless_condensation
-
-   !> x = R^{-T} x for an upper triangular R (m x m), x (m x k), by forward substitution.
-   pure subroutine solve_upper_transposed(m, k, rf, x)
-      integer, intent(in) :: m, k
-      real(wp), intent(in) :: rf(:, :)
-      real(wp), intent(inout) :: x(:, :)
-      integer :: i, j, c
-      do c = 1, k
-         do i = 1, m
-            do j = 1, i - 1
-               x(i, c) = x(i, c) - rf(j, i)*x(j, c)
-            end do
-            x(i, c) = x(i, c)/rf(i, i)
-         end do
-      end do
-   end subroutine solve_upper_transposed
 
    !> Refuse a scheme with beta < 1/4 asked beyond the reduced model's linear stability limit,
    !> unless allowed (the reduced kappa is at most the full kappa_h: a reduced model may take a

@@ -1,13 +1,16 @@
 !> The kernels of the massless boundary's step (mass redistribution on a reduced model, SPEC 10,
 !> 11; beamstops_reduced builds it, advance_massless in beamstops_reduced_scheme runs it): tip
 !> stops, m = 1, q = (a, p) with p the massless tip value, S_r = [[Lambda_c + G G^T/S_bb, G],
-!> [G^T, S_bb]], M_r = diag(I, 0). Each is one allocation-free sweep of O(r).
+!> [G^T, S_bb]], M_r = diag(I, 0). Each is one allocation-free sweep of O(r). Also the build's
+!> condensed interior stiffness and the condensed spectrum of (S_r, M_r).
 module beamstops_reduced_massless
    use beamstops_kinds, only: wp
-   use beamstops_reduced, only: reduced_model_type
+   use beamstops_error, only: error_type, fatal_error
+   use beamstops_band, only: kd
+   use beamstops_lapack, only: dpotrf, dpotrf_message
    implicit none
    private
-   public :: coupling_dots, massless_rhs, massless_update, equilibrium_start
+   public :: coupling_dots, massless_rhs, massless_update, equilibrium_start, condense_stiffness, massless_condensation
 
 contains
 
@@ -89,22 +92,93 @@ contains
    !> The massless boundary at the start: each stop coordinate of q^1 from the equilibrium of its
    !> row at t_1, (S_r q^1)_p = sigma_1 l_p, the modal amplitudes fixed (the full model's
    !> equilibrium_start in the reduced basis).
-   pure subroutine equilibrium_start(reduced, sigma, q)
-      !> Reduced model (massless).
-      type(reduced_model_type), intent(in) :: reduced
+   pure subroutine equilibrium_start(r, m, g, s_pp, load, sigma, q)
+      !> Modes r and stop coordinates m.
+      integer, intent(in) :: r, m
+      !> G (r, m), S_bb (m, m), l_r (r + m).
+      real(wp), intent(in) :: g(r, m), s_pp(m, m), load(r + m)
       !> Load average sigma_1.
       real(wp), intent(in) :: sigma
-      !> q^1: its stop coordinates set.
-      real(wp), intent(inout) :: q(:)
-      integer :: r, j, k
+      !> q^1: its stop coordinates set (r + m).
+      real(wp), intent(inout) :: q(r + m)
+      integer :: j, k
       real(wp) :: others
-      r = reduced%r
-      do k = 1, reduced%m
-         others = dot_product(reduced%stiffness_coupling(:, k), q(1:r))
-         do j = 1, reduced%m
-            if (j /= k) others = others + reduced%stiffness_pp(k, j)*q(r + j)
+      do k = 1, m
+         others = dot_product(g(:, k), q(1:r))
+         do j = 1, m
+            if (j /= k) others = others + s_pp(k, j)*q(r + j)
          end do
-         q(r + k) = (sigma*reduced%load(r + k) - others)/reduced%stiffness_pp(k, k)
+         q(r + k) = (sigma*load(r + k) - others)/s_pp(k, k)
       end do
    end subroutine equilibrium_start
+   !> S_ii - S_ib S_ib^T/S_bb in band storage on the interior unknowns (one stop unknown b): the
+   !> stiffness of the interior with the massless stop condensed. The update touches the
+   !> neighbours of b only, within kd of each other once b is removed: the band is kept.
+   pure subroutine condense_stiffness(stiffness, interior, b, sc)
+      !> S in band storage (kd + 1, n).
+      real(wp), intent(in) :: stiffness(:, :)
+      !> The interior unknowns (ascending) and the stop unknown b.
+      integer, intent(in) :: interior(:), b
+      !> S_ii in band storage (kd + 1, n - 1) on entry, condensed on return.
+      real(wp), intent(inout) :: sc(:, :)
+      real(wp) :: sib(size(interior)), sbb
+      integer :: ii, jj, i
+      sbb = stiffness(kd + 1, b)
+      do ii = 1, size(interior)
+         i = interior(ii)
+         sib(ii) = 0
+         if (i < b .and. b - i <= kd) sib(ii) = stiffness(kd + 1 + i - b, b)
+         if (i > b .and. i - b <= kd) sib(ii) = stiffness(kd + 1 + b - i, i)
+      end do
+      do jj = 1, size(interior)
+         if (sib(jj) == 0) cycle
+         do ii = max(1, jj - kd), jj
+            if (sib(ii) /= 0) sc(kd + 1 + ii - jj, jj) = sc(kd + 1 + ii - jj, jj) - sib(ii)*sib(jj)/sbb
+         end do
+      end do
+   end subroutine condense_stiffness
+
+   !> The finite spectrum of (S_r, M_r) with M_r = diag(I, 0) (the massless boundary): that of
+   !> the modal block with the massless coordinates condensed, Lambda - G S_bb^{-1} G^T (mass I),
+   !> the full model's finite spectrum of (S, M^rho) in the reduced basis. mr and sr become r x r.
+   subroutine massless_condensation(r, m, mr, sr, error)
+      integer, intent(in) :: r, m
+      real(wp), allocatable, intent(inout) :: mr(:, :), sr(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: sbb(:, :), g(:, :)
+      integer :: info, i
+      sbb = sr(r + 1:, r + 1:)
+      g = transpose(sr(1:r, r + 1:))
+      call dpotrf('U', m, sbb, m, info)
+      if (info /= 0) then
+         call fatal_error(error, 'reduced model: '//dpotrf_message(info, 'S_bb (the massless boundary)'))
+         return
+      end if
+      ! g = R^{-T} G^T, so G S_bb^{-1} G^T = g^T g.
+      call solve_upper_transposed(m, r, sbb, g)
+      sr = sr(1:r, 1:r) - matmul(transpose(g), g)
+      sr = 0.5_wp*(sr + transpose(sr))
+      deallocate (mr)
+      allocate (mr(r, r))
+      mr = 0
+      do i = 1, r
+         mr(i, i) = 1
+      end do
+   end subroutine massless_condensation
+
+   !> x = R^{-T} x for an upper triangular R (m x m), x (m x k), by forward substitution.
+   pure subroutine solve_upper_transposed(m, k, rf, x)
+      integer, intent(in) :: m, k
+      real(wp), intent(in) :: rf(:, :)
+      real(wp), intent(inout) :: x(:, :)
+      integer :: i, j, c
+      do c = 1, k
+         do i = 1, m
+            do j = 1, i - 1
+               x(i, c) = x(i, c) - rf(j, i)*x(j, c)
+            end do
+            x(i, c) = x(i, c)/rf(i, i)
+         end do
+      end do
+   end subroutine solve_upper_transposed
 end module beamstops_reduced_massless

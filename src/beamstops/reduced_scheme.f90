@@ -146,8 +146,8 @@ contains
          call block_solve(reduced%m_solver, state%x)
          state%q = state%q + 0.5_wp*reduced%dt2*state%x
       end if
-      if (reduced%massless) call equilibrium_start(reduced, load_average(1_ik, dt, scene%omega, scene%centered_load), &
-         & state%q)
+      if (reduced%massless) call equilibrium_start(reduced%r, reduced%m, reduced%stiffness_coupling, &
+         & reduced%stiffness_pp, reduced%load, load_average(1_ik, dt, scene%omega, scene%centered_load), state%q)
       if (reduced%stops%m > 0) then
          call start_span(scene, reduced, state, error)
          if (allocated(error)) return
