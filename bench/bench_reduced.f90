@@ -6,6 +6,16 @@
 !>                                            full engine's loop; plus the time to build each model
 !>   bench_reduced tube J STEPS EVERY r1 r2 ...  the same for the tube of input/tube_supports.nml
 !>                                            (stops at J/3, 2J/3 and the tip; J a multiple of 3)
+!>   bench_reduced damped J STEPS EVERY r1 r2 ...  ns per step of the reduced loop (paper's scene) for
+!>                                            each r without damping and with Rayleigh damping
+!>                                            (a = 2 1/s, b = 1e-5 s: the damped loop variant), and
+!>                                            their ratio, measured in the same run
+!>   bench_reduced massless J STEPS EVERY r1 r2 ...  ns per step of the full engine with mass
+!>                                            redistribution (SPEC 10), then for each r of the plain
+!>                                            reduced loop (consistent mass) and of the massless
+!>                                            boundary (mass redistributed), their ratio and the
+!>                                            speed-up of the massless boundary over the full
+!>                                            redistributed engine, measured in the same run
 !>   bench_reduced stats J DT T0 T1 r1 r2 ...  power the stops take (W), RMS tip (m) and impacts
 !>                                            per second over [T0, T1] (paper's scene, beta = 1/2,
 !>                                            a record every 10 steps), full model then each r
@@ -38,13 +48,17 @@ program bench_reduced
       call bench_cost(int_argument(2, 19), int_argument(3, 100000), int_argument(4, 1))
    case ('tube')
       call bench_cost(int_argument(2, 30), int_argument(3, 100000), int_argument(4, 1), tube=.true.)
+   case ('damped')
+      call bench_damped(int_argument(2, 19), int_argument(3, 100000), int_argument(4, 1))
+   case ('massless')
+      call bench_massless(int_argument(2, 19), int_argument(3, 100000), int_argument(4, 1))
    case ('stats')
       call bench_stats(int_argument(2, 19), real_argument(3, 1.0e-5_wp), real_argument(4, 2.0_wp), &
          & real_argument(5, 22.0_wp))
    case ('error')
       call bench_error(int_argument(2, 19), real_argument(3, 1.0e-5_wp))
    case default
-      write (error_unit, '(a)') 'usage: bench_reduced cost|tube|stats|error ...'
+      write (error_unit, '(a)') 'usage: bench_reduced cost|tube|damped|massless|stats|error ...'
       error stop 2
    end select
 
@@ -122,6 +136,97 @@ contains
       end do
       if (rec%sink == 12345.678_wp) print *, rec%sink
    end subroutine bench_cost
+
+   subroutine bench_damped(elements, steps, every)
+      integer, intent(in) :: elements, steps, every
+      type(scene_type) :: plain, damped
+      real(wp) :: ns_plain, ns_damped
+      integer :: k, r
+      plain = paper_scene(elements, 1.0e-6_wp, steps*1.0e-6_wp)
+      plain%record_every = every
+      damped = plain
+      damped%damping_mass = 2.0_wp
+      damped%damping_stiffness = 1.0e-5_wp
+      call put_int('elements', elements)
+      do k = 5, command_argument_count()
+         r = int_argument(k, 1)
+         if (r > 2*elements - stop_unknowns(plain)) cycle
+         plain%modes = r
+         damped%modes = r
+         ns_plain = reduced_ns_per_step(plain, steps)
+         ns_damped = reduced_ns_per_step(damped, steps)
+         write (*, '(a, i0, a, f10.2, a, f10.2, a, f8.3)') 'r ', r, ' ns_per_step ', ns_plain, ' damped_ns_per_step ', &
+            & ns_damped, ' ratio ', ns_damped/ns_plain
+      end do
+   end subroutine bench_damped
+
+   subroutine bench_massless(elements, steps, every)
+      integer, intent(in) :: elements, steps, every
+      type(scene_type) :: plain, massless
+      type(model_type) :: model
+      type(null_recorder) :: rec
+      type(run_summary) :: summary
+      type(error_type), allocatable :: error
+      real(wp) :: ns_plain, ns_massless, ns_full, t0, t1, best
+      integer :: k, r, rep
+      plain = paper_scene(elements, 1.0e-6_wp, steps*1.0e-6_wp)
+      plain%record_every = every
+      massless = plain
+      massless%redistributed_mass = .true.
+      call prepare_run(massless, 'bench', model, error)
+      call fail_on(error)
+      best = huge(1.0_wp)
+      do rep = 1, 3
+         t0 = thread_cpu_seconds()
+         call simulate(massless, model, rec, summary, error)
+         t1 = thread_cpu_seconds()
+         call fail_on(error)
+         best = min(best, (t1 - t0))
+      end do
+      ns_full = 1.0e9_wp*best/steps
+      call put_int('elements', elements)
+      call put('full_redistributed_ns_per_step', ns_full)
+      do k = 5, command_argument_count()
+         r = int_argument(k, 1)
+         if (r > 2*elements - stop_unknowns(plain)) cycle
+         plain%modes = r
+         massless%modes = r
+         ns_plain = reduced_ns_per_step(plain, steps)
+         ns_massless = reduced_ns_per_step(massless, steps)
+         write (*, '(a, i0, a, f10.2, a, f10.2, a, f8.3, a, f8.2)') 'r ', r, ' ns_per_step ', ns_plain, &
+            & ' massless_ns_per_step ', ns_massless, ' ratio ', ns_massless/ns_plain, ' speedup_over_full ', &
+            & ns_full/ns_massless
+      end do
+      if (rec%sink == 12345.678_wp) print *, rec%sink
+   end subroutine bench_massless
+
+   !> Best of three: ns per step of the reduced loop of a scene (modes > 0).
+   function reduced_ns_per_step(scene, steps) result(ns)
+      type(scene_type), intent(in) :: scene
+      integer, intent(in) :: steps
+      real(wp) :: ns
+      type(model_type) :: model
+      type(reduced_model_type) :: reduced
+      type(null_recorder) :: rec
+      type(run_summary) :: summary
+      type(error_type), allocatable :: error
+      real(wp) :: t0, t1, best
+      integer :: rep
+      call build_model(scene, model, error)
+      call fail_on(error)
+      call build_reduced(scene, model, reduced, error)
+      call fail_on(error)
+      best = huge(1.0_wp)
+      do rep = 1, 3
+         t0 = thread_cpu_seconds()
+         call simulate_reduced(scene, reduced, rec, summary, error)
+         t1 = thread_cpu_seconds()
+         call fail_on(error)
+         best = min(best, (t1 - t0))
+      end do
+      ns = 1.0e9_wp*best/steps
+      if (rec%sink == 12345.678_wp) print *, rec%sink
+   end function reduced_ns_per_step
 
    subroutine bench_error(elements, dt)
       integer, intent(in) :: elements

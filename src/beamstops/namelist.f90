@@ -8,7 +8,7 @@ module beamstops_namelist
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
-   use beamstops_scene, only: scene_type, validate_scene, tube_beam, law_code, law_compliance, max_stops
+   use beamstops_scene, only: scene_type, validate_scene, tube_beam, law_code, law_compliance, max_stops, stop_count
    use beamstops_strings, only: fmt_real, itoa, lower, squeeze
    use beamstops_physics_checks, only: validate_physics
    use beamstops_observe_statistics, only: validate_statistics, validate_ensemble
@@ -262,9 +262,15 @@ contains
       if (allocated(error)) return
       call validate_reduced(scene, 2*scene%elements, stop_unknowns(scene), source, error)
       if (allocated(error)) return
-      if (scene%modes > 0 .and. (scene%redistributed_mass .or. scene%members > 1)) then
+      if (scene%modes > 0 .and. scene%members > 1) then
+         call fatal_error(error, source//': &mesh modes = '//itoa(scene%modes)//' with an ensemble (&ensemble '// &
+            & 'members > 1) is not supported; allowed: modes = 0 (the full model) for ensembles')
+         return
+      end if
+      if (scene%modes > 0 .and. scene%redistributed_mass .and. stop_count(scene) > 0) then
          call fatal_error(error, source//': &mesh modes = '//itoa(scene%modes)//" with &stops mass = 'redistributed' "// &
-            & 'or an ensemble (&ensemble members > 1) is not supported; allowed: modes = 0 (the full model) for those')
+            & 'and stops along the span (&stops x) is not supported; allowed: modes = 0 (the full model) for '// &
+            & 'those, or the tip stops (the massless boundary of the reduced model is the tip value)')
          return
       end if
       if (.not. (ieee_is_finite(scene%perturbation) .and. scene%perturbation >= 0 .and. &

@@ -35,6 +35,12 @@
 !> z_r = A_r^{-1} e_{r+1} and the span stops' box QP on C_r = P_r^T A_r^{-1} P_r are exact for the
 !> reduced model. The load is l_r = T^T l.
 !>
+!> The massless boundary (mass redistribution, SPEC 10; tip stops): T = [Phi e_tip] with Phi the
+!> modes of (S_ii - S_ib S_bi/S_bb, M^rho_ii), the interior with the massless tip condensed, so
+!> M_r = diag(I, 0), S_r = [[Lambda_c + G G^T/S_bb, G], [G^T, S_bb]] (G = Phi^T S e_tip, stored
+!> in stiffness_coupling, Lambda_c in lambda), A_r solved in closed form (massless_solve); its
+!> frequencies are the full redistributed model's r lowest. See docs/reduced.md.
+!>
 !> Initial data: the stop values exactly, the rest M-orthogonally projected on the
 !> fixed-interface modes: p0 = u0(b), a0 = Phi^T M (u0 - Psi p0) (and the same for v0). With
 !> r = n - m, T is square and invertible, this is q0 = T^{-1} u0 exactly, and the reduced model is
@@ -49,13 +55,14 @@ module beamstops_reduced
    use beamstops_model, only: model_type, build_model
    use beamstops_contact_span_stops, only: span_stops_type
    use beamstops_contact_box_qp, only: box_qp_type, new_box_qp
+   use beamstops_reduced_massless, only: condense_stiffness, massless_condensation
    use beamstops_lapack, only: dsbgvx, dgbtrf, dgbtrs, dpotrf, dsygv, dsbgvx_message, dgbtrf_message, &
       & dpotrf_message, dsygv_message
    implicit none
    private
    public :: reduced_model_type, block_solver_type, build_reduced, prepare_reduced, validate_reduced
    public :: check_stability_reduced, block_solve, reduced_stiffness_product, reduced_mass_product
-   public :: reduced_matrices, expand, stop_unknowns, max_reduced_unknowns, reduced_damping_product
+   public :: reduced_matrices, expand, stop_unknowns, max_reduced_unknowns, reduced_damping_product, massless_solve
 
    !> Largest number of full unknowns n = 2J for which a reduced basis is built (the eigenvalues
    !> by dsbgvx cost O(n^2)).
@@ -101,7 +108,8 @@ module beamstops_reduced
       logical :: damped = .false.
       !> The coefficients a (1/s) and b (s) of C_r (the full model's, from its own spectrum).
       real(wp) :: damping_a = 0, damping_b = 0
-      !> Squared frequencies omega_k^2 of the fixed-interface modes, ascending (r) (1/s^2).
+      !> Squared frequencies omega_k^2 of the fixed-interface modes, ascending (r) (1/s^2); with the
+      !> massless boundary those of the condensed interior (Lambda_c).
       real(wp), allocatable :: lambda(:)
       !> Basis T = [Phi Psi] (n, r + m): u = T q.
       real(wp), allocatable :: basis(:, :)
@@ -128,6 +136,14 @@ module beamstops_reduced
       real(wp), allocatable :: tip_row(:)
       !> Node abscissae x_0..x_J and the lifting shape h there (J + 1).
       real(wp), allocatable :: x(:), lift(:)
+      !> The massless boundary (mass redistribution, SPEC 10): T = [Phi E_b] (unit columns at the
+      !> massless stop unknowns instead of Psi), M_r = diag(I, 0), the coupling in S_r.
+      logical :: massless = .false.
+      !> Modal-stop stiffness coupling G = Phi^T S E_b (r, m) of the massless boundary (zero in
+      !> the Craig-Bampton basis, where Phi^T S Psi = 0; unallocated there).
+      real(wp), allocatable :: stiffness_coupling(:, :)
+      !> The rows of A_r of the massless stop coordinates over those of S_r: dt^2 beta.
+      real(wp) :: row_scale = 0
       !> Largest generalized eigenvalue of (S_r, M_r) (with the compliance spring at the tip),
       !> computed only for beta < 1/4 (0 otherwise) (1/s^2).
       real(wp) :: kappa = 0
@@ -214,7 +230,7 @@ contains
       !> The eigenvectors by inverse iteration (.true., the default) or by dsbgvx (.false.; only
       !> up to dense_modes_limit interior unknowns).
       logical, intent(in), optional :: inverse_iteration
-      real(wp), allocatable :: phi_i(:, :), psi_i(:, :), mt(:, :), st(:, :), col(:), w(:)
+      real(wp), allocatable :: phi_i(:, :), psi_i(:, :), mt(:, :), st(:, :), col(:), w(:), sc(:, :)
       integer, allocatable :: interior(:)
       integer :: n, m, r, ni, j, k, stat
       logical :: by_iteration
@@ -228,6 +244,11 @@ contains
       end if
       m = size(reduced%b)
       ni = n - m
+      if (model%redistributed .and. model%stops%m > 0) then
+         call fatal_error(error, "reduced model: &stops mass = 'redistributed' with stops along the span is not "// &
+            & 'supported; allowed: the tip stops (the massless boundary is the tip value) or modes = 0')
+         return
+      end if
       if (r < 1 .or. r > ni) then
          call fatal_error(error, 'reduced model: modes = '//fmt_int(int(r, ik))//' is out of range; allowed: 1 <= modes <= '// &
             & fmt_int(int(ni, ik)))
@@ -248,16 +269,29 @@ contains
       reduced%x = model%x
       reduced%lift = model%lift
 
+      ! The massless boundary keeps unit vectors at the stop unknowns (no constraint modes) and
+      ! takes the modes of the interior with the stop condensed (free, massless).
+      reduced%massless = model%redistributed
       interior = interior_unknowns(n, reduced%b)
       ! Inverse iteration by default: its modes are accurate relative to their own scale (at
       ! J = 1000, phi_2^T S phi_1 = 5e-8 lambda_2), dsbgvx's only to eps lambda_max in absolute
       ! terms (7e-5 lambda_2), and the modal block of S_r is taken diagonal. It is also O(n) a mode.
       by_iteration = .true.
       if (present(inverse_iteration)) by_iteration = inverse_iteration .or. ni > dense_modes_limit
-      call fixed_interface_modes(model%stiffness, model%mass, interior, r, by_iteration, reduced%lambda, phi_i, error)
+      if (reduced%massless) then
+         allocate (sc(kd + 1, ni))
+         sc = band_restriction(model%stiffness, interior)
+         call condense_stiffness(model%stiffness, interior, reduced%b(1), sc)
+         call fixed_interface_modes(model%stiffness, model%mass, interior, r, by_iteration, reduced%lambda, phi_i, &
+            & error, sc)
+      else
+         call fixed_interface_modes(model%stiffness, model%mass, interior, r, by_iteration, reduced%lambda, phi_i, error)
+      end if
       if (allocated(error)) return
-      call constraint_modes(model%stiffness, interior, reduced%b, psi_i, error)
-      if (allocated(error)) return
+      if (.not. reduced%massless) then
+         call constraint_modes(model%stiffness, interior, reduced%b, psi_i, error)
+         if (allocated(error)) return
+      end if
 
       allocate (reduced%basis(n, r + m), stat=stat)
       if (stat /= 0) then
@@ -271,10 +305,10 @@ contains
       end do
       call rayleigh_quotients(model%stiffness, model%mass, reduced%basis(:, 1:r), reduced%lambda)
       do j = 1, m
-         reduced%basis(interior, r + j) = psi_i(:, j)
+         if (.not. reduced%massless) reduced%basis(interior, r + j) = psi_i(:, j)
          reduced%basis(reduced%b(j), r + j) = 1
       end do
-      deallocate (phi_i, psi_i)
+      deallocate (phi_i)
 
       ! M Psi and S Psi, then the blocks.
       allocate (mt(n, m), st(n, m), col(n))
@@ -294,6 +328,19 @@ contains
       end do
       reduced%mass_pp = 0.5_wp*(reduced%mass_pp + transpose(reduced%mass_pp))
       reduced%stiffness_pp = 0.5_wp*(reduced%stiffness_pp + transpose(reduced%stiffness_pp))
+      if (reduced%massless) then
+         ! M^rho E_b = 0: B and M_pp are exact zeros; G = Phi^T S E_b.
+         reduced%coupling = 0
+         reduced%mass_pp = 0
+         allocate (reduced%stiffness_coupling(r, m))
+         do j = 1, m
+            do k = 1, r
+               reduced%stiffness_coupling(k, j) = dot_product(reduced%basis(:, k), st(:, j))
+            end do
+         end do
+         ! The condensed quotients phi^T (S_ii - S_ib S_bi/S_bb) phi (m = 1).
+         reduced%lambda = reduced%lambda - reduced%stiffness_coupling(:, 1)**2/reduced%stiffness_pp(1, 1)
+      end if
 
       reduced%load = matmul(model%load, reduced%basis)
       call project_initial(reduced, model%mass, model%u0, reduced%q0)
@@ -302,7 +349,16 @@ contains
       reduced%damped = model%damped
       reduced%damping_a = model%damping_a
       reduced%damping_b = model%damping_b
-      if (reduced%damped) then
+      if (reduced%massless) then
+         ! A_r = (1 + dt a/2) M_r + dt^2 beta S_r (b = 0 with redistribution: build_model refuses
+         ! it): [D, dt^2 beta G; dt^2 beta G^T, dt^2 beta S_bb], D = 1 + dt a/2 + dt^2 beta Lambda.
+         ! M_r is singular: the Taylor start solves its modal block alone (unit E).
+         reduced%row_scale = reduced%dt2*reduced%beta
+         reduced%a_solver%r = r
+         reduced%a_solver%m = m
+         reduced%a_solver%dinv = 1/(1 + 0.5_wp*reduced%dt*reduced%damping_a + reduced%row_scale*reduced%lambda)
+         reduced%a_solver%b = reduced%stiffness_coupling/reduced%stiffness_pp(1, 1)
+      else if (reduced%damped) then
          ! A_r = mass_scale M_r + stiffness_scale S_r: its modal block stays diagonal.
          associate (mass_scale => 1 + 0.5_wp*reduced%dt*reduced%damping_a, &
             & stiffness_scale => 0.5_wp*reduced%dt*reduced%damping_b + reduced%dt2*reduced%beta)
@@ -317,14 +373,22 @@ contains
       if (allocated(error)) return
       allocate (w(r))
       w = 1
-      call new_block_solver(reduced%m_solver, w, reduced%coupling, reduced%mass_pp, 'M_r', error)
+      if (reduced%massless) then
+         call new_block_solver(reduced%m_solver, w, reduced%coupling, identity(m), 'M_r', error)
+      else
+         call new_block_solver(reduced%m_solver, w, reduced%coupling, reduced%mass_pp, 'M_r', error)
+      end if
       if (allocated(error)) return
 
       allocate (reduced%z(r + m, m))
       do j = 1, m
          reduced%z(:, j) = 0
          reduced%z(r + j, j) = 1
-         call block_solve(reduced%a_solver, reduced%z(:, j))
+         if (reduced%massless) then
+            call massless_solve(reduced, reduced%z(:, j))
+         else
+            call block_solve(reduced%a_solver, reduced%z(:, j))
+         end if
       end do
       reduced%tip_row = reduced%basis(model%tip, :)
       if (model%stops%m > 0) then
@@ -333,6 +397,37 @@ contains
       end if
       call reduced_spectrum(scene, reduced, error)
    end subroutine build_reduced
+
+   !> Solve A_r x = y in place for the massless boundary (m = 1), O(r), allocation-free:
+   !> A_r = [D + s G G^T/S_bb, s G; s G^T, s S_bb] (s = dt^2 beta, D diagonal) gives
+   !> x_a = D^{-1} (y_a - G y_p/S_bb), x_p = (y_p/s - G.x_a)/S_bb.
+   pure subroutine massless_solve(reduced, y)
+      !> Reduced model (massless).
+      type(reduced_model_type), intent(in) :: reduced
+      !> Right-hand side on entry, solution on return (r + 1).
+      real(wp), intent(inout) :: y(:)
+      integer :: r, i
+      real(wp) :: yp, acc
+      r = reduced%r
+      yp = y(r + 1)
+      acc = 0
+      do i = 1, r
+         y(i) = reduced%a_solver%dinv(i)*(y(i) - reduced%a_solver%b(i, 1)*yp)
+         acc = acc + reduced%stiffness_coupling(i, 1)*y(i)
+      end do
+      y(r + 1) = (yp/reduced%row_scale - acc)/reduced%stiffness_pp(1, 1)
+   end subroutine massless_solve
+
+   !> The m x m identity.
+   pure function identity(m) result(e)
+      integer, intent(in) :: m
+      real(wp) :: e(m, m)
+      integer :: j
+      e = 0
+      do j = 1, m
+         e(j, j) = 1
+      end do
+   end function identity
 
    !> The unknowns 1..n not in b, ascending.
    pure function interior_unknowns(n, b) result(interior)
@@ -366,19 +461,27 @@ contains
    !> eigenvalues by dsbgvx alone (O(n^2)) and each eigenvector by inverse iteration with the
    !> band LU factor of S_ii - lambda_k M_ii (O(n) a mode), or (on request) all by dsbgvx with
    !> its n x n orthogonal matrix (O(n^3)).
-   subroutine fixed_interface_modes(stiffness, mass, interior, r, by_inverse_iteration, lambda, phi, error)
+   subroutine fixed_interface_modes(stiffness, mass, interior, r, by_inverse_iteration, lambda, phi, error, &
+      & stiffness_ii)
       real(wp), intent(in) :: stiffness(:, :), mass(:, :)
       integer, intent(in) :: interior(:), r
       logical, intent(in) :: by_inverse_iteration
       real(wp), allocatable, intent(out) :: lambda(:), phi(:, :)
       type(error_type), allocatable, intent(out) :: error
+      !> The interior stiffness to use instead of S_ii (band, kd + 1 by n - m): the massless
+      !> boundary's condensed S_ii - S_ib S_bb^{-1} S_bi.
+      real(wp), intent(in), optional :: stiffness_ii(:, :)
       real(wp), allocatable :: sa(:, :), ma(:, :), sb(:, :), mb(:, :), q(:, :), w(:), work(:)
       integer, allocatable :: iwork(:), ifail(:)
       integer :: ni, found, info, stat
       character :: range, jobz
       ni = size(interior)
       allocate (sa(kd + 1, ni), ma(kd + 1, ni))
-      sa = band_restriction(stiffness, interior)
+      if (present(stiffness_ii)) then
+         sa = stiffness_ii
+      else
+         sa = band_restriction(stiffness, interior)
+      end if
       ma = band_restriction(mass, interior)
       jobz = 'V'
       if (by_inverse_iteration) then
@@ -600,7 +703,8 @@ contains
       end do
    end subroutine block_solve
 
-   !> y = S_r q = (Lambda a, K_pp p), O(r + m^2).
+   !> y = S_r q = (Lambda a, K_pp p), O(r + m^2); with the massless boundary
+   !> (Lambda a + G p, G^T a + S_bb p), O(r m + m^2).
    pure subroutine reduced_stiffness_product(reduced, q, y)
       !> Reduced model.
       type(reduced_model_type), intent(in) :: reduced
@@ -619,6 +723,12 @@ contains
          end do
          y(r + i) = acc
       end do
+      if (reduced%massless) then
+         ! (Lambda_c a + G (G.a/S_bb + p), G.a + S_bb p) (m = 1).
+         acc = dot_product(reduced%stiffness_coupling(:, 1), q(1:r))
+         y(1:r) = y(1:r) + reduced%stiffness_coupling(:, 1)*(acc/reduced%stiffness_pp(1, 1) + q(r + 1))
+         y(r + 1) = y(r + 1) + acc
+      end if
    end subroutine reduced_stiffness_product
 
    !> d^T M_r d = a.a + 2 a.(B p) + p.(M_pp p), O(r m + m^2).
@@ -697,6 +807,12 @@ contains
       mass(r + 1:, 1:r) = transpose(reduced%coupling)
       mass(r + 1:, r + 1:) = reduced%mass_pp
       stiffness(r + 1:, r + 1:) = reduced%stiffness_pp
+      if (reduced%massless) then
+         stiffness(1:r, 1:r) = stiffness(1:r, 1:r) + matmul(reduced%stiffness_coupling, &
+            & transpose(reduced%stiffness_coupling))/reduced%stiffness_pp(1, 1)
+         stiffness(1:r, r + 1:) = reduced%stiffness_coupling
+         stiffness(r + 1:, 1:r) = transpose(reduced%stiffness_coupling)
+      end if
    end subroutine reduced_matrices
 
    !> u = T q (n) from a reduced vector.
@@ -750,7 +866,9 @@ contains
          s = reduced%r + reduced%tip_stop
          sr(s, s) = sr(s, s) + scene%stiffness_per_mass
       end if
-      s = reduced%size
+      if (reduced%massless) call massless_condensation(reduced%r, reduced%m, mr, sr, error)
+      if (allocated(error)) return
+      s = size(sr, 1)
       allocate (w(s), work(max(1, 3*s)))
       call dsygv(1, 'N', 'U', s, sr, s, mr, s, w, work, size(work), info)
       if (info /= 0) then

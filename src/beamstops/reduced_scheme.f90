@@ -9,6 +9,8 @@
 !>               + (1 - 2 beta) q^n S_r q^{n+1}]
 !> is the full model's energy of u = T q, and its balance (SPEC 6) holds as in the full loop.
 !> A step costs O(r m + m^2) (the block solve of A_r and S_r q): the modal block is diagonal.
+!> With mass redistribution (reduced%massless) the loop is advance_massless: the massless tip
+!> stepped as the full model's equilibrium row (its kernels in reduced_massless.f90).
 !> Records go to the same recorder interface, snapshots expanded to the nodes (u = T q).
 !> The loop allocates nothing and writes nothing itself.
 module beamstops_reduced_scheme
@@ -25,6 +27,8 @@ module beamstops_reduced_scheme
    use beamstops_contact_compliance, only: spring_force, solve_spring_tip
    use beamstops_contact_span_stops, only: span_work_type, new_span_work, span_contact, span_settle, span_energy
    use beamstops_contact_box_qp, only: qp_solved, qp_message
+   use beamstops_contact_mass_redistribution, only: massless_reaction
+   use beamstops_reduced_massless, only: coupling_dots, massless_rhs, massless_update, equilibrium_start
    use beamstops_observe_observer, only: observer_type, observe_scene
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
       & col_work, col_dissipated, col_damped
@@ -136,9 +140,14 @@ contains
             call reduced_damping_product(reduced, reduced%v0, state%sq)
             state%x = state%x - state%sq
          end if
+         ! The massless boundary: M_r = diag(I, 0); the stop coordinates' accelerations 0 (their
+         ! values follow from their equilibrium below), as the full model's start.
+         if (reduced%massless) state%x(reduced%r + 1:) = 0
          call block_solve(reduced%m_solver, state%x)
          state%q = state%q + 0.5_wp*reduced%dt2*state%x
       end if
+      if (reduced%massless) call equilibrium_start(reduced%r, reduced%m, reduced%stiffness_coupling, &
+         & reduced%stiffness_pp, reduced%load, load_average(1_ik, dt, scene%omega, scene%centered_load), state%q)
       if (reduced%stops%m > 0) then
          call start_span(scene, reduced, state, error)
          if (allocated(error)) return
@@ -371,6 +380,10 @@ contains
       logical :: contact, recording, span, enforce, damped
       type(load_rotation) :: loads
 
+      if (reduced%massless) then
+         call advance_massless(scene, reduced, state, recorder, last, done)
+         return
+      end if
       dt2 = reduced%dt2
       pt = tip_coordinate(reduced)
       span = reduced%stops%m > 0
@@ -505,6 +518,108 @@ contains
       state%step = done + 1
    end subroutine advance_reduced
 
+   !> advance_reduced with the massless boundary (mass redistribution, SPEC 10; the tip-only
+   !> scene, m = 1): the stop coordinate p carries no mass and is stepped as the equilibrium of
+   !> its row at t_{n+1}, as the full model's massless tip (equilibrium_rows):
+   !>   rhs_p = dt^2 beta (sigma_{n+1} l_p - (S_r q^n)_p - (S_r d^{n-1})_p),
+   !> the modal rows as the plain loop's with the stiffness coupling G p in S_r q; then the same
+   !> contact law at p, no exact fix-up of p (d stays the primary variable), and the reaction
+   !> of the step as the residual of p's Newmark row (massless_reaction). O(r) a step.
+   subroutine advance_massless(scene, reduced, state, recorder, last, done)
+      type(scene_type), intent(in) :: scene
+      type(reduced_model_type), intent(in) :: reduced
+      type(reduced_state_type), intent(inout) :: state
+      class(recorder_type), intent(inout) :: recorder
+      integer(ik), intent(in) :: last
+      integer(ik), intent(out) :: done
+      integer(ik) :: step, next_record, next_snapshot
+      integer :: pt, r
+      real(wp) :: sigma_next, weight, c, gd, tip_value, r_step, r_prev, old_tip, old_dtip, sbb, s_u, s_d_prev, acc
+      real(wp) :: u_tip_prev, d_tip_prev, u_old_su, row(n_columns), g_q, g_d, y_p
+      logical :: contact, recording
+      type(load_rotation) :: loads
+
+      r = reduced%r
+      pt = r + 1
+      sbb = reduced%stiffness_pp(1, 1)
+      call first_events(scene, state%step, next_record, next_snapshot)
+      done = state%step - 1
+      u_old_su = 0
+      u_tip_prev = 0
+      d_tip_prev = 0
+      call start_loads(loads, state%step + 1, reduced%dt, scene%omega, scene%centered_load)
+      do step = state%step, last
+         sigma_next = loads%sigma
+         call next_load(loads)
+         weight = reduced%beta*sigma_next + (1 - 2*reduced%beta)*state%sigma_now + reduced%beta*state%sigma_prev
+         recording = step == next_record
+         if (recording) then
+            u_old_su = stiffness_norm2(reduced, state%q)
+            u_tip_prev = state%q(pt)
+            d_tip_prev = state%d(pt)
+         end if
+         ! G.a and G.d_a, then (S_r q^n)_p, (S_r d^{n-1})_p and the tip's equilibrium row.
+         call coupling_dots(r, reduced%stiffness_coupling(:, 1), state%q, state%d, g_q, g_d)
+         s_u = g_q + sbb*state%q(pt)
+         s_d_prev = g_d + sbb*state%d(pt)
+         y_p = reduced%row_scale*(sigma_next*reduced%load(pt) - (s_u + s_d_prev))
+         ! x_a = D^{-1} (y_a - G y_p/S_bb) with y_a = dt^2 (weight l_a - (S_r q)_a) [- dt (C_r d)_a],
+         ! (S_r q)_a = Lambda_c a + G s_u/S_bb; x_p = (y_p/(dt^2 beta) - G.x_a)/S_bb (massless_solve).
+         if (reduced%damped) then
+            call massless_rhs(r, reduced%a_solver%dinv, reduced%a_solver%b(:, 1), reduced%lambda, &
+               & reduced%stiffness_coupling(:, 1), reduced%load, state%q, reduced%dt2, weight, s_u, y_p, state%x, &
+               & acc, state%cd, reduced%dt)
+         else
+            call massless_rhs(r, reduced%a_solver%dinv, reduced%a_solver%b(:, 1), reduced%lambda, &
+               & reduced%stiffness_coupling(:, 1), reduced%load, state%q, reduced%dt2, weight, s_u, y_p, state%x, acc)
+         end if
+         state%x(pt) = (y_p/reduced%row_scale - acc)/sbb
+         r_prev = state%reaction
+         old_tip = state%q(pt)
+         old_dtip = state%d(pt)
+         call contact_law(scene, reduced, state, old_tip + (old_dtip + state%x(pt)), c, tip_value, r_step, contact)
+         call massless_update(r, reduced%z(:, 1), reduced%load, reduced%stiffness_coupling(:, 1), c, state%x, &
+            & state%d, state%q, gd, g_d)
+         r_step = massless_reaction(reduced%beta, weight, reduced%load(pt), s_u, s_d_prev, g_d + sbb*state%d(pt))
+         if (scene%law /= law_none) state%max_violation = max(state%max_violation, violation(state%q(pt), scene))
+         if (contact .and. .not. state%in_contact) state%impacts = state%impacts + 1
+         state%in_contact = contact
+         state%work = state%work + 0.5_wp*weight*(gd + state%gd_prev)
+         state%dissipated = state%dissipated - 0.5_wp*r_step*(state%d(pt) + old_dtip)
+         if (reduced%damped) call damping_loss(reduced, state)
+         state%reaction = r_step
+         if (state%observer%active) call state%observer%tip(real(step + 1, wp)*reduced%dt, state%q(pt), &
+            & merge(r_step, 0.0_wp, contact), state%dissipated)
+         state%gd_prev = gd
+         state%sigma_prev = state%sigma_now
+         state%sigma_now = sigma_next
+         if (recording) then
+            next_record = next_record + scene%record_every
+            row = 0
+            row(col_t) = real(step, wp)*reduced%dt
+            row(col_u) = u_tip_prev
+            row(col_v) = (state%d(pt) + d_tip_prev)/(2*reduced%dt)
+            row(col_reaction) = scene%mass_per_length*r_prev
+            row(col_work) = scene%mass_per_length*state%work
+            row(col_dissipated) = scene%mass_per_length*state%dissipated
+            row(col_damped) = scene%mass_per_length*state%damped
+            ! M_r = diag(I, 0): d.M_r d = d_a.d_a.
+            call reduced_stiffness_product(reduced, state%q, state%sq)
+            row(col_energy) = scene%mass_per_length*energy(reduced, dot_product(state%d(1:r), state%d(1:r)), &
+               & dot_product(state%q, state%sq), dot_product(state%d, state%sq), u_old_su)
+            call recorder%record(row)
+         end if
+         if (step == next_snapshot) then
+            next_snapshot = next_snapshot + scene%snapshot_every
+            state%x = state%q - state%d
+            call physical_shape(reduced, state%x, real(step, wp)*reduced%dt, scene, state%shape)
+            call recorder%snapshot(real(step, wp)*reduced%dt, state%shape)
+         end if
+         done = step
+      end do
+      state%step = done + 1
+   end subroutine advance_massless
+
    !> The tip value of a reduced vector: its tip coordinate when the tip is a stop, else T(tip, :) q.
    pure function tip_value_of(reduced, q) result(u)
       type(reduced_model_type), intent(in) :: reduced
@@ -536,6 +651,11 @@ contains
          end do
          qsq = qsq + q(r + j)*acc
       end do
+      ! The massless boundary: + (G.a)^2/S_bb + 2 p G.a (m = 1).
+      if (reduced%massless) then
+         acc = dot_product(reduced%stiffness_coupling(:, 1), q(1:r))
+         qsq = qsq + acc*(acc/reduced%stiffness_pp(1, 1) + 2*q(r + 1))
+      end if
    end function stiffness_norm2
 
    !> The modal parts of q.S_r q, d.S_r q and d.M_r d in one sweep (the coupling's B d_a kept in

@@ -8,10 +8,11 @@
 !> (u^{n+1} + e u^{n-1})/(1 + e) satisfies the KKT conditions every step in reduced coordinates.
 module test_reduced_physics
    use testing
-   use test_support, only: int_text
+   use test_support, only: int_text, run_recorded, band_eigenvalues
+   use beamstops_model, only: model_type, build_model
    use test_reduced, only: run_reduced_recorded, compare_full
    use physics_support, only: peaks
-   use beamstops, only: ik, scene_type, array_recorder, run_summary, law_none, law_signorini, validate_scene, &
+   use beamstops, only: ik, scene_type, array_recorder, run_summary, law_none, law_signorini, law_compliance, validate_scene, &
       & steps_of, scene_from_text, record_count, stop_count, status_complete
    use beamstops_forcing, only: load_average
    use beamstops_lapack, only: dsygv
@@ -19,7 +20,7 @@ module test_reduced_physics
    use beamstops_reduced_scheme, only: reduced_state_type, simulate_reduced, start_reduced, advance_reduced, run_reduced
    use beamstops_reduced_checkpoint, only: write_reduced_checkpoint, read_reduced_checkpoint
    use beamstops_files, only: remove_file
-   use beamstops_recorder, only: col_t, col_u, col_energy, col_work, col_dissipated, col_damped
+   use beamstops_recorder, only: col_t, col_u, col_energy, col_work, col_dissipated, col_damped, col_v, col_reaction
    implicit none
    private
    public :: collect_reduced_physics
@@ -40,6 +41,20 @@ contains
          & new_unittest('r = 6, e = 0.5: KKT of the combination every step, in reduced coordinates', test_kkt_restitution), &
          & new_unittest('a reduced run (damped, restitution, three stops, statistics) resumed from a checkpoint: '// &
          & 'the same bits', test_resume), &
+         & new_unittest('massless boundary, all modes: the full redistributed engine to round-off through the '// &
+         & 'first contact period', test_full_massless), &
+         & new_unittest('massless boundary, all modes, mass damping: the full redistributed engine', &
+         & test_full_massless_damped), &
+         & new_unittest('massless boundary, all modes, restitution e = 0.5 / compliance: the full redistributed '// &
+         & 'engine', test_full_massless_laws), &
+         & new_unittest('massless boundary: its frequencies are the full redistributed model''s lowest r for any r; '// &
+         & 'its kappa (beta < 1/4) the full kappa_h', test_massless_frequencies), &
+         & new_unittest('massless boundary, no contact: E - E0 = W - damped to round-off', test_massless_balance), &
+         & new_unittest('massless boundary, r = 8: KKT of the projection every step; the rows are the scheme''s', &
+         & test_massless_kkt), &
+         & new_unittest('massless boundary, r = 8: the stops'' energy -> 0 and the tip converges in dt through the '// &
+         & 'first contact period', test_massless_convergence), &
+         & new_unittest('a massless-boundary run resumed from a checkpoint: the same bits', test_massless_resume), &
          & new_unittest('&mesh modes with damping and restitution accepted; what remains refused', test_validate) &
          & ]
    end subroutine collect_reduced_physics
@@ -359,6 +374,378 @@ contains
       call check(error, sa%impacts == sb%impacts .and. sa%impacts > 0, 'the shocks')
    end subroutine test_resume
 
+   ! ---------------------------------------------------------------- the massless boundary (SPEC 10, 11)
+
+   !> The paper's scene through the first contact period (t <= 0.125 s), beta = 1/4, mass
+   !> redistributed, centred load, Taylor start, records every 1e-5 s.
+   function massless_scene(dt, modes) result(scene)
+      real(wp), intent(in) :: dt
+      integer, intent(in) :: modes
+      type(scene_type) :: scene
+      scene%law = law_signorini
+      scene%beta = 0.25_wp
+      scene%dt = dt
+      scene%t_end = 0.125_wp
+      scene%record_every = nint(1.0e-5_wp/dt)
+      scene%redistributed_mass = .true.
+      scene%modes = modes
+   end function massless_scene
+
+   !> T = [Phi E_tip] with all r = n - 1 modes is a change of basis of the full redistributed model
+   !> (the tip row the same equilibrium): every column to round-off before the first impact, the
+   !> tip, energy and work within 1e-6 of their scale through the impacts of the first contact
+   !> period, and the same contact phases.
+   subroutine test_full_massless(error)
+      type(error_type), allocatable, intent(out) :: error
+      call compare_massless(massless_scene(6.25e-7_wp, 0), error)
+   end subroutine test_full_massless
+
+   !> The full redistributed run and the all-modes (r = n - 1) massless boundary: t, u, v,
+   !> reaction, energy, work and damped within 1e-10 of their scale before the first impact
+   !> (t <= 0.085 s); u, energy and work within 1e-6 of their scale through the contact period;
+   !> the stops' energy (O(dt^2), ~0) within 1e-8 of the work's scale; the same contact phases.
+   subroutine compare_massless(scene, error)
+      type(scene_type), intent(in) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: reduced_scene
+      type(array_recorder) :: full, red
+      type(run_summary) :: sf, sr
+      integer, parameter :: clean_columns(7) = [col_t, col_u, col_v, col_reaction, col_energy, col_work, col_damped]
+      real(wp) :: clean, whole, work_scale
+      integer(ik) :: last
+      integer :: k, col
+      reduced_scene = scene
+      reduced_scene%modes = 2*scene%elements - 1
+      call run_recorded(scene, full, sf, error)
+      if (allocated(error)) return
+      call run_reduced_recorded(reduced_scene, red, sr, error)
+      if (allocated(error)) return
+      call check(error, red%filled == full%filled, 'as many records'); if (allocated(error)) return
+      last = count(full%rows(col_t, :full%filled) <= 0.085_wp, kind=ik)
+      do k = 1, size(clean_columns)
+         col = clean_columns(k)
+         clean = relative_difference(full, red, col, last)
+         whole = relative_difference(full, red, col, full%filled)
+         call note('column '//int_text(col)//': largest difference / scale up to 0.085 s '//real_text(clean)// &
+            & ', up to t_end '//real_text(whole))
+         call check(error, clean, 0.0_wp, 'column '//int_text(col)//' before the first impact', thr=1e-10_wp)
+         if (allocated(error)) return
+         if (any(col == [col_u, col_energy, col_work])) call check(error, whole, 0.0_wp, 'column '//int_text(col)// &
+            & ' through the contact period', thr=1e-6_wp)
+         if (allocated(error)) return
+      end do
+      work_scale = maxval(abs(full%rows(col_work, :full%filled)))
+      whole = maxval(abs(full%rows(col_dissipated, :full%filled) - red%rows(col_dissipated, :red%filled)))/work_scale
+      call note('stops'' energy: largest difference / work scale '//real_text(whole)//'; contact phases: full '// &
+         & int_text(sf%impacts)//', reduced '//int_text(sr%impacts))
+      call check(error, whole, 0.0_wp, 'the stops'' energy', thr=1e-8_wp)
+      if (allocated(error)) return
+      call check(error, sf%impacts > 0, 'the scene has impacts'); if (allocated(error)) return
+      call check(error, int(sr%impacts), int(sf%impacts), 'the same contact phases')
+   end subroutine compare_massless
+
+   !> Largest difference of a column over rows 1..last, relative to the column's largest value.
+   function relative_difference(a, b, c, last) result(diff)
+      type(array_recorder), intent(in) :: a, b
+      integer, intent(in) :: c
+      integer(ik), intent(in) :: last
+      real(wp) :: diff
+      diff = maxval(abs(a%rows(c, :last) - b%rows(c, :last)))/max(maxval(abs(a%rows(c, :a%filled))), tiny(1.0_wp))
+   end function relative_difference
+
+   !> The same with mass-proportional damping (a = 3/s; the full model refuses b > 0 with
+   !> redistribution) and beta = 1/2.
+   subroutine test_full_massless_damped(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      scene = massless_scene(1.25e-6_wp, 0)
+      scene%beta = 0.5_wp
+      scene%damping_mass = 3.0_wp
+      call compare_massless(scene, error)
+   end subroutine test_full_massless_damped
+
+   !> The massless tip's static condensation is exact, so the finite spectrum of (S, M^rho) is that
+   !> of the interior (S_ii - S_ib S_bi/S_bb, M^rho_ii), whose first r modes the basis takes: the
+   !> reduced model's squared frequencies (M_r = diag(I, 0), S_r condensed: Lambda_c) are the full
+   !> redistributed model's r lowest for every r (J = 19: r = 3, 8, 37), to 1e-10; with
+   !> beta = 0.2 the reduced kappa of r = n - 1 is the full kappa_h and the reduced Newmark limit
+   !> at r = 8 is larger than the full one (dt may grow).
+   subroutine test_massless_frequencies(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: rs(3) = [3, 8, 37]
+      type(scene_type) :: scene
+      type(model_type) :: model
+      type(reduced_model_type) :: reduced
+      real(wp), allocatable :: mu(:), kappa_full(:)
+      real(wp) :: worst, dt_full
+      integer :: i, k, n
+      scene = massless_scene(1e-5_wp, 1)
+      scene%beta = 0.2_wp
+      call build_model(scene, model, error)
+      if (allocated(error)) return
+      ! (M^rho, S): mu = 1/kappa, the massless mode at mu = 0 (the smallest).
+      call band_eigenvalues(model%mass, model%stiffness, mu, error)
+      if (allocated(error)) return
+      n = size(mu)
+      kappa_full = [(1/mu(n + 1 - k), k=1, n - 1)]
+      do i = 1, size(rs)
+         scene%modes = rs(i)
+         call prepare_reduced(scene, 'test scene', reduced, error)
+         if (allocated(error)) return
+         worst = maxval(abs(reduced%lambda - kappa_full(:rs(i)))/kappa_full(:rs(i)))
+         call note('r = '//int_text(rs(i))//': largest relative difference of omega^2 from the full model''s '// &
+            & real_text(worst)//'; reduced kappa '//real_text(reduced%kappa)//', full kappa_h '// &
+            & real_text(model%kappa_h)//' 1/s^2')
+         call check(error, worst, 0.0_wp, 'the r lowest frequencies', thr=1e-10_wp)
+         if (allocated(error)) return
+         call check(error, reduced%kappa, kappa_full(rs(i)), 'kappa of the reduced model: its largest', rel=.true., &
+            & thr=1e-10_wp)
+         if (allocated(error)) return
+      end do
+      call check(error, reduced%kappa, model%kappa_h, 'r = n - 1: the full kappa_h', rel=.true., thr=1e-10_wp)
+      if (allocated(error)) return
+      scene%modes = 8
+      call prepare_reduced(scene, 'test scene', reduced, error)
+      if (allocated(error)) return
+      dt_full = 2/sqrt((1 - 4*scene%beta)*model%kappa_h)
+      call note('beta = 0.2: Newmark limit of the full model '//real_text(dt_full)//' s, of r = 8 '// &
+         & real_text(reduced%dt_newmark)//' s')
+      call check(error, reduced%dt_newmark > 10*dt_full, 'r = 8 takes a dt ten times the full model''s')
+   end subroutine test_massless_frequencies
+
+   !> The same with the other laws at the massless tip: restitution e = 0.5 (Euler start) and the
+   !> compliance spring (k = 1e6 N/m per unit mass; the full model overwrites the spring's
+   !> explicit part in the tip's row by its equilibrium, and so does the reduced loop).
+   subroutine test_full_massless_laws(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      scene = massless_scene(1.25e-6_wp, 0)
+      scene%restitution = 0.5_wp
+      scene%taylor_start = .false.
+      call compare_massless(scene, error)
+      if (allocated(error)) return
+      scene = massless_scene(1.25e-6_wp, 0)
+      scene%law = law_compliance
+      scene%stiffness_per_mass = 1.0e6_wp
+      call compare_massless(scene, error)
+   end subroutine test_full_massless_laws
+
+   !> No contact (law none, 1 s, dt = 1e-4), beta = 1/4 and 1/2, r = 5 and r = n - 1, with and
+   !> without mass damping: max |(E_n - E_0) - (W_n - damped_n)| / max |E| in the records and the
+   !> summary's residual within 1e-12, and no energy taken at the massless tip.
+   subroutine test_massless_balance(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(array_recorder) :: rec
+      type(run_summary) :: summary
+      real(wp), parameter :: betas(2) = [0.25_wp, 0.5_wp], dampings(2) = [0.0_wp, 3.0_wp]
+      integer, parameter :: rs(2) = [5, 37]
+      integer :: i, k, l
+      integer(ik) :: j
+      real(wp) :: worst, escale
+      do l = 1, 2
+         do k = 1, 2
+            do i = 1, 2
+               scene = scene_type()
+               scene%law = law_none
+               scene%beta = betas(k)
+               scene%dt = 1e-4_wp
+               scene%t_end = 1.0_wp
+               scene%modes = rs(i)
+               scene%redistributed_mass = .true.
+               scene%damping_mass = dampings(l)
+               call run_reduced_recorded(scene, rec, summary, error)
+               if (allocated(error)) return
+               escale = maxval(abs(rec%rows(col_energy, :rec%filled)))
+               worst = 0
+               do j = 1, rec%filled
+                  worst = max(worst, abs((rec%rows(col_energy, j) - rec%rows(col_energy, 1)) &
+                     & - (rec%rows(col_work, j) - rec%rows(col_damped, j) - rec%rows(col_dissipated, j))))
+               end do
+               call note('beta = '//real_text(betas(k))//', r = '//int_text(rs(i))//', a = '// &
+                  & real_text(dampings(l))//': balance defect / max |E| '//real_text(worst/escale)// &
+                  & ', summary residual / max |E| '//real_text(summary%energy_residual/escale)//', tip''s energy '// &
+                  & real_text(rec%rows(col_dissipated, rec%filled))//' J')
+               call check(error, worst/escale, 0.0_wp, 'balance defect', thr=1e-10_wp)
+               if (allocated(error)) return
+               call check(error, summary%energy_residual/escale, 0.0_wp, 'summary residual', thr=1e-10_wp)
+               if (allocated(error)) return
+               if (dampings(l) > 0) call check(error, summary%damped > 0.01_wp*escale, 'the damping takes energy')
+               if (allocated(error)) return
+            end do
+         end do
+      end do
+   end subroutine test_massless_balance
+
+   !> Step by step (r = 8, first contact period, dt = 1.25e-6): the residual
+   !> rho = A_r (d^n - d^{n-1}) - rhs of the scheme vanishes in the modal rows, with the tip's
+   !> rhs its equilibrium at t_{n+1}; there rho/(dt^2 beta) = (S_r q^{n+1})_tip - sigma_{n+1} l_tip
+   !> is the stops' force: the tip within the stops, the force zero unless the tip is on a stop,
+   !> pushing away from it; and E - E0 = W - D through the contacts.
+   subroutine test_massless_kkt(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(reduced_model_type) :: reduced
+      type(reduced_state_type) :: state
+      type(array_recorder) :: rec
+      real(wp), allocatable :: mr(:, :), sr(:, :), ar(:, :), q_old(:), d_old(:), rho(:), rhs(:), sd(:)
+      real(wp) :: weight, sigma_next, scale, worst_rows, force, tol_u, worst_balance
+      integer(ik) :: step, done, steps, contacts, j
+      integer :: pt
+      scene = massless_scene(1.25e-6_wp, 8)
+      call validate_scene(scene, 'test scene', error)
+      if (allocated(error)) return
+      call prepare_reduced(scene, 'test scene', reduced, error)
+      if (allocated(error)) return
+      call reduced_matrices(reduced, mr, sr)
+      call check(error, all(mr(:, reduced%r + 1) == 0) .and. all(mr(reduced%r + 1, :) == 0), &
+         & 'M_r = diag(I, 0): the tip coordinate carries no mass')
+      if (allocated(error)) return
+      ar = mr + scene%dt**2*scene%beta*sr
+      pt = reduced%r + reduced%tip_stop
+      steps = steps_of(scene)
+      call rec%reserve(record_count(scene), 0_ik, scene%elements + 1)
+      call start_reduced(scene, reduced, state, rec, error)
+      if (allocated(error)) return
+      worst_rows = 0
+      contacts = 0
+      tol_u = 8*epsilon(1.0_wp)*scene%upper
+      do step = 1, steps
+         q_old = state%q
+         d_old = state%d
+         call advance_reduced(scene, reduced, state, rec, step, done)
+         sigma_next = load_average(step + 1, scene%dt, scene%omega, .true.)
+         weight = scene%beta*sigma_next + (1 - 2*scene%beta)*load_average(step, scene%dt, scene%omega, .true.) &
+            & + scene%beta*load_average(step - 1, scene%dt, scene%omega, .true.)
+         rhs = scene%dt**2*(weight*reduced%load - matmul(sr, q_old))
+         sd = matmul(sr, d_old)
+         rhs(pt) = scene%dt**2*scene%beta*(sigma_next*reduced%load(pt) - dot_product(sr(pt, :), q_old) - sd(pt))
+         rho = matmul(ar, state%d - d_old) - rhs
+         scale = maxval(matmul(abs(ar), abs(state%d) + abs(d_old)) + scene%dt**2*(matmul(abs(sr), &
+            & abs(q_old) + abs(d_old)) + abs(reduced%load)))
+         worst_rows = max(worst_rows, maxval(abs(rho(:pt - 1)))/scale)
+         force = rho(pt)/(scene%dt**2*scene%beta)
+         call check(error, state%q(pt) >= scene%lower - tol_u .and. state%q(pt) <= scene%upper + tol_u, 'step '// &
+            & int_text(step)//': tip '//real_text(state%q(pt))//' within the stops')
+         if (allocated(error)) return
+         if (abs(rho(pt)) > 1e-12_wp*scale) then
+            contacts = contacts + 1
+            call check(error, (force > 0 .and. abs(state%q(pt) - scene%lower) <= tol_u) .or. &
+               & (force < 0 .and. abs(state%q(pt) - scene%upper) <= tol_u), 'step '//int_text(step)//': force '// &
+               & real_text(force)//' only with the tip on a stop, pushing away from it (tip '// &
+               & real_text(state%q(pt))//')')
+            if (allocated(error)) return
+         end if
+      end do
+      worst_balance = 0
+      do j = 1, rec%filled
+         worst_balance = max(worst_balance, abs(rec%rows(col_energy, j) - rec%rows(col_energy, 1) &
+            & - rec%rows(col_work, j) + rec%rows(col_dissipated, j)))
+      end do
+      call note('contact steps '//int_text(contacts)//', largest residual off the tip row / scale '// &
+         & real_text(worst_rows)//', balance defect '//real_text(worst_balance)//' J, max |E| '// &
+         & real_text(maxval(abs(rec%rows(col_energy, :rec%filled))))//' J')
+      call check(error, contacts > 10, 'the tip meets the stops'); if (allocated(error)) return
+      call check(error, worst_rows, 0.0_wp, 'residual of the modal rows', thr=1e-14_wp)
+      if (allocated(error)) return
+      call check(error, worst_balance < 1e-12_wp*maxval(abs(rec%rows(col_energy, :rec%filled))), &
+         & 'E - E0 = W - D through the contacts')
+   end subroutine test_massless_kkt
+
+   !> r = 8 (the first contact period): the stops' energy at t = 0.125 s -> 0 at order > 1.5
+   !> between dt = 2.5e-6 and 1.25e-6, and the tip's largest error on [0.08, 0.125] s against
+   !> dt = 7.8125e-8 falls at order > 1 from dt = 2.5e-6 to 6.25e-7, with the same contact
+   !> phases in the two finest runs.
+   subroutine test_massless_convergence(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(array_recorder) :: ref, a, b, c
+      type(run_summary) :: sref, sa, sb, sc
+      real(wp) :: ea, ec, order, da, db, stop_order
+      call run_reduced_recorded(massless_scene(7.8125e-8_wp, 8), ref, sref, error)
+      if (allocated(error)) return
+      call run_reduced_recorded(massless_scene(2.5e-6_wp, 8), a, sa, error)
+      if (allocated(error)) return
+      call run_reduced_recorded(massless_scene(1.25e-6_wp, 8), b, sb, error)
+      if (allocated(error)) return
+      call run_reduced_recorded(massless_scene(6.25e-7_wp, 8), c, sc, error)
+      if (allocated(error)) return
+      ea = late_distance(a, ref)
+      ec = late_distance(c, ref)
+      order = log(ea/ec)/log(4.0_wp)
+      da = a%rows(col_dissipated, a%filled)
+      db = b%rows(col_dissipated, b%filled)
+      stop_order = log(abs(da/db))/log(2.0_wp)
+      call note('r = 8: error on [0.08, 0.125] s against dt = 7.8125e-8: '//real_text(ea)//' (dt = 2.5e-6), '// &
+         & real_text(late_distance(b, ref))//' (1.25e-6), '//real_text(ec)//' m (6.25e-7): order '// &
+         & real_text(order)//'; stops'' energy '//real_text(da)//', '//real_text(db)//' J (order '// &
+         & real_text(stop_order)//'), work '//real_text(b%rows(col_work, b%filled))//' J; contact phases '// &
+         & int_text(sa%impacts)//', '//int_text(sb%impacts)//', '//int_text(sc%impacts)//', '//int_text(sref%impacts))
+      call check(error, sref%impacts > 0, 'the tip meets the stops'); if (allocated(error)) return
+      call check(error, order > 1.0_wp, 'the tip converges at order > 1'); if (allocated(error)) return
+      call check(error, stop_order > 1.5_wp, 'the stops'' energy -> 0 at order > 1.5'); if (allocated(error)) return
+      call check(error, abs(db) < 1.0e-4_wp*b%rows(col_work, b%filled), 'the stops'' energy below 1e-4 of the work')
+      if (allocated(error)) return
+      call check(error, int(sc%impacts), int(sref%impacts), 'the same contact phases as the reference')
+   end subroutine test_massless_convergence
+
+   !> max |u_tip - reference| on [0.08, 0.125] s at the common record times (every 1e-5 s).
+   function late_distance(a, ref) result(e)
+      type(array_recorder), intent(in) :: a, ref
+      real(wp) :: e
+      e = maxval(abs(a%rows(col_u, 1:a%filled) - ref%rows(col_u, 1:ref%filled)), &
+         & mask=a%rows(col_t, 1:a%filled) >= 0.08_wp - 1.0e-12_wp)
+   end function late_distance
+
+   !> The massless boundary (r = 8, mass damping, statistics) to step 40000 (past the first
+   !> impacts), checkpointed, read back; both continued to t = 0.2 s: the records, q, d and the
+   !> energy ledger to the bit.
+   subroutine test_massless_resume(error)
+      character(len=*), parameter :: path = 'test_reduced_massless.checkpoint'
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(reduced_model_type) :: reduced
+      type(reduced_state_type) :: straight, resumed
+      type(array_recorder) :: a, b
+      type(run_summary) :: sa, sb
+      integer(ik) :: records, snapshots, first
+      scene = massless_scene(2.5e-6_wp, 8)
+      scene%t_end = 0.2_wp
+      scene%damping_mass = 2.0_wp
+      scene%statistics = .true.
+      scene%transient = 0.05_wp
+      scene%batches = 4
+      call validate_scene(scene, 'test scene', error)
+      if (allocated(error)) return
+      call prepare_reduced(scene, 'test scene', reduced, error)
+      if (allocated(error)) return
+      call a%reserve(record_count(scene), 0_ik, scene%elements + 1)
+      call b%reserve(record_count(scene), 0_ik, scene%elements + 1)
+      call start_reduced(scene, reduced, straight, a, error)
+      if (allocated(error)) return
+      call run_reduced(scene, reduced, straight, a, sa, 40000_ik)
+      call check(error, sa%status == 'running' .and. straight%step == 40001 .and. straight%impacts > 0, &
+         & 'stopped at step 40000, after impacts')
+      if (allocated(error)) return
+      call write_reduced_checkpoint(path, scene, straight, a%filled, 0_ik, error)
+      if (allocated(error)) return
+      call read_reduced_checkpoint(path, scene, reduced, resumed, records, snapshots, error)
+      call remove_file(path)
+      if (allocated(error)) return
+      first = a%filled + 1
+      b%filled = a%filled
+      call run_reduced(scene, reduced, straight, a, sa)
+      call run_reduced(scene, reduced, resumed, b, sb)
+      call check(error, sa%status == status_complete .and. sb%status == status_complete, 'both complete')
+      if (allocated(error)) return
+      call check(error, all(a%rows(:, first:a%filled) == b%rows(:, first:b%filled)) .and. a%filled == b%filled, &
+         & 'the records after the checkpoint to the bit')
+      if (allocated(error)) return
+      call check(error, all(straight%q == resumed%q) .and. all(straight%d == resumed%d), 'q and d to the bit')
+      if (allocated(error)) return
+      call check(error, sa%damped == sb%damped .and. sa%dissipated == sb%dissipated .and. &
+         & sa%energy_residual == sb%energy_residual .and. sa%impacts == sb%impacts, 'the ledger and the shocks')
+   end subroutine test_massless_resume
+
    !> Read by the one reader (scene_from_text): damping (ratios) and restitution are accepted with
    !> modes > 0; mass redistribution and an ensemble are refused with one message naming the file
    !> and the keys.
@@ -378,8 +765,17 @@ contains
          & 'the scene read')
       if (allocated(error)) return
       call scene_from_text('&mesh modes = 5 /'//nl//"&stops mass = 'redistributed' /", 'in.nml', scene, failure)
+      if (allocated(failure)) then
+         call test_failed(error, 'mass redistribution (tip stops) with modes > 0 refused: '//failure%message)
+         return
+      end if
+      call check(error, scene%modes == 5 .and. scene%redistributed_mass, 'the massless boundary read')
+      if (allocated(error)) return
+      call scene_from_text('&beam length = 1.5 /'//nl//'&mesh elements = 30, modes = 5 /'//nl// &
+         & "&stops mass = 'redistributed', x = 0.5, 1.0, 1.5, lower = -0.002, upper = 0.1, 0.2, 0.3 /", 'in.nml', &
+         & scene, failure)
       if (.not. allocated(failure)) then
-         call test_failed(error, 'mass redistribution with modes > 0 refused')
+         call test_failed(error, 'mass redistribution with stops along the span and modes > 0 refused')
          return
       end if
       call note(failure%message)
