@@ -33,14 +33,15 @@ module beamstops_lockstep
    use beamstops_hermite, only: hermite_basis, gauss_points, gauss_weights
    use beamstops_band, only: band_matvec
    use beamstops_band_solve, only: band_solver, band_diagonals, prepare_solver, prepare_diagonals, diagonal_matvec, dot
-   use beamstops_band_solve_lockstep, only: lockstep_forward, lockstep_forward_energy, lockstep_back, &
-      & lockstep_matvec, lockstep_dot, lockstep_min_unknowns, lockstep_work_columns, &
-      & lockstep_lanes, lockstep_matvec_rhs, lockstep_update
+   use beamstops_band_solve_lockstep, only: lockstep_forward, lockstep_forward_energy, lockstep_back_edge, &
+      & lockstep_back_update, lockstep_matvec, lockstep_dot, lockstep_min_unknowns, lockstep_work_columns, &
+      & lockstep_lanes, lockstep_matvec_rhs
+   use beamstops_lockstep_lanes, only: lanes_type, lanes_restart_loads, lanes_next_loads, lanes_begin_step, &
+      & lanes_contact, lanes_close
    use beamstops_state, only: state_type
    use beamstops_scheme, only: start_state, block_steps
    use beamstops_clock, only: thread_cpu_seconds
-   use beamstops_forcing, only: load_average, support_position, lift_shape, lift_slope
-      use beamstops_contact_compliance, only: spring_force, solve_spring_tip
+   use beamstops_forcing, only: support_position, lift_shape, lift_slope
    use beamstops_observe_observer, only: observer_type
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
       & col_work, col_dissipated, col_damped
@@ -73,28 +74,18 @@ module beamstops_lockstep
       real(wp), allocatable :: u(:, :, :), d(:, :, :), su(:, :, :), rhs(:, :, :), g(:, :, :)
       !> Work array of the kernels (lanes, lockstep_work_columns).
       real(wp), allocatable :: partial(:, :)
-      !> Per member, padded to p lanes: load averages sigma_{n-1}, sigma_n; g.d^{n-1}; spring forces p(u^{n-1}), p(u^n);
-      !> work, energy taken by the stops, E^{1/2}, reaction of the last step, largest
-      !> violation (K, per unit mass).
+      !> Per member, padded to p lanes, between blocks (during a block the chunks' lanes hold
+      !> them, beamstops_lockstep_lanes): load averages sigma_{n-1}, sigma_n; g.d^{n-1}; spring
+      !> forces p(u^{n-1}), p(u^n); work, energy taken by the stops, E^{1/2}, reaction of the last
+      !> step, largest violation (per unit mass).
       real(wp), allocatable :: sigma_prev(:), sigma_now(:), gd_prev(:), p_prev(:), p_now(:), work(:), &
          & dissipated(:), energy0(:), reaction(:), max_violation(:)
       !> Whether the last step was in contact; whether the member still runs (K).
       logical, allocatable :: in_contact(:), active(:)
       !> Impacts so far (K).
       integer(ik), allocatable :: impacts(:)
-      !> The load rotation of each member (beamstops_scheme's load_rotation): its step index
-      !> (shared), f sin and f cos of omega c_k, cos and sin of omega dt (K).
-      integer(ik) :: load_k = 0
-      real(wp), allocatable :: sigma(:), cosine(:), cos_step(:), sin_step(:)
-      !> Tip stops of each member (padding lanes: -1, 1) (K).
-      real(wp), allocatable :: lower(:), upper(:)
-      !> Tip value and increment after the update (K).
-      real(wp), allocatable :: u_tip(:), d_tip(:)
-      !> Values of the step (K).
-      real(wp), allocatable :: sigma_next(:), weight(:), coef(:), spring(:), trial(:), c(:), tip_value(:), &
-         & r_step(:), u_tip_prev(:), d_tip_prev(:), r_prev(:), usu(:), dsu(:), dmd(:), u_old_su(:), gd(:)
-      !> Contact in the step; a record waiting for its energy (K).
-      logical, allocatable :: contact(:), pending(:)
+      !> A record waiting for its energy (K).
+      logical, allocatable :: pending(:)
       !> Next record and snapshot step of each member (K).
       integer(ik), allocatable :: next_record(:), next_snapshot(:)
       !> Record rows waiting for their energy (n_columns, K).
@@ -377,19 +368,10 @@ contains
       allocate (ms%sigma_prev(nk), ms%sigma_now(nk), ms%gd_prev(nk), ms%p_prev(nk), ms%p_now(nk), ms%work(nk), &
          & ms%dissipated(nk), ms%energy0(nk), ms%reaction(nk), ms%max_violation(nk), ms%in_contact(nk), &
          & ms%active(nk), ms%impacts(nk))
-      allocate (ms%sigma(nk), ms%cosine(nk), ms%cos_step(nk), ms%sin_step(nk))
-      allocate (ms%sigma_next(nk), ms%weight(nk), ms%coef(nk), ms%spring(nk), ms%trial(nk), ms%c(nk), &
-         & ms%tip_value(nk), ms%r_step(nk), ms%u_tip_prev(nk), ms%d_tip_prev(nk), ms%r_prev(nk), ms%usu(nk), &
-         & ms%dsu(nk), ms%dmd(nk), ms%u_old_su(nk), ms%gd(nk), ms%contact(nk), ms%pending(nk), &
-         & ms%next_record(nk), ms%next_snapshot(nk), ms%rows(n_columns, nk))
+      allocate (ms%pending(nk), ms%next_record(nk), ms%next_snapshot(nk), ms%rows(n_columns, nk))
       allocate (ms%vec_u(n), ms%vec_d(n), ms%vec_su(n), ms%vec_s(n), ms%shape(size(model%x)))
       allocate (ms%observers(ms%k))
-      allocate (ms%lower(nk), ms%upper(nk), ms%u_tip(nk), ms%d_tip(nk))
       call zero_members(ms)
-      ms%lower = -1
-      ms%upper = 1
-      ms%u_tip = 0
-      ms%d_tip = 0
       ms%active = .false.
       ms%active(:ms%k) = .true.
       nk = ms%k
@@ -413,8 +395,6 @@ contains
             return
          end if
          ms%g(lane(k), :, chunk(k)) = member%load
-         ms%lower(k) = scenes(k)%lower
-         ms%upper(k) = scenes(k)%upper
          ms%u(lane(k), :, chunk(k)) = state%u
          ms%d(lane(k), :, chunk(k)) = state%d
          ms%su(lane(k), :, chunk(k)) = state%su
@@ -450,27 +430,6 @@ contains
       ms%max_violation = 0
       ms%in_contact = .false.
       ms%impacts = 0
-      ms%sigma = 0
-      ms%cosine = 0
-      ms%cos_step = 0
-      ms%sin_step = 0
-      ms%sigma_next = 0
-      ms%weight = 0
-      ms%coef = 0
-      ms%spring = 0
-      ms%trial = 0
-      ms%c = 0
-      ms%tip_value = 0
-      ms%r_step = 0
-      ms%u_tip_prev = 0
-      ms%d_tip_prev = 0
-      ms%r_prev = 0
-      ms%usu = 0
-      ms%dsu = 0
-      ms%dmd = 0
-      ms%u_old_su = 0
-      ms%gd = 0
-      ms%contact = .false.
       ms%pending = .false.
       ms%next_record = huge(1_ik)
       ms%next_snapshot = huge(1_ik)
@@ -522,7 +481,11 @@ contains
    end subroutine load_shapes
 
    !> Advance every member from ms%step through step `last` (advance_fused of beamstops_scheme,
-   !> per member, the member index innermost).
+   !> per member, the member index innermost). The members' values live in the chunks' lanes
+   !> (beamstops_lockstep_lanes) during the block. Per step and chunk: the load rotation, S u and
+   !> the right-hand side, the forward substitution (with the energy sums when a record wants
+   !> them); then the tip rows of the back substitution, the contact law of each lane, the rest
+   !> of the back substitution with the update riding on it, g.d and the bookkeeping.
    subroutine advance_members(scenes, model, ops, ms, recorders, last)
       type(scene_type), intent(in) :: scenes(:)
       type(model_type), intent(in) :: model
@@ -530,12 +493,15 @@ contains
       type(members_type), intent(inout) :: ms
       class(recorder_type), intent(inout) :: recorders(:)
       integer(ik), intent(in) :: last
-      integer(ik) :: step, next_record, next_snapshot
-      integer :: k, c, lo, hi, n, tip, law
-      logical :: energy_wanted, pending, observing
+      type(lanes_type), allocatable :: lanes(:)
+      integer(ik) :: step, next_record, next_snapshot, load_k
+      integer :: k, c, n, tip, law
+      logical :: energy_wanted, pending, observing, restart
+      real(wp) :: z_tip
 
       n = ms%n
       tip = model%tip
+      z_tip = model%z(tip)
       law = scenes(1)%law
       do k = 1, ms%k
          call first_events(scenes(k), ms%step, ms%next_record(k), ms%next_snapshot(k))
@@ -545,78 +511,60 @@ contains
       observing = any(ms%observers%active)
       ms%pending = .false.
       pending = .false.
-      ms%u_old_su = 0
-      ms%dmd = 0
-      call start_loads(ms, ms%step + 1, scenes, model)
+      allocate (lanes(ms%chunks))
+      call gather_lanes(scenes, ms, lanes)
+      load_k = start_lanes_loads(lanes, ms%step + 1, model%dt)
       do step = ms%step, last
-         ms%sigma_next = ms%sigma
-         call next_loads(ms, scenes, model)
-         ms%weight = model%beta*ms%sigma_next + (1 - 2*model%beta)*ms%sigma_now + model%beta*ms%sigma_prev
-         ! the forward pass, a chunk of members after the other
-         ms%coef = model%dt2*ms%weight
-         if (law == law_compliance) ms%spring = model%dt2*((1 - 2*model%beta)*ms%p_now + model%beta*ms%p_prev)
+         restart = mod(load_k + 1, restart_every) == 0
          energy_wanted = pending .or. step == next_record
+         ! the forward pass, a chunk of members after the other
          do c = 1, ms%chunks
-            lo = (c - 1)*lockstep_lanes + 1
-            hi = c*lockstep_lanes
-            call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), ms%coef(lo:hi), ms%g(:, :, c), model%dt2, &
-               & ms%spring(lo:hi), ms%su(:, :, c), ms%rhs(:, :, c))
+            call lanes_begin_step(lanes(c), law, model%beta, model%dt2, restart, load_k + 1, model%dt)
+            call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), lanes(c)%coef, ms%g(:, :, c), model%dt2, &
+               & lanes(c)%spring, ms%su(:, :, c), ms%rhs(:, :, c))
             if (energy_wanted) then
                call lockstep_forward_energy(ops%solver, ops%mass, ms%u(:, :, c), ms%d(:, :, c), ms%su(:, :, c), &
-                  & ms%rhs(:, :, c), ms%usu(lo:hi), ms%dsu(lo:hi), ms%dmd(lo:hi), ms%partial)
+                  & ms%rhs(:, :, c), lanes(c)%usu, lanes(c)%dsu, lanes(c)%dmd, ms%partial)
             else
                call lockstep_forward(ops%solver, ms%rhs(:, :, c))
             end if
          end do
+         load_k = load_k + 1
          if (pending) then
             do k = 1, ms%k
                if (.not. ms%pending(k)) cycle
-               ms%rows(col_energy, k) = scenes(k)%mass_per_length*energy(model, ms%dmd(k), ms%usu(k), ms%dsu(k), &
-                  & ms%u_old_su(k))
+               associate (ln => lanes(chunk(k)), i => lane(k))
+                  ms%rows(col_energy, k) = scenes(k)%mass_per_length*energy(model, ln%dmd(i), ln%usu(i), ln%dsu(i), &
+                     & ln%u_old_su(i))
+               end associate
                if (ms%active(k)) call recorders(k)%record(ms%rows(:, k))
                ms%pending(k) = .false.
             end do
             pending = .false.
          end if
-         if (energy_wanted) then
-            ms%u_old_su = ms%usu
-         else
-            ms%u_old_su = 0
-         end if
          ! the back substitution and the tip step: the contact law, the update and the
          ! bookkeeping (tip_step, close_step)
          do c = 1, ms%chunks
-            lo = (c - 1)*lockstep_lanes + 1
-            hi = c*lockstep_lanes
-            call lockstep_back(ops%solver, ms%rhs(:, :, c), ms%partial)
-            ms%d_tip_prev(lo:hi) = ms%d(:, tip, c)
-            ms%u_tip_prev(lo:hi) = ms%u(:, tip, c)
-            ms%trial(lo:hi) = ms%u_tip_prev(lo:hi) + (ms%d_tip_prev(lo:hi) + ms%rhs(:, tip, c))
+            if (energy_wanted) then
+               lanes(c)%u_old_su = lanes(c)%usu
+            else
+               lanes(c)%u_old_su = 0
+            end if
+            call lockstep_back_edge(ops%solver, ms%rhs(:, :, c), ms%partial)
+            call lanes_contact(lanes(c), law, ms%u(:, tip, c), ms%d(:, tip, c), ms%rhs(:, tip, c), z_tip, model%dt2, &
+               & model%beta)
+            call lockstep_back_update(ops%solver, ms%rhs(:, :, c), lanes(c)%c, model%z, ms%d(:, :, c), ms%u(:, :, c))
+            call lockstep_dot(n, ms%g(:, :, c), ms%d(:, :, c), ms%partial, lanes(c)%gd, model%dt2)
+            call lanes_close(lanes(c), law, ms%u(:, tip, c), ms%d(:, tip, c))
          end do
-         call contact_law(law, scenes, model, ms)
-         do c = 1, ms%chunks
-            lo = (c - 1)*lockstep_lanes + 1
-            hi = c*lockstep_lanes
-            call lockstep_update(n, ms%rhs(:, :, c), ms%c(lo:hi), model%z, ms%d(:, :, c), ms%u(:, :, c))
-            call lockstep_dot(n, ms%g(:, :, c), ms%d(:, :, c), ms%partial, ms%gd(lo:hi), model%dt2)
-            ms%u_tip(lo:hi) = ms%u(:, tip, c)
-            ms%d_tip(lo:hi) = ms%d(:, tip, c)
-         end do
-         ms%r_prev = ms%reaction
-         call close_steps(law, ms)
-         if (law == law_signorini) then
-            do c = 1, ms%chunks
-               lo = (c - 1)*lockstep_lanes + 1
-               hi = c*lockstep_lanes
-               ms%u(:, tip, c) = ms%u_tip(lo:hi)
-               ms%d(:, tip, c) = ms%d_tip(lo:hi)
-            end do
-         end if
          ! the shock log and statistics of each member that keeps them
          if (observing) then
             do k = 1, ms%k
-               if (ms%observers(k)%active .and. ms%active(k)) call ms%observers(k)%tip(real(step + 1, wp)*model%dt, &
-                  & ms%u_tip(k), ms%reaction(k), ms%dissipated(k))
+               if (ms%observers(k)%active .and. ms%active(k)) then
+                  associate (ln => lanes(chunk(k)), i => lane(k))
+                     call ms%observers(k)%tip(real(step + 1, wp)*model%dt, ln%u_tip(i), ln%reaction(i), ln%dissipated(i))
+                  end associate
+               end if
             end do
          end if
          ! records and snapshots
@@ -624,7 +572,7 @@ contains
             do k = 1, ms%k
                if (step == ms%next_record(k)) then
                   ms%next_record(k) = ms%next_record(k) + scenes(k)%record_every
-                  call fill_row(scenes(k), model, ms, k, step, ms%rows(:, k))
+                  call fill_row(scenes(k), model, ms, lanes(chunk(k)), k, step, ms%rows(:, k))
                   ms%pending(k) = .true.
                   pending = .true.
                end if
@@ -637,6 +585,7 @@ contains
             next_snapshot = minval(ms%next_snapshot)
          end if
       end do
+      call scatter_lanes(lanes, ms)
       ! S u^{last+1}; it also completes the waiting records, as advance_fused does (one member
       ! at a time, with the one-member products and dot products).
       do c = 1, ms%chunks
@@ -651,147 +600,102 @@ contains
          ms%vec_su = ms%su(lane(k), :, chunk(k))
          call diagonal_matvec(ops%mass, ms%vec_d, ms%vec_s)
          ms%rows(col_energy, k) = scenes(k)%mass_per_length*energy(model, dot(ms%vec_d, ms%vec_s), &
-            & dot(ms%vec_u, ms%vec_su), dot(ms%vec_d, ms%vec_su), ms%u_old_su(k))
+            & dot(ms%vec_u, ms%vec_su), dot(ms%vec_d, ms%vec_su), lanes(chunk(k))%u_old_su(lane(k)))
          call recorders(k)%record(ms%rows(:, k))
       end do
    end subroutine advance_members
 
-   !> The contact law at the tip of every member (beamstops_scheme's contact_law and the
-   !> projection of beamstops_contact_tip_projection, written over the members): from the
-   !> trial tip values, the multiple c of z, the tip value, the reaction of the step, contact.
-   !> Padding lanes: trial 0 between their stops -1 and 1, so c = 0.
-   subroutine contact_law(law, scenes, model, ms)
-      integer, intent(in) :: law
+   !> The chunks' lanes at the start of a block: each member's constants and the values it
+   !> carries from step to step (padding lanes keep the lanes' defaults: at rest).
+   subroutine gather_lanes(scenes, ms, lanes)
       type(scene_type), intent(in) :: scenes(:)
-      type(model_type), intent(in) :: model
-      type(members_type), intent(inout) :: ms
-      real(wp) :: p_next, z_tip
-      integer :: k, c, lo, hi
-      z_tip = model%z(model%tip)
-      select case (law)
-      case (law_signorini)
-         do c = 1, ms%chunks
-            lo = (c - 1)*lockstep_lanes + 1
-            hi = c*lockstep_lanes
-            call project_lanes(ms%trial(lo:hi), ms%lower(lo:hi), ms%upper(lo:hi), z_tip, model%dt2, &
-               & ms%tip_value(lo:hi), ms%c(lo:hi), ms%contact(lo:hi), ms%r_step(lo:hi))
-         end do
-      case (law_compliance)
-         do k = 1, ms%k
-            ms%tip_value(k) = solve_spring_tip(ms%trial(k), scenes(k)%lower, scenes(k)%upper, &
-               & scenes(k)%stiffness_per_mass, model%dt2*model%beta*model%z(model%tip))
-            p_next = spring_force(ms%tip_value(k), scenes(k)%lower, scenes(k)%upper, scenes(k)%stiffness_per_mass)
-            ms%c(k) = model%dt2*model%beta*p_next
-            ms%r_step(k) = model%beta*p_next + (1 - 2*model%beta)*ms%p_now(k) + model%beta*ms%p_prev(k)
-            ms%p_prev(k) = ms%p_now(k)
-            ms%p_now(k) = p_next
-            ms%contact(k) = ms%r_step(k) /= 0
-         end do
-      case default
-         ms%c = 0
-         ms%tip_value = ms%trial
-         ms%r_step = 0
-         ms%contact = .false.
-      end select
-   end subroutine contact_law
-
-   !> After the update, for every member (beamstops_scheme's close_step, written over the
-   !> members, on the gathered tip values u_tip, d_tip): the exact tip value (Signorini), the
-   !> violation, impacts, the work of the load and the energy the stops take, the load averages
-   !> moved on.
-   subroutine close_steps(law, ms)
-      integer, intent(in) :: law
-      type(members_type), intent(inout) :: ms
-      integer :: c, lo, hi
-      do c = 1, ms%chunks
-         lo = (c - 1)*lockstep_lanes + 1
-         hi = c*lockstep_lanes
-         call close_lanes(law, ms%contact(lo:hi), ms%tip_value(lo:hi), ms%u_tip_prev(lo:hi), ms%d_tip_prev(lo:hi), &
-            & ms%lower(lo:hi), ms%upper(lo:hi), ms%weight(lo:hi), ms%gd(lo:hi), ms%r_step(lo:hi), &
-            & ms%sigma_next(lo:hi), ms%u_tip(lo:hi), ms%d_tip(lo:hi), ms%max_violation(lo:hi), ms%impacts(lo:hi), &
-            & ms%in_contact(lo:hi), ms%work(lo:hi), ms%dissipated(lo:hi), ms%reaction(lo:hi), ms%gd_prev(lo:hi), &
-            & ms%sigma_prev(lo:hi), ms%sigma_now(lo:hi))
-      end do
-   end subroutine close_steps
-
-   !> The projection of the trial tip values on the stops of a chunk of lanes (beamstops_contact_
-   !> tip_projection's project_tip): tip value, multiple c of z, contact, reaction of the step.
-   pure subroutine project_lanes(trial, lower, upper, z_tip, dt2, tip_value, c, contact, r_step)
-      real(wp), intent(in) :: trial(lockstep_lanes), lower(lockstep_lanes), upper(lockstep_lanes), z_tip, dt2
-      real(wp), intent(out) :: tip_value(lockstep_lanes), c(lockstep_lanes), r_step(lockstep_lanes)
-      logical, intent(out) :: contact(lockstep_lanes)
+      type(members_type), intent(in) :: ms
+      type(lanes_type), intent(out) :: lanes(:)
       integer :: k
-!GCC$ ivdep
-!GCC$ vector
-      do k = 1, lockstep_lanes
-         tip_value(k) = min(max(trial(k), lower(k)), upper(k))
-         c(k) = (tip_value(k) - trial(k))/z_tip
-         contact(k) = c(k) /= 0
-         r_step(k) = c(k)/dt2
+      do k = 1, ms%k
+         associate (ln => lanes(chunk(k)), i => lane(k))
+            ln%member(i) = .true.
+            ln%omega(i) = scenes(k)%omega
+            ln%centered(i) = scenes(k)%centered_load
+            ln%lower(i) = scenes(k)%lower
+            ln%upper(i) = scenes(k)%upper
+            ln%stiffness(i) = scenes(k)%stiffness_per_mass
+            ln%sigma_prev(i) = ms%sigma_prev(k)
+            ln%sigma_now(i) = ms%sigma_now(k)
+            ln%gd_prev(i) = ms%gd_prev(k)
+            ln%p_prev(i) = ms%p_prev(k)
+            ln%p_now(i) = ms%p_now(k)
+            ln%work(i) = ms%work(k)
+            ln%dissipated(i) = ms%dissipated(k)
+            ln%reaction(i) = ms%reaction(k)
+            ln%max_violation(i) = ms%max_violation(k)
+            ln%in_contact(i) = ms%in_contact(k)
+            ln%impacts(i) = ms%impacts(k)
+         end associate
       end do
-   end subroutine project_lanes
+   end subroutine gather_lanes
 
-   !> close_steps for a chunk of lanes.
-   pure subroutine close_lanes(law, contact, tip_value, u_tip_prev, d_tip_prev, lower, upper, weight, gd, r_step, &
-      & sigma_next, u_tip, d_tip, max_violation, impacts, in_contact, work, dissipated, reaction, gd_prev, &
-      & sigma_prev, sigma_now)
-      integer, intent(in) :: law
-      logical, intent(in) :: contact(lockstep_lanes)
-      real(wp), intent(in) :: tip_value(lockstep_lanes), u_tip_prev(lockstep_lanes), d_tip_prev(lockstep_lanes), &
-         & lower(lockstep_lanes), upper(lockstep_lanes), weight(lockstep_lanes), gd(lockstep_lanes), &
-         & r_step(lockstep_lanes), sigma_next(lockstep_lanes)
-      real(wp), intent(inout) :: u_tip(lockstep_lanes), d_tip(lockstep_lanes), max_violation(lockstep_lanes), &
-         & work(lockstep_lanes), dissipated(lockstep_lanes), reaction(lockstep_lanes), gd_prev(lockstep_lanes), &
-         & sigma_prev(lockstep_lanes), sigma_now(lockstep_lanes)
-      integer(ik), intent(inout) :: impacts(lockstep_lanes)
-      logical, intent(inout) :: in_contact(lockstep_lanes)
+   !> The values the members carry from step to step, back from the lanes at the end of a block.
+   subroutine scatter_lanes(lanes, ms)
+      type(lanes_type), intent(in) :: lanes(:)
+      type(members_type), intent(inout) :: ms
       integer :: k
-      if (law == law_signorini) then
-!GCC$ ivdep
-!GCC$ vector
-         do k = 1, lockstep_lanes
-            if (contact(k)) then
-               u_tip(k) = tip_value(k)
-               d_tip(k) = tip_value(k) - u_tip_prev(k)
-            end if
-         end do
-      end if
-      if (law /= law_none) then
-!GCC$ ivdep
-!GCC$ vector
-         do k = 1, lockstep_lanes
-            max_violation(k) = max(max_violation(k), max(u_tip(k) - upper(k), lower(k) - u_tip(k), 0.0_wp))
-         end do
-      end if
-!GCC$ ivdep
-!GCC$ vector
-      do k = 1, lockstep_lanes
-         if (contact(k) .and. .not. in_contact(k)) impacts(k) = impacts(k) + 1
-         in_contact(k) = contact(k)
-         work(k) = work(k) + 0.5_wp*weight(k)*(gd(k) + gd_prev(k))
-         dissipated(k) = dissipated(k) - 0.5_wp*r_step(k)*(d_tip(k) + d_tip_prev(k))
-         reaction(k) = r_step(k)
-         gd_prev(k) = gd(k)
-         sigma_prev(k) = sigma_now(k)
-         sigma_now(k) = sigma_next(k)
+      do k = 1, ms%k
+         associate (ln => lanes(chunk(k)), i => lane(k))
+            ms%sigma_prev(k) = ln%sigma_prev(i)
+            ms%sigma_now(k) = ln%sigma_now(i)
+            ms%gd_prev(k) = ln%gd_prev(i)
+            ms%p_prev(k) = ln%p_prev(i)
+            ms%p_now(k) = ln%p_now(i)
+            ms%work(k) = ln%work(i)
+            ms%dissipated(k) = ln%dissipated(i)
+            ms%reaction(k) = ln%reaction(i)
+            ms%max_violation(k) = ln%max_violation(i)
+            ms%in_contact(k) = ln%in_contact(i)
+            ms%impacts(k) = ln%impacts(i)
+         end associate
       end do
-   end subroutine close_lanes
+   end subroutine scatter_lanes
+
+   !> The load rotation of every chunk at step k (beamstops_forcing's start_loads): from
+   !> load_average at the last multiple of restart_every, then rotated. Returns k.
+   function start_lanes_loads(lanes, k, dt) result(load_k)
+      type(lanes_type), intent(inout) :: lanes(:)
+      integer(ik), intent(in) :: k
+      real(wp), intent(in) :: dt
+      integer(ik) :: load_k
+      integer :: c
+      load_k = (k/restart_every)*restart_every
+      do c = 1, size(lanes)
+         call lanes_restart_loads(lanes(c), load_k, dt)
+      end do
+      do while (load_k < k)
+         do c = 1, size(lanes)
+            call lanes_next_loads(lanes(c), mod(load_k + 1, restart_every) == 0, load_k + 1, dt)
+         end do
+         load_k = load_k + 1
+      end do
+   end function start_lanes_loads
 
    !> Member k's record row of step n, the energy column left for later (fill_row).
-   subroutine fill_row(scene, model, ms, k, step, row)
+   subroutine fill_row(scene, model, ms, lanes, k, step, row)
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
       type(members_type), intent(in) :: ms
+      !> Member k's chunk.
+      type(lanes_type), intent(in) :: lanes
       integer, intent(in) :: k
       integer(ik), intent(in) :: step
       real(wp), intent(out) :: row(n_columns)
+      integer :: i
+      i = lane(k)
       row(col_t) = real(step, wp)*model%dt
-      row(col_u) = ms%u_tip_prev(k)
-      row(col_v) = (ms%d(lane(k), model%tip, chunk(k)) + ms%d_tip_prev(k))/(2*model%dt)
-      row(col_reaction) = scene%mass_per_length*ms%r_prev(k)
+      row(col_u) = lanes%u_tip_prev(i)
+      row(col_v) = (ms%d(i, model%tip, chunk(k)) + lanes%d_tip_prev(i))/(2*model%dt)
+      row(col_reaction) = scene%mass_per_length*lanes%r_prev(i)
       row(col_energy) = 0
-      row(col_work) = scene%mass_per_length*ms%work(k)
-      row(col_dissipated) = scene%mass_per_length*ms%dissipated(k)
+      row(col_work) = scene%mass_per_length*lanes%work(i)
+      row(col_dissipated) = scene%mass_per_length*lanes%dissipated(i)
       row(col_damped) = scene%mass_per_length*0.0_wp
    end subroutine fill_row
 
@@ -811,63 +715,6 @@ contains
       ms%shape(2:) = ms%shape(2:) + ms%vec_s(1::2)
       call recorder%snapshot(real(step, wp)*model%dt, ms%shape)
    end subroutine take_snapshot
-
-   !> The load rotation of every member at step k (start_loads): from load_average at the last
-   !> multiple of restart_every, then rotated.
-   subroutine start_loads(ms, k, scenes, model)
-      type(members_type), intent(inout) :: ms
-      integer(ik), intent(in) :: k
-      type(scene_type), intent(in) :: scenes(:)
-      type(model_type), intent(in) :: model
-      call restart_loads(ms, (k/restart_every)*restart_every, scenes, model)
-      do while (ms%load_k < k)
-         call next_loads(ms, scenes, model)
-      end do
-   end subroutine start_loads
-
-   !> The load rotation of every member at step k, exact (restart_loads).
-   subroutine restart_loads(ms, k, scenes, model)
-      type(members_type), intent(inout) :: ms
-      integer(ik), intent(in) :: k
-      type(scene_type), intent(in) :: scenes(:)
-      type(model_type), intent(in) :: model
-      real(wp) :: centre, x, factor
-      integer :: m
-      ms%load_k = k
-      do m = 1, ms%k
-         centre = real(k, wp)*model%dt
-         if (.not. scenes(m)%centered_load) centre = (real(k, wp) + 0.5_wp)*model%dt
-         x = 0.5_wp*scenes(m)%omega*model%dt
-         if (abs(x) < 1.0e-8_wp) then
-            factor = 1 - x**2/6
-         else
-            factor = sin(x)/x
-         end if
-         ms%sigma(m) = load_average(k, model%dt, scenes(m)%omega, scenes(m)%centered_load)
-         ms%cosine(m) = factor*cos(scenes(m)%omega*centre)
-         ms%cos_step(m) = cos(scenes(m)%omega*model%dt)
-         ms%sin_step(m) = sin(scenes(m)%omega*model%dt)
-      end do
-   end subroutine restart_loads
-
-   !> The load rotation of every member moved on by one step (next_load).
-   subroutine next_loads(ms, scenes, model)
-      type(members_type), intent(inout) :: ms
-      type(scene_type), intent(in) :: scenes(:)
-      type(model_type), intent(in) :: model
-      real(wp) :: sigma
-      integer :: m
-      if (mod(ms%load_k + 1, restart_every) == 0) then
-         call restart_loads(ms, ms%load_k + 1, scenes, model)
-         return
-      end if
-      do m = 1, ms%p
-         sigma = ms%sigma(m)*ms%cos_step(m) + ms%cosine(m)*ms%sin_step(m)
-         ms%cosine(m) = ms%cosine(m)*ms%cos_step(m) - ms%sigma(m)*ms%sin_step(m)
-         ms%sigma(m) = sigma
-      end do
-      ms%load_k = ms%load_k + 1
-   end subroutine next_loads
 
    !> The first recorded step and the first snapshot step at or after `step` (first_events).
    pure subroutine first_events(scene, step, next_record, next_snapshot)
