@@ -8,9 +8,9 @@
 !>                                                    default; 0: &statistics off)
 !>
 !> Members: the paper's scene (Signorini, beta = 1/2, dt = 1e-6 s) with omega and amplitude
-!> varied per member. One at a time: start_state + advance of each member alone (the fused
-!> path), as many members as the largest group. Lockstep: simulate_lockstep of K = 1, 2, 4, 8,
-!> 16 members. Recorders keep nothing (bench_null_recorder). Times of the loops only, in CPU
+!> varied per member. One at a time: start_state + run_scheme of each member alone (the fused
+!> path, start and summary included), as many members as the largest group. Lockstep:
+!> simulate_lockstep of K = 1, 2, 4, 8, 16 members (start and summaries included). Recorders keep nothing (bench_null_recorder). Times of the loops only, in CPU
 !> seconds of the thread (beamstops_clock: per core, and not inflated when a shared machine
 !> runs other work meanwhile); the variants' repeats are interleaved; medians.
 !>
@@ -24,7 +24,7 @@ program bench_lockstep
    use beamstops_error, only: error_type
    use beamstops_scene, only: scene_type, law_signorini
    use beamstops_model, only: model_type, build_model
-   use beamstops_scheme, only: state_type, start_state, advance
+   use beamstops_scheme, only: state_type, start_state, run_scheme
    use beamstops_summary, only: run_summary
    use beamstops_lockstep, only: prepare_lockstep, simulate_lockstep
    use beamstops_clock, only: thread_cpu_seconds
@@ -109,28 +109,33 @@ contains
       end do
    end subroutine members
 
-   !> ns per member-step, each member run alone on the fused path (start_state + advance).
+   !> ns per member-step, each member run alone on the fused path: start_state + run_scheme (its
+   !> loop in blocks and its summary: the work simulate does, as simulate_lockstep does it for the
+   !> group, so that both sides include a run's start and end).
    function time_alone(s) result(ns)
       type(scene_type), intent(in) :: s(:)
       real(wp) :: ns
       type(model_type) :: model
       type(state_type) :: state
       type(null_recorder) :: recorder
+      type(run_summary) :: summary
       type(error_type), allocatable :: error
-      real(wp) :: t0, total
+      real(wp) :: t0, total, member_steps
       integer :: k
       total = 0
+      member_steps = 0
       do k = 1, size(s)
          call build_model(s(k), model, error)
          if (allocated(error)) call fail(error%message)
+         t0 = thread_cpu_seconds()
          call start_state(s(k), model, state, recorder, error)
          if (allocated(error)) call fail(error%message)
-         t0 = thread_cpu_seconds()
-         call advance(s(k), model, state, recorder, int(steps, ik))
+         call run_scheme(s(k), model, state, recorder, summary)
          total = total + (thread_cpu_seconds() - t0)
+         member_steps = member_steps + real(summary%steps, wp)
          if (recorder%sink == 12345) print *, recorder%sink
       end do
-      ns = 1.0e9_wp*total/(real(steps, wp)*size(s))
+      ns = 1.0e9_wp*total/member_steps
    end function time_alone
 
    !> ns per member-step of the members in lockstep (simulate_lockstep, start included: it is
