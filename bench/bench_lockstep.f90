@@ -11,24 +11,26 @@
 !>                                                    loop against the plain one, in the same run)
 !>
 !> Members: the paper's scene (Signorini, beta = 1/2, dt = 1e-6 s) with omega and amplitude
-!> varied per member. One at a time: start_state + advance of each member alone (the fused
-!> path), as many members as the largest group. Lockstep: simulate_lockstep of K = 1, 2, 4, 8,
-!> 16 members. Recorders keep nothing (bench_null_recorder). Wall-clock times of the loops only
-!> (system_clock), one core; the variants' repeats are interleaved; medians.
+!> varied per member. One at a time: start_state + run_scheme of each member alone (the fused
+!> path, start and summary included), as many members as the largest group. Lockstep:
+!> simulate_lockstep of K = 1, 2, 4, 8, 16 members (start and summaries included). Recorders keep nothing (bench_null_recorder). Times of the loops only, in CPU
+!> seconds of the thread (beamstops_clock: per core, and not inflated when a shared machine
+!> runs other work meanwhile); the variants' repeats are interleaved; medians.
 !>
 !> The floor beside each: a step is bounded by the chain of its two substitutions (2n dependent
 !> multiply-adds, shared by the K members of a group: 2n latencies / K per member-step) and by
 !> its operations (20 n multiply-adds per member-step, 760 at J = 19; 30 n when recorded) over
 !> the peak rate of independent multiply-adds, both measured here by tiny kernels.
 program bench_lockstep
-   use, intrinsic :: iso_fortran_env, only: int64, error_unit
+   use, intrinsic :: iso_fortran_env, only: error_unit
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type
    use beamstops_scene, only: scene_type, law_signorini
    use beamstops_model, only: model_type, build_model
-   use beamstops_scheme, only: state_type, start_state, advance
+   use beamstops_scheme, only: state_type, start_state, run_scheme
    use beamstops_summary, only: run_summary
    use beamstops_lockstep, only: prepare_lockstep, simulate_lockstep
+   use beamstops_clock, only: thread_cpu_seconds
    use bench_null_recorder, only: null_recorder
    implicit none
 
@@ -146,29 +148,33 @@ contains
       end do
    end subroutine members
 
-   !> ns per member-step, each member run alone on the fused path (start_state + advance).
+   !> ns per member-step, each member run alone on the fused path: start_state + run_scheme (its
+   !> loop in blocks and its summary: the work simulate does, as simulate_lockstep does it for the
+   !> group, so that both sides include a run's start and end).
    function time_alone(s) result(ns)
       type(scene_type), intent(in) :: s(:)
       real(wp) :: ns
       type(model_type) :: model
       type(state_type) :: state
       type(null_recorder) :: recorder
+      type(run_summary) :: summary
       type(error_type), allocatable :: error
-      integer(int64) :: t0, t1, rate, total
+      real(wp) :: t0, total, member_steps
       integer :: k
       total = 0
+      member_steps = 0
       do k = 1, size(s)
          call build_model(s(k), model, error)
          if (allocated(error)) call fail(error%message)
+         t0 = thread_cpu_seconds()
          call start_state(s(k), model, state, recorder, error)
          if (allocated(error)) call fail(error%message)
-         call system_clock(t0, rate)
-         call advance(s(k), model, state, recorder, int(steps, ik))
-         call system_clock(t1)
-         total = total + (t1 - t0)
+         call run_scheme(s(k), model, state, recorder, summary)
+         total = total + (thread_cpu_seconds() - t0)
+         member_steps = member_steps + real(summary%steps, wp)
          if (recorder%sink == 12345) print *, recorder%sink
       end do
-      ns = 1.0e9_wp*real(total, wp)/real(rate, wp)/(real(steps, wp)*size(s))
+      ns = 1.0e9_wp*total/member_steps
    end function time_alone
 
    !> ns per member-step of the members in lockstep (simulate_lockstep, start included: it is
@@ -180,14 +186,14 @@ contains
       type(null_recorder) :: recorders(size(s))
       type(run_summary) :: summaries(size(s))
       type(error_type), allocatable :: error
-      integer(int64) :: t0, t1, rate
+      real(wp) :: t0, t1
       call prepare_lockstep(s, 'bench', model, error)
       if (allocated(error)) call fail(error%message)
-      call system_clock(t0, rate)
+      t0 = thread_cpu_seconds()
       call simulate_lockstep(s, model, recorders, summaries, error)
-      call system_clock(t1)
+      t1 = thread_cpu_seconds()
       if (allocated(error)) call fail(error%message)
-      ns = 1.0e9_wp*real(t1 - t0, wp)/real(rate, wp)/(real(summaries(1)%steps, wp)*size(s))
+      ns = 1.0e9_wp*(t1 - t0)/(real(summaries(1)%steps, wp)*size(s))
       if (recorders(1)%sink == 12345) print *, recorders(1)%sink
    end function time_group
 
@@ -204,18 +210,16 @@ contains
    function fma_latency() result(ns)
       real(wp) :: ns
       integer, parameter :: count = 20000000
-      real(wp) :: a, b, x
-      integer(int64) :: t0, t1, rate
+      real(wp) :: a, b, x, t0
       integer :: k
       a = 0.999_wp
       b = 1.0e-3_wp
       x = runtime_one()
-      call system_clock(t0, rate)
+      t0 = thread_cpu_seconds()
       do k = 1, count
          x = b - a*x
       end do
-      call system_clock(t1)
-      ns = 1.0e9_wp*real(t1 - t0, wp)/real(rate, wp)/count
+      ns = 1.0e9_wp*(thread_cpu_seconds() - t0)/count
       if (x == 12345) print *, x
    end function fma_latency
 
@@ -223,18 +227,16 @@ contains
    function fma_throughput() result(per_ns)
       real(wp) :: per_ns
       integer, parameter :: count = 2000000, width = 64
-      real(wp) :: acc(width), a, b
-      integer(int64) :: t0, t1, rate
+      real(wp) :: acc(width), a, b, t0
       integer :: k
       a = 0.999_wp*runtime_one()
       b = 1.0e-3_wp
       acc = [(real(k, wp)/width, k=1, width)]
-      call system_clock(t0, rate)
+      t0 = thread_cpu_seconds()
       do k = 1, count
          acc = acc*a + b
       end do
-      call system_clock(t1)
-      per_ns = real(count, wp)*width/(1.0e9_wp*real(t1 - t0, wp)/real(rate, wp))
+      per_ns = real(count, wp)*width/(1.0e9_wp*(thread_cpu_seconds() - t0))
       if (sum(acc) == 12345) print *, acc(1)
    end function fma_throughput
 

@@ -30,6 +30,8 @@ ratio is computed from numbers of the same run):
   memory bandwidth, are the other two bounds; the floor is the largest of the three;
 - scaling in J from 19 to 1e5 (time per step and per unknown, peak memory of the program),
   and in the number of records (record_every);
+- lockstep ensembles (scripts/bench_lockstep.py): member-steps per second per core, one at a time
+  against K = 1..16 members in lockstep, J = 19 and 100, with their floor;
 - the paper's CPU-time table beside ours;
 - the paper's Figure 4 run against issue 15's targets: the whole ``beamstops run`` process within
   1.15x the engine loop with nothing recorded, that loop within 2x the chain floor;
@@ -68,6 +70,7 @@ SCRIPTS = Path(__file__).resolve().parent
 sys.path.insert(0, str(SCRIPTS))
 
 import bench_ext  # noqa: E402
+import bench_lockstep  # noqa: E402
 import reference_scheme  # noqa: E402
 
 # The paper's CPU times (SPEC 2; Scilab on a 1.1 GHz PowerPC G4), its runs: figure ->
@@ -476,6 +479,8 @@ def main() -> int:
         ]
         say(table(["quantity", "value"], rows))
         say("")
+
+        say(bench_lockstep.section(build, quick, repeats))
 
         # -------------------------------------------------------- scaling in J
         say("### Scaling in J (Signorini, β = 1/2, dt = 1e-6 s, tip recorded every step)\n")

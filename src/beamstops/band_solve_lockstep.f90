@@ -33,6 +33,7 @@ module beamstops_band_solve_lockstep
    private
    public :: lockstep_forward, lockstep_forward_energy, lockstep_back, lockstep_matvec, lockstep_dot
    public :: lockstep_rhs, lockstep_update, lockstep_matvec_rhs
+   public :: lockstep_back_edge, lockstep_back_update
    public :: lockstep_min_unknowns, lockstep_work_columns, lockstep_lanes
 
    !> Fewest unknowns these routines handle (J >= 4).
@@ -270,6 +271,98 @@ contains
       end associate
    end subroutine lockstep_back
 
+   !> The first rows of lockstep_back, x_n, x_{n-1} and x_{n-2} of every lane (beamstops_band_solve's
+   !> back_substitution_edge): the tip value x_{n-1} that the contact law needs before the rest
+   !> of the substitution, lockstep_back_update.
+   pure subroutine lockstep_back_edge(solver, b, work)
+      !> Solver from prepare_solver.
+      type(band_solver), intent(in) :: solver
+      !> D^{-2} w (lanes, n); its last kd rows replaced by those of x.
+      real(wp), intent(inout) :: b(lockstep_lanes, solver%n)
+      !> Work array (lanes, lockstep_work_columns).
+      real(wp), intent(out) :: work(lockstep_lanes, lockstep_work_columns)
+      integer :: n
+      n = solver%n
+      associate (off => solver%off)
+         ! each product rounded before its subtraction
+         work(:, 1) = off(3, n)*b(:, n)
+         call subtract_rounded(b(:, n - 1), work(:, 1), solver%inv_d2(1))
+         work(:, 1) = off(2, n)*b(:, n)
+         call subtract_rounded(b(:, n - 2), work(:, 1), solver%inv_d2(1))
+         work(:, 1) = off(3, n - 1)*b(:, n - 1)
+         call subtract_rounded(b(:, n - 2), work(:, 1), solver%inv_d2(1))
+      end associate
+   end subroutine lockstep_back_edge
+
+   !> The rest of lockstep_back after lockstep_back_edge, each row of x followed at once by its
+   !> row of the update (lockstep_update: d = d + x + c z, u = u + d), so that the update rides in
+   !> the shadow of the substitution's chain instead of a pass of its own, and x itself is not
+   !> stored (the update is its only use). Per lane the same operations as lockstep_back then
+   !> lockstep_update (the update of a row needs only that row).
+   pure subroutine lockstep_back_update(solver, b, c, z, d, u)
+      !> Solver from prepare_solver.
+      type(band_solver), intent(in) :: solver
+      !> D^{-2} w (lanes, n) with its last kd rows from lockstep_back_edge (left as it is).
+      real(wp), intent(in) :: b(lockstep_lanes, solver%n)
+      !> Multiples of z (lanes).
+      real(wp), intent(in) :: c(lockstep_lanes)
+      !> z = A^{-1} e_tip (n).
+      real(wp), intent(in) :: z(solver%n)
+      !> d^{n-1} and u^n on entry, d^n and u^{n+1} on return (lanes, n).
+      real(wp), intent(inout) :: d(lockstep_lanes, solver%n), u(lockstep_lanes, solver%n)
+      real(wp) :: xa(lockstep_lanes), xb(lockstep_lanes), xc(lockstep_lanes)
+      integer :: i, k, n
+      n = solver%n
+      associate (off => solver%off)
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            xa(k) = b(k, n)
+            xb(k) = b(k, n - 1)
+            xc(k) = b(k, n - 2)
+            d(k, n) = d(k, n) + xa(k) + c(k)*z(n)
+            u(k, n) = u(k, n) + d(k, n)
+            d(k, n - 1) = d(k, n - 1) + xb(k) + c(k)*z(n - 1)
+            u(k, n - 1) = u(k, n - 1) + d(k, n - 1)
+            d(k, n - 2) = d(k, n - 2) + xc(k) + c(k)*z(n - 2)
+            u(k, n - 2) = u(k, n - 2) + d(k, n - 2)
+         end do
+         do i = n - kd, 3, -3
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               xa(k) = b(k, i) - off(1, i + 3)*xa(k) - off(2, i + 2)*xb(k) - off(3, i + 1)*xc(k)
+               d(k, i) = d(k, i) + xa(k) + c(k)*z(i)
+               u(k, i) = u(k, i) + d(k, i)
+               xb(k) = b(k, i - 1) - off(1, i + 2)*xb(k) - off(2, i + 1)*xc(k) - off(3, i)*xa(k)
+               d(k, i - 1) = d(k, i - 1) + xb(k) + c(k)*z(i - 1)
+               u(k, i - 1) = u(k, i - 1) + d(k, i - 1)
+               xc(k) = b(k, i - 2) - off(1, i + 1)*xc(k) - off(2, i)*xa(k) - off(3, i - 1)*xb(k)
+               d(k, i - 2) = d(k, i - 2) + xc(k) + c(k)*z(i - 2)
+               u(k, i - 2) = u(k, i - 2) + d(k, i - 2)
+            end do
+         end do
+         if (i >= 1) then
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               xa(k) = b(k, i) - off(1, i + 3)*xa(k) - off(2, i + 2)*xb(k) - off(3, i + 1)*xc(k)
+               d(k, i) = d(k, i) + xa(k) + c(k)*z(i)
+               u(k, i) = u(k, i) + d(k, i)
+            end do
+         end if
+         if (i - 1 >= 1) then
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               xb(k) = b(k, i - 1) - off(1, i + 2)*xb(k) - off(2, i + 1)*xc(k) - off(3, i)*xa(k)
+               d(k, i - 1) = d(k, i - 1) + xb(k) + c(k)*z(i - 1)
+               u(k, i - 1) = u(k, i - 1) + d(k, i - 1)
+            end do
+         end if
+      end associate
+   end subroutine lockstep_back_update
+
    !> y = A x of every lane for a symmetric band matrix by diagonals (beamstops_band_solve's
    !> diagonal_matvec, n >= 2 kd + 1).
    pure subroutine lockstep_matvec(diagonals, x, y)
@@ -323,21 +416,39 @@ contains
       !> Any positive number the compiler cannot see (add_rounded); the loop passes dt^2.
       real(wp), intent(in) :: positive
       integer :: j, k
-      partial(:, 1:8) = 0
-      do j = 1, n - 7, 8
+      if (n < 8) then
+         partial(:, 1:8) = 0
+         j = 1
+      else
+         ! the first eight rows start the partial sums from zero (0 + x y, no store of zeros
+         ! before them)
 !GCC$ ivdep
 !GCC$ vector
          do k = 1, lockstep_lanes
-            partial(k, 1) = partial(k, 1) + x(k, j)*y(k, j)
-            partial(k, 2) = partial(k, 2) + x(k, j + 1)*y(k, j + 1)
-            partial(k, 3) = partial(k, 3) + x(k, j + 2)*y(k, j + 2)
-            partial(k, 4) = partial(k, 4) + x(k, j + 3)*y(k, j + 3)
-            partial(k, 5) = partial(k, 5) + x(k, j + 4)*y(k, j + 4)
-            partial(k, 6) = partial(k, 6) + x(k, j + 5)*y(k, j + 5)
-            partial(k, 7) = partial(k, 7) + x(k, j + 6)*y(k, j + 6)
-            partial(k, 8) = partial(k, 8) + x(k, j + 7)*y(k, j + 7)
+            partial(k, 1) = 0.0_wp + x(k, 1)*y(k, 1)
+            partial(k, 2) = 0.0_wp + x(k, 2)*y(k, 2)
+            partial(k, 3) = 0.0_wp + x(k, 3)*y(k, 3)
+            partial(k, 4) = 0.0_wp + x(k, 4)*y(k, 4)
+            partial(k, 5) = 0.0_wp + x(k, 5)*y(k, 5)
+            partial(k, 6) = 0.0_wp + x(k, 6)*y(k, 6)
+            partial(k, 7) = 0.0_wp + x(k, 7)*y(k, 7)
+            partial(k, 8) = 0.0_wp + x(k, 8)*y(k, 8)
          end do
-      end do
+         do j = 9, n - 7, 8
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               partial(k, 1) = partial(k, 1) + x(k, j)*y(k, j)
+               partial(k, 2) = partial(k, 2) + x(k, j + 1)*y(k, j + 1)
+               partial(k, 3) = partial(k, 3) + x(k, j + 2)*y(k, j + 2)
+               partial(k, 4) = partial(k, 4) + x(k, j + 3)*y(k, j + 3)
+               partial(k, 5) = partial(k, 5) + x(k, j + 4)*y(k, j + 4)
+               partial(k, 6) = partial(k, 6) + x(k, j + 5)*y(k, j + 5)
+               partial(k, 7) = partial(k, 7) + x(k, j + 6)*y(k, j + 6)
+               partial(k, 8) = partial(k, 8) + x(k, j + 7)*y(k, j + 7)
+            end do
+         end do
+      end if
       call dot_tail(n, j, x, y, partial, s, positive)
    end subroutine lockstep_dot
 
@@ -403,34 +514,37 @@ contains
    pure subroutine dot_tail(n, first, x, y, partial, s, positive)
       integer, intent(in) :: n, first
       real(wp), intent(in) :: x(lockstep_lanes, n), y(lockstep_lanes, n)
-      real(wp), intent(inout) :: partial(lockstep_lanes, lockstep_work_columns)
+      real(wp), intent(in) :: partial(lockstep_lanes, lockstep_work_columns)
       real(wp), intent(out) :: s(lockstep_lanes)
       real(wp), intent(in) :: positive
+      real(wp) :: t(lockstep_lanes), p(lockstep_lanes, 4)
       integer :: j, k
       j = first
 !GCC$ ivdep
 !GCC$ vector
       do k = 1, lockstep_lanes
-         s(k) = ((partial(k, 1) + partial(k, 5)) + (partial(k, 2) + partial(k, 6))) &
+         t(k) = ((partial(k, 1) + partial(k, 5)) + (partial(k, 2) + partial(k, 6))) &
             & + ((partial(k, 3) + partial(k, 7)) + (partial(k, 4) + partial(k, 8)))
       end do
       ! the rows after the last eight: four or more, the next four products rounded and added
-      ! in order; then the rest (at most three) by multiply-adds
+      ! in order; then the rest (at most three) by multiply-adds (t local: the sums stay in
+      ! registers)
       if (n - j + 1 >= 4) then
-         partial(:, 1:4) = x(:, j:j + 3)*y(:, j:j + 3)
-         call add_rounded(s, partial(:, 1), positive)
-         call add_rounded(s, partial(:, 2), positive)
-         call add_rounded(s, partial(:, 3), positive)
-         call add_rounded(s, partial(:, 4), positive)
+         p = x(:, j:j + 3)*y(:, j:j + 3)
+         call add_rounded(t, p(:, 1), positive)
+         call add_rounded(t, p(:, 2), positive)
+         call add_rounded(t, p(:, 3), positive)
+         call add_rounded(t, p(:, 4), positive)
          j = j + 4
       end if
       do j = j, n
 !GCC$ ivdep
 !GCC$ vector
          do k = 1, lockstep_lanes
-            s(k) = s(k) + x(k, j)*y(k, j)
+            t(k) = t(k) + x(k, j)*y(k, j)
          end do
       end do
+      s = t
    end subroutine dot_tail
 
    !> The right-hand sides of a step, rhs = a g - b S u plus `spring` in the tip row n-1 (the

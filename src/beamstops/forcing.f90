@@ -6,7 +6,7 @@ module beamstops_forcing
    implicit none
    private
    public :: lift_shape, lift_slope, support_position, load_average
-   public :: load_rotation, start_loads, next_load
+   public :: load_rotation, start_loads, next_load, restart_every
 
    !> The load averages sigma_k = f sin(omega c_k) (load_average; f = sinc(omega dt/2),
    !> c_k the centre of step k's interval) step after step by rotating (f sin, f cos)(omega c_k)

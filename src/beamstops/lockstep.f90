@@ -27,29 +27,34 @@
 !> (SPEC 9) and the massless tip of mass redistribution (SPEC 10) run in the general loop of
 !> beamstops_lockstep_general (lockstep_general.f90), advance_fused_general per member; the
 !> members' state and the pieces of a step both loops share are beamstops_lockstep_members'.
+!> The plain loop here (advance_members) keeps a step's per-member values in fixed-size lanes
+!> during a block (beamstops_lockstep_lanes, gathered and scattered at the block's ends).
 !> Stops along the span (SPEC 7) are refused (their QP per member is not in this path yet).
 module beamstops_lockstep
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
    use beamstops_strings, only: fmt_real, fmt_int
-   use beamstops_scene, only: scene_type, steps_of, stop_count, law_signorini, law_compliance, law_name
+   use beamstops_scene, only: scene_type, steps_of, stop_count, law_compliance, law_name
    use beamstops_model, only: model_type, build_model, check_stability
    use beamstops_hermite, only: hermite_basis, gauss_points, gauss_weights
    use beamstops_band, only: band_matvec
    use beamstops_band_solve, only: prepare_solver, prepare_diagonals, diagonal_matvec, dot
-   use beamstops_band_solve_lockstep, only: lockstep_forward, lockstep_forward_energy, lockstep_back, &
-      & lockstep_matvec, lockstep_dot, lockstep_min_unknowns, lockstep_work_columns, &
-      & lockstep_lanes, lockstep_matvec_rhs, lockstep_update
+   use beamstops_band_solve_lockstep, only: lockstep_forward, lockstep_forward_energy, lockstep_back_edge, &
+      & lockstep_back_update, lockstep_matvec, lockstep_dot, lockstep_min_unknowns, lockstep_work_columns, &
+      & lockstep_lanes, lockstep_matvec_rhs
+   use beamstops_lockstep_lanes, only: lanes_type, lanes_restart_loads, lanes_next_loads, lanes_begin_step, &
+      & lanes_contact, lanes_close
    use beamstops_state, only: state_type
    use beamstops_scheme, only: start_state, block_steps
    use beamstops_clock, only: thread_cpu_seconds
-   use beamstops_forcing, only: lift_shape, lift_slope
+   use beamstops_forcing, only: lift_shape, lift_slope, restart_every
    use beamstops_lockstep_physics, only: check_shared_physics
-   use beamstops_lockstep_members, only: operators_type, members_type, lane, chunk, contact_law, close_steps, &
-      & fill_row, take_snapshot, start_loads, next_loads, first_events, energy
+   use beamstops_lockstep_members, only: operators_type, members_type, lane, chunk, take_snapshot, first_events, &
+      & energy
    use beamstops_lockstep_general, only: advance_members_general
-   use beamstops_recorder, only: recorder_type, n_columns, col_energy
+   use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
+      & col_work, col_dissipated, col_damped
    use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running
    implicit none
    private
@@ -275,7 +280,8 @@ contains
       summary%max_violation = ms%max_violation(k)
       summary%contact_phases = ms%impacts(k)
       ! the ledger (close_ledger)
-      damped = ms%damped(k)
+      damped = 0
+      if (ms%general) damped = ms%damped(k)
       ms%vec_u = ms%u(lane(k), :, chunk(k))
       ms%vec_d = ms%d(lane(k), :, chunk(k))
       call band_matvec(model%mass, ms%vec_d, ms%vec_s)
@@ -303,12 +309,12 @@ contains
       ms%p_prev(k) = 0
       ms%p_now(k) = 0
       if (allocated(ms%cd)) ms%cd(lane(k), :, chunk(k)) = 0
-      ms%dcd_prev(k) = 0
+      if (ms%general) ms%dcd_prev(k) = 0
    end subroutine finish_member
 
    !> Start every member by the one-scene start (start_state, which hands each recorder its
    !> record of t = 0) with the member's load vector and initial velocity, and gather the
-   !> states into the members' arrays.
+   !> states into the members' arrays (with the general loop's own, start_general).
    subroutine start_members(scenes, model, recorders, ms, error, initial_displacement)
       type(scene_type), intent(in) :: scenes(:)
       type(model_type), intent(in) :: model
@@ -339,26 +345,12 @@ contains
       allocate (ms%sigma_prev(nk), ms%sigma_now(nk), ms%gd_prev(nk), ms%p_prev(nk), ms%p_now(nk), ms%work(nk), &
          & ms%dissipated(nk), ms%energy0(nk), ms%reaction(nk), ms%max_violation(nk), ms%in_contact(nk), &
          & ms%active(nk), ms%impacts(nk))
-      allocate (ms%sigma(nk), ms%cosine(nk), ms%cos_step(nk), ms%sin_step(nk))
-      allocate (ms%sigma_next(nk), ms%weight(nk), ms%coef(nk), ms%spring(nk), ms%trial(nk), ms%c(nk), &
-         & ms%tip_value(nk), ms%r_step(nk), ms%u_tip_prev(nk), ms%d_tip_prev(nk), ms%r_prev(nk), ms%usu(nk), &
-         & ms%dsu(nk), ms%dmd(nk), ms%u_old_su(nk), ms%gd(nk), ms%contact(nk), ms%pending(nk), &
-         & ms%next_record(nk), ms%next_snapshot(nk), ms%rows(n_columns, nk))
+      allocate (ms%pending(nk), ms%next_record(nk), ms%next_snapshot(nk), ms%rows(n_columns, nk))
       allocate (ms%vec_u(n), ms%vec_d(n), ms%vec_su(n), ms%vec_s(n), ms%shape(size(model%x)))
       allocate (ms%observers(ms%k))
-      allocate (ms%lower(nk), ms%upper(nk), ms%u_tip(nk), ms%d_tip(nk))
-      allocate (ms%damped(nk), ms%dcd_prev(nk), ms%cross(nk), ms%dcd(nk), ms%restitution(nk), ms%s_u_tip(nk), &
-         & ms%s_d_prev_tip(nk), ms%bound_lower(nk), ms%bound_upper(nk))
       call zero_members(ms)
       ms%general = model%damped .or. model%redistributed .or. any(scenes%restitution > 0)
-      if (model%damped) then
-         allocate (ms%cd(lockstep_lanes, n, ms%chunks))
-         ms%cd = 0
-      end if
-      ms%lower = -1
-      ms%upper = 1
-      ms%u_tip = 0
-      ms%d_tip = 0
+      if (ms%general) call start_general(model%damped, ms)
       ms%active = .false.
       ms%active(:ms%k) = .true.
       nk = ms%k
@@ -382,8 +374,6 @@ contains
             return
          end if
          ms%g(lane(k), :, chunk(k)) = member%load
-         ms%lower(k) = scenes(k)%lower
-         ms%upper(k) = scenes(k)%upper
          ms%u(lane(k), :, chunk(k)) = state%u
          ms%d(lane(k), :, chunk(k)) = state%d
          ms%su(lane(k), :, chunk(k)) = state%su
@@ -401,7 +391,11 @@ contains
          ms%impacts(k) = state%impacts
          ms%observers(k) = state%observer
          ms%step = state%step
-         ms%restitution(k) = scenes(k)%restitution
+         if (ms%general) then
+            ms%lower(k) = scenes(k)%lower
+            ms%upper(k) = scenes(k)%upper
+            ms%restitution(k) = scenes(k)%restitution
+         end if
          if (model%damped) then
             ms%cd(lane(k), :, chunk(k)) = state%cd
             ms%dcd_prev(k) = state%dcd_prev
@@ -425,6 +419,26 @@ contains
       ms%max_violation = 0
       ms%in_contact = .false.
       ms%impacts = 0
+      ms%pending = .false.
+      ms%next_record = huge(1_ik)
+      ms%next_snapshot = huge(1_ik)
+   end subroutine zero_members
+
+   !> The general loop's per-member arrays (beamstops_lockstep_general: it keeps a step's values
+   !> per member, where the plain loop keeps them in its chunks' lanes), zero; the stops -1 and 1
+   !> (the padding lanes keep them); C d^{n-1} with damping.
+   subroutine start_general(damped, ms)
+      logical, intent(in) :: damped
+      type(members_type), intent(inout) :: ms
+      integer :: nk
+      nk = ms%p
+      allocate (ms%sigma(nk), ms%cosine(nk), ms%cos_step(nk), ms%sin_step(nk))
+      allocate (ms%sigma_next(nk), ms%weight(nk), ms%coef(nk), ms%spring(nk), ms%trial(nk), ms%c(nk), &
+         & ms%tip_value(nk), ms%r_step(nk), ms%u_tip_prev(nk), ms%d_tip_prev(nk), ms%r_prev(nk), ms%usu(nk), &
+         & ms%dsu(nk), ms%dmd(nk), ms%u_old_su(nk), ms%gd(nk), ms%contact(nk))
+      allocate (ms%lower(nk), ms%upper(nk), ms%u_tip(nk), ms%d_tip(nk))
+      allocate (ms%damped(nk), ms%dcd_prev(nk), ms%cross(nk), ms%dcd(nk), ms%restitution(nk), ms%s_u_tip(nk), &
+         & ms%s_d_prev_tip(nk), ms%bound_lower(nk), ms%bound_upper(nk))
       ms%sigma = 0
       ms%cosine = 0
       ms%cos_step = 0
@@ -446,9 +460,10 @@ contains
       ms%u_old_su = 0
       ms%gd = 0
       ms%contact = .false.
-      ms%pending = .false.
-      ms%next_record = huge(1_ik)
-      ms%next_snapshot = huge(1_ik)
+      ms%lower = -1
+      ms%upper = 1
+      ms%u_tip = 0
+      ms%d_tip = 0
       ms%damped = 0
       ms%dcd_prev = 0
       ms%cross = 0
@@ -458,7 +473,11 @@ contains
       ms%s_d_prev_tip = 0
       ms%bound_lower = -1
       ms%bound_upper = 1
-   end subroutine zero_members
+      if (damped) then
+         allocate (ms%cd(lockstep_lanes, ms%n, ms%chunks))
+         ms%cd = 0
+      end if
+   end subroutine start_general
 
 
    !> A member's load vector g = a (omega^2 (h, phi_i) + 8 k^2/L^4 (1, phi_i)), as build_model
@@ -495,7 +514,11 @@ contains
    end subroutine load_shapes
 
    !> Advance every member from ms%step through step `last` (advance_fused of beamstops_scheme,
-   !> per member, the member index innermost).
+   !> per member, the member index innermost). The members' values live in the chunks' lanes
+   !> (beamstops_lockstep_lanes) during the block. Per step and chunk: the load rotation, S u and
+   !> the right-hand side, the forward substitution (with the energy sums when a record wants
+   !> them); then the tip rows of the back substitution, the contact law of each lane, the rest
+   !> of the back substitution with the update riding on it, g.d and the bookkeeping.
    subroutine advance_members(scenes, model, ops, ms, recorders, last)
       type(scene_type), intent(in) :: scenes(:)
       type(model_type), intent(in) :: model
@@ -503,12 +526,15 @@ contains
       type(members_type), intent(inout) :: ms
       class(recorder_type), intent(inout) :: recorders(:)
       integer(ik), intent(in) :: last
-      integer(ik) :: step, next_record, next_snapshot
-      integer :: k, c, lo, hi, n, tip, law
-      logical :: energy_wanted, pending, observing
+      type(lanes_type), allocatable :: lanes(:)
+      integer(ik) :: step, next_record, next_snapshot, load_k
+      integer :: k, c, n, tip, law
+      logical :: energy_wanted, pending, observing, restart
+      real(wp) :: z_tip
 
       n = ms%n
       tip = model%tip
+      z_tip = model%z(tip)
       law = scenes(1)%law
       do k = 1, ms%k
          call first_events(scenes(k), ms%step, ms%next_record(k), ms%next_snapshot(k))
@@ -518,78 +544,61 @@ contains
       observing = any(ms%observers%active)
       ms%pending = .false.
       pending = .false.
-      ms%u_old_su = 0
-      ms%dmd = 0
-      call start_loads(ms, ms%step + 1, scenes, model)
+      allocate (lanes(ms%chunks))
+      call gather_lanes(scenes, ms, lanes)
+      load_k = start_lanes_loads(lanes, ms%step + 1, model%dt)
       do step = ms%step, last
-         ms%sigma_next = ms%sigma
-         call next_loads(ms, scenes, model)
-         ms%weight = model%beta*ms%sigma_next + (1 - 2*model%beta)*ms%sigma_now + model%beta*ms%sigma_prev
-         ! the forward pass, a chunk of members after the other
-         ms%coef = model%dt2*ms%weight
-         if (law == law_compliance) ms%spring = model%dt2*((1 - 2*model%beta)*ms%p_now + model%beta*ms%p_prev)
+         restart = mod(load_k + 1, restart_every) == 0
          energy_wanted = pending .or. step == next_record
+         ! the forward pass, a chunk of members after the other
          do c = 1, ms%chunks
-            lo = (c - 1)*lockstep_lanes + 1
-            hi = c*lockstep_lanes
-            call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), ms%coef(lo:hi), ms%g(:, :, c), model%dt2, &
-               & ms%spring(lo:hi), ms%su(:, :, c), ms%rhs(:, :, c))
+            call lanes_begin_step(lanes(c), law, model%beta, model%dt2, restart, load_k + 1, model%dt)
+            call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), lanes(c)%coef, ms%g(:, :, c), model%dt2, &
+               & lanes(c)%spring, ms%su(:, :, c), ms%rhs(:, :, c))
             if (energy_wanted) then
                call lockstep_forward_energy(ops%solver, ops%mass, ms%u(:, :, c), ms%d(:, :, c), ms%su(:, :, c), &
-                  & ms%rhs(:, :, c), ms%usu(lo:hi), ms%dsu(lo:hi), ms%dmd(lo:hi), ms%partial)
+                  & ms%rhs(:, :, c), lanes(c)%usu, lanes(c)%dsu, lanes(c)%dmd, ms%partial)
             else
                call lockstep_forward(ops%solver, ms%rhs(:, :, c))
             end if
          end do
+         load_k = load_k + 1
          if (pending) then
             do k = 1, ms%k
                if (.not. ms%pending(k)) cycle
-               ms%rows(col_energy, k) = scenes(k)%mass_per_length*energy(model, ms%dmd(k), ms%usu(k), ms%dsu(k), &
-                  & ms%u_old_su(k))
+               associate (ln => lanes(chunk(k)), i => lane(k))
+                  ms%rows(col_energy, k) = scenes(k)%mass_per_length*energy(model, ln%dmd(i), ln%usu(i), ln%dsu(i), &
+                     & ln%u_old_su(i))
+               end associate
                if (ms%active(k)) call recorders(k)%record(ms%rows(:, k))
                ms%pending(k) = .false.
             end do
             pending = .false.
          end if
-         if (energy_wanted) then
-            ms%u_old_su = ms%usu
-         else
-            ms%u_old_su = 0
-         end if
          ! the back substitution and the tip step: the contact law, the update and the
          ! bookkeeping (tip_step, close_step)
          do c = 1, ms%chunks
-            lo = (c - 1)*lockstep_lanes + 1
-            hi = c*lockstep_lanes
-            call lockstep_back(ops%solver, ms%rhs(:, :, c), ms%partial)
-            ms%d_tip_prev(lo:hi) = ms%d(:, tip, c)
-            ms%u_tip_prev(lo:hi) = ms%u(:, tip, c)
-            ms%trial(lo:hi) = ms%u_tip_prev(lo:hi) + (ms%d_tip_prev(lo:hi) + ms%rhs(:, tip, c))
+            if (energy_wanted) then
+               lanes(c)%u_old_su = lanes(c)%usu
+            else
+               lanes(c)%u_old_su = 0
+            end if
+            call lockstep_back_edge(ops%solver, ms%rhs(:, :, c), ms%partial)
+            call lanes_contact(lanes(c), law, ms%u(:, tip, c), ms%d(:, tip, c), ms%rhs(:, tip, c), z_tip, model%dt2, &
+               & model%beta)
+            call lockstep_back_update(ops%solver, ms%rhs(:, :, c), lanes(c)%c, model%z, ms%d(:, :, c), ms%u(:, :, c))
+            call lockstep_dot(n, ms%g(:, :, c), ms%d(:, :, c), ms%partial, lanes(c)%gd, model%dt2)
+            call lanes_close(lanes(c), law, ms%u(:, tip, c), ms%d(:, tip, c))
          end do
-         call contact_law(law, scenes, model, ms)
-         do c = 1, ms%chunks
-            lo = (c - 1)*lockstep_lanes + 1
-            hi = c*lockstep_lanes
-            call lockstep_update(n, ms%rhs(:, :, c), ms%c(lo:hi), model%z, ms%d(:, :, c), ms%u(:, :, c))
-            call lockstep_dot(n, ms%g(:, :, c), ms%d(:, :, c), ms%partial, ms%gd(lo:hi), model%dt2)
-            ms%u_tip(lo:hi) = ms%u(:, tip, c)
-            ms%d_tip(lo:hi) = ms%d(:, tip, c)
-         end do
-         ms%r_prev = ms%reaction
-         call close_steps(law, ms)
-         if (law == law_signorini) then
-            do c = 1, ms%chunks
-               lo = (c - 1)*lockstep_lanes + 1
-               hi = c*lockstep_lanes
-               ms%u(:, tip, c) = ms%u_tip(lo:hi)
-               ms%d(:, tip, c) = ms%d_tip(lo:hi)
-            end do
-         end if
          ! the shock log and statistics of each member that keeps them
          if (observing) then
             do k = 1, ms%k
-               if (ms%observers(k)%active .and. ms%active(k)) call ms%observers(k)%tip(real(step + 1, wp)*model%dt, &
-                  & ms%u_tip(k), ms%reaction(k), ms%dissipated(k))
+               if (ms%observers(k)%active .and. ms%active(k)) then
+                  associate (ln => lanes(chunk(k)), i => lane(k))
+                     call ms%observers(k)%tip(real(step + 1, wp)*model%dt, ln%u_tip(i), ln%reaction(i), &
+                        & ln%dissipated(i))
+                  end associate
+               end if
             end do
          end if
          ! records and snapshots
@@ -597,7 +606,7 @@ contains
             do k = 1, ms%k
                if (step == ms%next_record(k)) then
                   ms%next_record(k) = ms%next_record(k) + scenes(k)%record_every
-                  call fill_row(scenes(k), model, ms, k, step, ms%rows(:, k))
+                  call fill_row_lanes(scenes(k), model, ms, lanes(chunk(k)), k, step, ms%rows(:, k))
                   ms%pending(k) = .true.
                   pending = .true.
                end if
@@ -610,6 +619,7 @@ contains
             next_snapshot = minval(ms%next_snapshot)
          end if
       end do
+      call scatter_lanes(lanes, ms)
       ! S u^{last+1}; it also completes the waiting records, as advance_fused does (one member
       ! at a time, with the one-member products and dot products).
       do c = 1, ms%chunks
@@ -624,10 +634,106 @@ contains
          ms%vec_su = ms%su(lane(k), :, chunk(k))
          call diagonal_matvec(ops%mass, ms%vec_d, ms%vec_s)
          ms%rows(col_energy, k) = scenes(k)%mass_per_length*energy(model, dot(ms%vec_d, ms%vec_s), &
-            & dot(ms%vec_u, ms%vec_su), dot(ms%vec_d, ms%vec_su), ms%u_old_su(k))
+            & dot(ms%vec_u, ms%vec_su), dot(ms%vec_d, ms%vec_su), lanes(chunk(k))%u_old_su(lane(k)))
          call recorders(k)%record(ms%rows(:, k))
       end do
    end subroutine advance_members
+
+   !> The chunks' lanes at the start of a block: each member's constants and the values it
+   !> carries from step to step (padding lanes keep the lanes' defaults: at rest).
+   subroutine gather_lanes(scenes, ms, lanes)
+      type(scene_type), intent(in) :: scenes(:)
+      type(members_type), intent(in) :: ms
+      type(lanes_type), intent(out) :: lanes(:)
+      integer :: k
+      do k = 1, ms%k
+         associate (ln => lanes(chunk(k)), i => lane(k))
+            ln%member(i) = .true.
+            ln%omega(i) = scenes(k)%omega
+            ln%centered(i) = scenes(k)%centered_load
+            ln%lower(i) = scenes(k)%lower
+            ln%upper(i) = scenes(k)%upper
+            ln%stiffness(i) = scenes(k)%stiffness_per_mass
+            ln%sigma_prev(i) = ms%sigma_prev(k)
+            ln%sigma_now(i) = ms%sigma_now(k)
+            ln%gd_prev(i) = ms%gd_prev(k)
+            ln%p_prev(i) = ms%p_prev(k)
+            ln%p_now(i) = ms%p_now(k)
+            ln%work(i) = ms%work(k)
+            ln%dissipated(i) = ms%dissipated(k)
+            ln%reaction(i) = ms%reaction(k)
+            ln%max_violation(i) = ms%max_violation(k)
+            ln%in_contact(i) = ms%in_contact(k)
+            ln%impacts(i) = ms%impacts(k)
+         end associate
+      end do
+   end subroutine gather_lanes
+
+   !> The values the members carry from step to step, back from the lanes at the end of a block.
+   subroutine scatter_lanes(lanes, ms)
+      type(lanes_type), intent(in) :: lanes(:)
+      type(members_type), intent(inout) :: ms
+      integer :: k
+      do k = 1, ms%k
+         associate (ln => lanes(chunk(k)), i => lane(k))
+            ms%sigma_prev(k) = ln%sigma_prev(i)
+            ms%sigma_now(k) = ln%sigma_now(i)
+            ms%gd_prev(k) = ln%gd_prev(i)
+            ms%p_prev(k) = ln%p_prev(i)
+            ms%p_now(k) = ln%p_now(i)
+            ms%work(k) = ln%work(i)
+            ms%dissipated(k) = ln%dissipated(i)
+            ms%reaction(k) = ln%reaction(i)
+            ms%max_violation(k) = ln%max_violation(i)
+            ms%in_contact(k) = ln%in_contact(i)
+            ms%impacts(k) = ln%impacts(i)
+         end associate
+      end do
+   end subroutine scatter_lanes
+
+   !> The load rotation of every chunk at step k (beamstops_forcing's start_loads): from
+   !> load_average at the last multiple of restart_every, then rotated. Returns k.
+   function start_lanes_loads(lanes, k, dt) result(load_k)
+      type(lanes_type), intent(inout) :: lanes(:)
+      integer(ik), intent(in) :: k
+      real(wp), intent(in) :: dt
+      integer(ik) :: load_k
+      integer :: c
+      load_k = (k/restart_every)*restart_every
+      do c = 1, size(lanes)
+         call lanes_restart_loads(lanes(c), load_k, dt)
+      end do
+      do while (load_k < k)
+         do c = 1, size(lanes)
+            call lanes_next_loads(lanes(c), mod(load_k + 1, restart_every) == 0, load_k + 1, dt)
+         end do
+         load_k = load_k + 1
+      end do
+   end function start_lanes_loads
+
+   !> Member k's record row of step n from its chunk's lanes, the energy column left for later
+   !> (beamstops_ledger's fill_row; the general loop's, on the members' arrays, is
+   !> beamstops_lockstep_members' fill_row_members).
+   subroutine fill_row_lanes(scene, model, ms, lanes, k, step, row)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(members_type), intent(in) :: ms
+      !> Member k's chunk.
+      type(lanes_type), intent(in) :: lanes
+      integer, intent(in) :: k
+      integer(ik), intent(in) :: step
+      real(wp), intent(out) :: row(n_columns)
+      integer :: i
+      i = lane(k)
+      row(col_t) = real(step, wp)*model%dt
+      row(col_u) = lanes%u_tip_prev(i)
+      row(col_v) = (ms%d(i, model%tip, chunk(k)) + lanes%d_tip_prev(i))/(2*model%dt)
+      row(col_reaction) = scene%mass_per_length*lanes%r_prev(i)
+      row(col_energy) = 0
+      row(col_work) = scene%mass_per_length*lanes%work(i)
+      row(col_dissipated) = scene%mass_per_length*lanes%dissipated(i)
+      row(col_damped) = scene%mass_per_length*0.0_wp
+   end subroutine fill_row_lanes
 
 
    !> Text of a real for messages.

@@ -2,7 +2,9 @@
 !> Rayleigh damping, restitution and/or the massless tip of mass redistribution, as
 !> beamstops_scheme's advance_fused_general is advance_fused with them. A loop of its own, so that
 !> the loop of the paper's scheme stays as it is (simulate_lockstep branches once per block); the
-!> members' state and the shared pieces of a step are beamstops_lockstep_members'.
+!> members' state and the shared pieces of a step are beamstops_lockstep_members'. Unlike the plain
+!> loop (which keeps a step's values in fixed-size lanes, beamstops_lockstep_lanes), it keeps them
+!> in the members' arrays (allocated only for a general group) and is not tuned for speed.
 !>
 !> Per member and step, the operations of advance_fused_general in the same order:
 !> - the forward pass with -dt C d^{n-1} in the right-hand side (lockstep_matvec_rhs_damped) and,
@@ -28,7 +30,7 @@ module beamstops_lockstep_general
    use beamstops_band_solve_lockstep_general, only: lockstep_matvec_rhs_damped, lockstep_row
    use beamstops_contact_mass_redistribution, only: massless_reaction, equilibrium_rows
    use beamstops_lockstep_members, only: operators_type, members_type, lane, chunk, contact_law, close_steps, &
-      & project_lanes, fill_row, take_snapshot, start_loads, next_loads, first_events, energy
+      & project_lanes, fill_row_members, take_snapshot, start_loads, next_loads, first_events, energy
    use beamstops_recorder, only: recorder_type, col_energy
    implicit none
    private
@@ -196,7 +198,7 @@ contains
             do k = 1, ms%k
                if (step == ms%next_record(k)) then
                   ms%next_record(k) = ms%next_record(k) + scenes(k)%record_every
-                  call fill_row(scenes(k), model, ms, k, step, ms%rows(:, k))
+                  call fill_row_members(scenes(k), model, ms, k, step, ms%rows(:, k))
                   ms%pending(k) = .true.
                   pending = .true.
                end if

@@ -1,10 +1,14 @@
-!> The members of a lockstep group (SPEC 13) and the per-member bookkeeping of a step shared by
-!> the loops of beamstops_lockstep (the paper's scheme) and beamstops_lockstep_general (damping,
-!> restitution, a massless tip): the state of K members with the member index first, the shared
-!> operators, and the pieces of a step written over the members (the tip's contact law, the close
-!> of a step, the record row, snapshots, the load rotation, the energy). Each is the one-scene
-!> routine of beamstops_scheme / beamstops_ledger / beamstops_contact_tip_contact, per member, with
-!> the same operations in the same order (tests/fortran/test_lockstep.f90 compares whole runs to
+!> The members of a lockstep group (SPEC 13): the state of K members with the member index first
+!> and the shared operators, for both loops, beamstops_lockstep's advance_members (the paper's
+!> scheme) and beamstops_lockstep_general's advance_members_general (damping, restitution, a
+!> massless tip); the pieces of a step both loops use (lane, chunk, snapshots; beamstops_ledger's
+!> first_events and energy handed on); and the general loop's pieces of a step over the members'
+!> arrays (the tip's contact law, the close of a step, the record row fill_row_members, the load
+!> rotation). The plain loop keeps a step's values in fixed-size lanes instead
+!> (beamstops_lockstep_lanes, with its own contact law, close and load rotation, and
+!> lockstep.f90's fill_row_lanes). Each is the one-scene routine of beamstops_scheme /
+!> beamstops_ledger / beamstops_contact_tip_contact, per member, with the same operations in the
+!> same order (tests/fortran/test_lockstep.f90 and test_lockstep_general.f90 compare whole runs to
 !> the bit).
 module beamstops_lockstep_members
    use beamstops_kinds, only: wp, ik
@@ -12,19 +16,18 @@ module beamstops_lockstep_members
    use beamstops_model, only: model_type
    use beamstops_band_solve, only: band_solver, band_diagonals
    use beamstops_band_solve_lockstep, only: lockstep_lanes
-   use beamstops_forcing, only: load_average, support_position
+   use beamstops_forcing, only: load_average, support_position, restart_every
    use beamstops_contact_compliance, only: spring_force, solve_spring_tip
    use beamstops_observe_observer, only: observer_type
+   use beamstops_ledger, only: energy, first_events
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
       & col_work, col_dissipated, col_damped
    implicit none
    private
-   public :: operators_type, members_type, lane, chunk, contact_law, close_steps, project_lanes, fill_row, &
-      & take_snapshot, start_loads, next_loads, first_events, energy
-
-   !> Steps between two restarts of the load rotation from exact values (beamstops_scheme's
-   !> restart_every: the two must agree for the loads to agree to the bit).
-   integer(ik), parameter :: restart_every = 64
+   public :: operators_type, members_type, lane, chunk, take_snapshot
+   !> beamstops_ledger's, handed on to both loops.
+   public :: first_events, energy
+   public :: contact_law, close_steps, project_lanes, fill_row_members, start_loads, next_loads
 
    !> The operators of the fused loop, shared by the members.
    type :: operators_type
@@ -48,28 +51,18 @@ module beamstops_lockstep_members
       real(wp), allocatable :: u(:, :, :), d(:, :, :), su(:, :, :), rhs(:, :, :), g(:, :, :)
       !> Work array of the kernels (lanes, lockstep_work_columns).
       real(wp), allocatable :: partial(:, :)
-      !> Per member, padded to p lanes: load averages sigma_{n-1}, sigma_n; g.d^{n-1}; spring forces p(u^{n-1}), p(u^n);
-      !> work, energy taken by the stops, E^{1/2}, reaction of the last step, largest
-      !> violation (K, per unit mass).
+      !> Per member, padded to p lanes (the plain loop: between blocks; during a block the chunks'
+      !> lanes hold them, beamstops_lockstep_lanes): load averages sigma_{n-1}, sigma_n; g.d^{n-1};
+      !> spring forces p(u^{n-1}), p(u^n); work, energy taken by the stops, E^{1/2}, reaction of
+      !> the last step, largest violation (per unit mass).
       real(wp), allocatable :: sigma_prev(:), sigma_now(:), gd_prev(:), p_prev(:), p_now(:), work(:), &
          & dissipated(:), energy0(:), reaction(:), max_violation(:)
       !> Whether the last step was in contact; whether the member still runs (K).
       logical, allocatable :: in_contact(:), active(:)
       !> Impacts so far (K).
       integer(ik), allocatable :: impacts(:)
-      !> The load rotation of each member (beamstops_scheme's load_rotation): its step index
-      !> (shared), f sin and f cos of omega c_k, cos and sin of omega dt (K).
-      integer(ik) :: load_k = 0
-      real(wp), allocatable :: sigma(:), cosine(:), cos_step(:), sin_step(:)
-      !> Tip stops of each member (padding lanes: -1, 1) (K).
-      real(wp), allocatable :: lower(:), upper(:)
-      !> Tip value and increment after the update (K).
-      real(wp), allocatable :: u_tip(:), d_tip(:)
-      !> Values of the step (K).
-      real(wp), allocatable :: sigma_next(:), weight(:), coef(:), spring(:), trial(:), c(:), tip_value(:), &
-         & r_step(:), u_tip_prev(:), d_tip_prev(:), r_prev(:), usu(:), dsu(:), dmd(:), u_old_su(:), gd(:)
-      !> Contact in the step; a record waiting for its energy (K).
-      logical, allocatable :: contact(:), pending(:)
+      !> A record waiting for its energy (K).
+      logical, allocatable :: pending(:)
       !> Next record and snapshot step of each member (K).
       integer(ik), allocatable :: next_record(:), next_snapshot(:)
       !> Record rows waiting for their energy (n_columns, K).
@@ -80,6 +73,21 @@ module beamstops_lockstep_members
       real(wp), allocatable :: vec_u(:), vec_d(:), vec_su(:), vec_s(:), shape(:)
       !> The general loop (lockstep_general.f90): damping, restitution or a massless tip.
       logical :: general = .false.
+      !> The rest is the general loop's, allocated only when `general` (the plain loop keeps a
+      !> step's values in its chunks' lanes). The load rotation of each member
+      !> (beamstops_forcing's load_rotation): its step index (shared), f sin and f cos of
+      !> omega c_k, cos and sin of omega dt (K).
+      integer(ik) :: load_k = 0
+      real(wp), allocatable :: sigma(:), cosine(:), cos_step(:), sin_step(:)
+      !> Tip stops of each member (padding lanes: -1, 1) (K).
+      real(wp), allocatable :: lower(:), upper(:)
+      !> Tip value and increment after the update (K).
+      real(wp), allocatable :: u_tip(:), d_tip(:)
+      !> Values of the step (K).
+      real(wp), allocatable :: sigma_next(:), weight(:), coef(:), spring(:), trial(:), c(:), tip_value(:), &
+         & r_step(:), u_tip_prev(:), d_tip_prev(:), r_prev(:), usu(:), dsu(:), dmd(:), u_old_su(:), gd(:)
+      !> Contact in the step (K).
+      logical, allocatable :: contact(:)
       !> With damping: C d^{n-1} of every member (lanes, n, chunks; unallocated without).
       real(wp), allocatable :: cd(:, :, :)
       !> Per member (padded): energy the damping took, d^{n-1}.C d^{n-1}, and the step's d^n.C d^{n-1}
@@ -224,8 +232,9 @@ contains
       end do
    end subroutine close_lanes
 
-   !> Member k's record row of step n, the energy column left for later (fill_row).
-   subroutine fill_row(scene, model, ms, k, step, row)
+   !> Member k's record row of step n from the members' arrays (the general loop's; the plain
+   !> loop's is lockstep.f90's fill_row_lanes), the energy column left for later (fill_row).
+   subroutine fill_row_members(scene, model, ms, k, step, row)
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
       type(members_type), intent(in) :: ms
@@ -240,7 +249,7 @@ contains
       row(col_work) = scene%mass_per_length*ms%work(k)
       row(col_dissipated) = scene%mass_per_length*ms%dissipated(k)
       row(col_damped) = scene%mass_per_length*ms%damped(k)
-   end subroutine fill_row
+   end subroutine fill_row_members
 
    !> Snapshot of member k's u^n (= u^{n+1} - d^n) at t_n (take_snapshot, physical_shape).
    subroutine take_snapshot(scene, model, ms, k, step, recorder)
@@ -315,30 +324,4 @@ contains
       end do
       ms%load_k = ms%load_k + 1
    end subroutine next_loads
-
-   !> The first recorded step and the first snapshot step at or after `step` (first_events).
-   pure subroutine first_events(scene, step, next_record, next_snapshot)
-      type(scene_type), intent(in) :: scene
-      integer(ik), intent(in) :: step
-      integer(ik), intent(out) :: next_record, next_snapshot
-      next_record = next_multiple(step, int(scene%record_every, ik))
-      next_snapshot = huge(step)
-      if (scene%snapshot_every > 0) next_snapshot = next_multiple(step, int(scene%snapshot_every, ik))
-   end subroutine first_events
-
-   !> The first multiple of `every` at or after `step`.
-   pure function next_multiple(step, every) result(m)
-      integer(ik), intent(in) :: step, every
-      integer(ik) :: m
-      m = ((step + every - 1)/every)*every
-   end function next_multiple
-
-   !> Discrete energy E^{n+1/2} per unit mass (beamstops_scheme's energy).
-   pure function energy(model, dmd, usu, dsu, u_old_s_u_old) result(e)
-      type(model_type), intent(in) :: model
-      real(wp), intent(in) :: dmd, usu, dsu, u_old_s_u_old
-      real(wp) :: e
-      e = 0.5_wp*dmd/model%dt2 + 0.5_wp*(model%beta*usu + model%beta*u_old_s_u_old &
-         & + (1 - 2*model%beta)*(usu - dsu))
-   end function energy
 end module beamstops_lockstep_members

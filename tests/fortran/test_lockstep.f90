@@ -21,7 +21,9 @@ module test_lockstep
    use beamstops_band_solve, only: band_solver, band_diagonals, prepare_solver, prepare_diagonals, diagonal_matvec, &
       & forward_substitution, forward_substitution_energy, back_substitution, dot
    use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_work_columns, lockstep_matvec, &
-      & lockstep_forward, lockstep_forward_energy, lockstep_back, lockstep_dot, lockstep_update
+      & lockstep_forward, lockstep_forward_energy, lockstep_back, lockstep_dot, lockstep_update, lockstep_back_edge, &
+      & lockstep_back_update
+   use beamstops_contact_tip_contact, only: update
    implicit none
    private
    public :: collect_lockstep
@@ -263,7 +265,7 @@ contains
       type(model_type) :: model
       type(band_solver) :: solver
       type(band_diagonals) :: s, m
-      real(wp), allocatable :: x(:, :), y(:, :), b(:, :), u(:, :), d(:, :), v(:), w(:)
+      real(wp), allocatable :: x(:, :), y(:, :), b(:, :), u(:, :), d(:, :), ub(:, :), v(:), w(:), uk(:)
       real(wp) :: work(lanes, lockstep_work_columns), usu(lanes), dsu(lanes), dmd(lanes), dd(lanes), c(lanes)
       real(wp) :: e(3)
       integer :: a, rep, k, n
@@ -277,8 +279,8 @@ contains
          call prepare_diagonals(model%stiffness, s)
          call prepare_diagonals(model%mass, m)
          n = model%n
-         if (allocated(x)) deallocate (x, y, b, u, d, v, w)
-         allocate (x(lanes, n), y(lanes, n), b(lanes, n), u(lanes, n), d(lanes, n), v(n), w(n))
+         if (allocated(x)) deallocate (x, y, b, u, d, ub, v, w, uk)
+         allocate (x(lanes, n), y(lanes, n), b(lanes, n), u(lanes, n), d(lanes, n), ub(lanes, n), v(n), w(n), uk(n))
          do rep = 1, 20
             call random_number(x)
             call random_number(u)
@@ -330,6 +332,21 @@ contains
                w = u(k, :) + v
                if (.not. (all(same_bits(v, b(k, :))) .and. all(same_bits(w, y(k, :))))) &
                   & call test_failed(error, where//'update, lane '//int_text(k))
+            end do
+            ! the back substitution with the update riding on it: back substitution, then update
+            b = x
+            call lockstep_back_edge(solver, b, work)
+            y = d
+            ub = u
+            call lockstep_back_update(solver, b, c, model%z, y, ub)
+            do k = 1, lanes
+               v = x(k, :)
+               call back_substitution(solver, v)
+               w = d(k, :)
+               uk = u(k, :)
+               call update(v, c(k), model%z, w, uk)
+               if (.not. (all(same_bits(w, y(k, :))) .and. all(same_bits(uk, ub(k, :))))) &
+                  & call test_failed(error, where//'back substitution with the update, d and u, lane '//int_text(k))
             end do
             if (allocated(error)) return
          end do
