@@ -111,29 +111,43 @@ contains
          q(r + k) = (sigma*load(r + k) - others)/s_pp(k, k)
       end do
    end subroutine equilibrium_start
-   !> S_ii - S_ib S_ib^T/S_bb in band storage on the interior unknowns (one stop unknown b): the
-   !> stiffness of the interior with the massless stop condensed. The update touches the
-   !> neighbours of b only, within kd of each other once b is removed: the band is kept.
+   !> S_ii - S_ib S_bb^{-1} S_bi in band storage on the interior unknowns: the stiffness of the
+   !> interior with the massless stop unknowns b condensed. No two stop nodes share an element, so
+   !> their values are more than kd apart and S_bb is diagonal: the correction is one rank-1 term
+   !> S_ib_k S_bi_k/S_bkbk a stop, touching its neighbours only. Those of the tip value (2J-3, 2J-2,
+   !> 2J) stay within kd = 3 of each other once b is removed; those of a value along the span
+   !> (2i-3, 2i-2, 2i, 2i+1, 2i+2) are five consecutive interior unknowns: the condensed band
+   !> needs a half-bandwidth kd + 1 (the caller gives sc kd + 2 rows then). The band of sc is its
+   !> first dimension minus one.
    pure subroutine condense_stiffness(stiffness, interior, b, sc)
       !> S in band storage (kd + 1, n).
       real(wp), intent(in) :: stiffness(:, :)
-      !> The interior unknowns (ascending) and the stop unknown b.
-      integer, intent(in) :: interior(:), b
-      !> S_ii in band storage (kd + 1, n - 1) on entry, condensed on return.
+      !> The interior unknowns (ascending) and the stop unknowns b (no two within kd).
+      integer, intent(in) :: interior(:), b(:)
+      !> S_ii in band storage (kc + 1, n - m) on entry, condensed on return.
       real(wp), intent(inout) :: sc(:, :)
       real(wp) :: sib(size(interior)), sbb
-      integer :: ii, jj, i
-      sbb = stiffness(kd + 1, b)
-      do ii = 1, size(interior)
-         i = interior(ii)
-         sib(ii) = 0
-         if (i < b .and. b - i <= kd) sib(ii) = stiffness(kd + 1 + i - b, b)
-         if (i > b .and. i - b <= kd) sib(ii) = stiffness(kd + 1 + b - i, i)
-      end do
-      do jj = 1, size(interior)
-         if (sib(jj) == 0) cycle
-         do ii = max(1, jj - kd), jj
-            if (sib(ii) /= 0) sc(kd + 1 + ii - jj, jj) = sc(kd + 1 + ii - jj, jj) - sib(ii)*sib(jj)/sbb
+      integer :: ii, jj, i, k, kc, first, last
+      kc = size(sc, 1) - 1
+      do k = 1, size(b)
+         sbb = stiffness(kd + 1, b(k))
+         first = size(interior) + 1
+         last = 0
+         do ii = 1, size(interior)
+            i = interior(ii)
+            sib(ii) = 0
+            if (i < b(k) .and. b(k) - i <= kd) sib(ii) = stiffness(kd + 1 + i - b(k), b(k))
+            if (i > b(k) .and. i - b(k) <= kd) sib(ii) = stiffness(kd + 1 + b(k) - i, i)
+            if (sib(ii) /= 0) then
+               first = min(first, ii)
+               last = max(last, ii)
+            end if
+         end do
+         do jj = first, last
+            if (sib(jj) == 0) cycle
+            do ii = max(first, jj - kc), jj
+               if (sib(ii) /= 0) sc(kc + 1 + ii - jj, jj) = sc(kc + 1 + ii - jj, jj) - sib(ii)*sib(jj)/sbb
+            end do
          end do
       end do
    end subroutine condense_stiffness

@@ -16,7 +16,7 @@ module test_reduced_physics
       & steps_of, scene_from_text, record_count, stop_count, status_complete
    use beamstops_forcing, only: load_average
    use beamstops_lapack, only: dsygv
-   use beamstops_reduced, only: reduced_model_type, prepare_reduced, reduced_matrices
+   use beamstops_reduced, only: reduced_model_type, prepare_reduced, reduced_matrices, build_reduced
    use beamstops_reduced_scheme, only: reduced_state_type, simulate_reduced, start_reduced, advance_reduced, run_reduced
    use beamstops_reduced_checkpoint, only: write_reduced_checkpoint, read_reduced_checkpoint
    use beamstops_files, only: remove_file
@@ -49,6 +49,8 @@ contains
          & 'engine', test_full_massless_laws), &
          & new_unittest('massless boundary: its frequencies are the full redistributed model''s lowest r for any r; '// &
          & 'its kappa (beta < 1/4) the full kappa_h', test_massless_frequencies), &
+         & new_unittest('massless boundary, tube (three stops along the span): the condensed band, its frequencies '// &
+         & 'the full redistributed model''s lowest r for any r; A_r z = e_p', test_massless_span_frequencies), &
          & new_unittest('massless boundary, no contact: E - E0 = W - damped to round-off', test_massless_balance), &
          & new_unittest('massless boundary, r = 8: KKT of the projection every step; the rows are the scheme''s', &
          & test_massless_kkt), &
@@ -512,6 +514,73 @@ contains
          & real_text(reduced%dt_newmark)//' s')
       call check(error, reduced%dt_newmark > 10*dt_full, 'r = 8 takes a dt ten times the full model''s')
    end subroutine test_massless_frequencies
+
+   !> The tube's three stops along the span, mass redistributed: each massless stop value couples
+   !> to five consecutive interior unknowns, so the condensed interior stiffness has the
+   !> half-bandwidth kd + 1 (a band of kd would drop the corner entries and shift the spectrum).
+   !> Its finite spectrum is still the full redistributed model's: the reduced squared
+   !> frequencies are the r lowest of (S, M^rho) for r = 4, 12 and n - 3 (the 12 lowest to 1e-10
+   !> each, all to 1e-9 of the largest); the reduced
+   !> kappa is the full kappa_h at r = n - m; the closed-form A_r solve (m = 3) gives
+   !> A_r z_j = e_{r+j} to round-off against the dense A_r = M_r + dt^2 beta S_r.
+   subroutine test_massless_span_frequencies(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(model_type) :: model
+      type(reduced_model_type) :: reduced
+      real(wp), allocatable :: mu(:), kappa_full(:), mr(:, :), sr(:, :), residual(:)
+      real(wp) :: worst
+      integer :: i, j, k, n, m
+      integer :: rs(3)
+      scene = tube(0.01_wp)
+      scene%redistributed_mass = .true.
+      ! beta < 1/4: the models compute their kappa.
+      scene%beta = 0.2_wp
+      scene%allow_unstable = .true.
+      call build_model(scene, model, error)
+      if (allocated(error)) return
+      m = size(scene%stop_nodes)
+      call band_eigenvalues(model%mass, model%stiffness, mu, error)
+      if (allocated(error)) return
+      n = size(mu)
+      ! mu = 1/kappa ascending: the m massless modes at mu = 0 first.
+      kappa_full = [(1/mu(n + 1 - k), k=1, n - m)]
+      rs = [4, 12, n - m]
+      do i = 1, size(rs)
+         scene%modes = rs(i)
+         call build_reduced(scene, model, reduced, error)
+         if (allocated(error)) return
+         ! Relative to each omega^2 for the 12 lowest; all of them relative to the largest: the
+         ! highest carry errors of eps times the spread (the reference 1/mu from (M^rho, S), the
+         ! reduced quotient phi^T S phi - G S_bb^{-1} G^T phi a difference): 5e-10 at r = n - m.
+         k = min(rs(i), 12)
+         worst = maxval(abs(reduced%lambda(:k) - kappa_full(:k))/kappa_full(:k))
+         call note('r = '//int_text(rs(i))//': largest relative difference of omega^2 from the full model''s '// &
+            & '(12 lowest) '//real_text(worst)//', all / the largest '// &
+            & real_text(maxval(abs(reduced%lambda - kappa_full(:rs(i))))/kappa_full(rs(i)))// &
+            & '; reduced kappa '//real_text(reduced%kappa))
+         call check(error, worst, 0.0_wp, 'the lowest frequencies', thr=1e-10_wp)
+         if (allocated(error)) return
+         call check(error, maxval(abs(reduced%lambda - kappa_full(:rs(i))))/kappa_full(rs(i)), 0.0_wp, &
+            & 'the r lowest frequencies', thr=1e-9_wp)
+         if (allocated(error)) return
+         call check(error, reduced%kappa, kappa_full(rs(i)), 'kappa of the reduced model: its largest', rel=.true., &
+            & thr=1e-10_wp)
+         if (allocated(error)) return
+      end do
+      call check(error, reduced%kappa, model%kappa_h, 'r = n - m: the full kappa_h', rel=.true., thr=1e-10_wp)
+      if (allocated(error)) return
+      call reduced_matrices(reduced, mr, sr)
+      mr = mr + reduced%dt2*reduced%beta*sr
+      do j = 1, m
+         residual = matmul(mr, reduced%z(:, j))
+         residual(reduced%r + j) = residual(reduced%r + j) - 1
+         worst = maxval(abs(residual))/maxval(abs(mr))/maxval(abs(reduced%z(:, j)))
+         call note('stop '//int_text(j)//': |A_r z - e| / (|A_r| |z|) '//real_text(worst))
+         call check(error, worst, 0.0_wp, 'A_r z_j = e_{r+j}', thr=1e-12_wp)
+         if (allocated(error)) return
+      end do
+   end subroutine test_massless_span_frequencies
 
    !> The same with the other laws at the massless tip: restitution e = 0.5 (Euler start) and the
    !> compliance spring (k = 1e6 N/m per unit mass; the full model overwrites the spring's
