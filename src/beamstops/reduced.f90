@@ -41,8 +41,8 @@
 !> in stiffness_coupling, Lambda_c in lambda), A_r solved in closed form (massless_solve); its
 !> frequencies are the full redistributed model's r lowest. With m stops along the span the
 !> same with E_b (S_bb diagonal: no two stop nodes on one element) and a condensed interior band
-!> of kd + 1 (condense_stiffness); the time loop is the tip's alone (prepare_reduced refuses the
-!> span). See docs/reduced.md.
+!> of kd + 1 (condense_stiffness); each stop row stepped as its equilibrium, the box QP on C_r
+!> (advance_massless_span). See docs/reduced.md.
 !>
 !> Initial data: the stop values exactly, the rest M-orthogonally projected on the
 !> fixed-interface modes: p0 = u0(b), a0 = Phi^T M (u0 - Psi p0) (and the same for v0). With
@@ -215,13 +215,6 @@ contains
       type(model_type) :: model
       call build_model(scene, model, error)
       if (allocated(error)) return
-      if (model%redistributed .and. model%stops%m > 0) then
-         ! The basis and operators are built (build_reduced), the time loop is the tip's alone.
-         call fatal_error(error, source//": &mesh modes = "//fmt_int(int(scene%modes, ik))//" with &stops mass = "// &
-            & "'redistributed' and stops along the span (&stops x) is not supported (the reduced time loop steps "// &
-            & 'the massless tip alone); allowed: modes = 0 for those, or the tip stops')
-         return
-      end if
       call build_reduced(scene, model, reduced, error)
       if (allocated(error)) return
       call check_stability_reduced(scene, reduced, source, error)
