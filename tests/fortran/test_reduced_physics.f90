@@ -62,8 +62,8 @@ contains
          & test_massless_kkt), &
          & new_unittest('massless boundary, r = 8: the stops'' energy -> 0 and the tip converges in dt through the '// &
          & 'first contact period', test_massless_convergence), &
-         & new_unittest('a massless-boundary run resumed from a checkpoint: the same bits', test_massless_resume), &
-         & new_unittest('&mesh modes with damping and restitution accepted; what remains refused', test_validate) &
+         & new_unittest('a massless-boundary run (tip; tube) resumed from a checkpoint: the same bits', test_massless_resume), &
+         & new_unittest('&mesh modes with damping, restitution and mass redistribution (tip, span) accepted', test_validate) &
          & ]
    end subroutine collect_reduced_physics
 
@@ -683,7 +683,7 @@ contains
       if (allocated(error)) return
       ar = mr + scene%dt**2*scene%beta*sr
       steps = steps_of(scene)
-      call rec%reserve(record_count(scene), size(scene%stop_nodes, kind=ik), scene%elements + 1)
+      call rec%reserve(record_count(scene), 0_ik, scene%elements + 1, stop_count(scene))
       call start_reduced(scene, reduced, state, rec, error)
       if (allocated(error)) return
       worst_rows = 0
@@ -915,34 +915,53 @@ contains
    end function late_distance
 
    !> The massless boundary (r = 8, mass damping, statistics) to step 40000 (past the first
-   !> impacts), checkpointed, read back; both continued to t = 0.2 s: the records, q, d and the
-   !> energy ledger to the bit.
+   !> impacts), and the tube's massless span stops to step 6000, checkpointed, read back; both
+   !> continued to t = 0.2 s: the records, q, d and the energy ledger to the bit.
    subroutine test_massless_resume(error)
-      character(len=*), parameter :: path = 'test_reduced_massless.checkpoint'
       type(error_type), allocatable, intent(out) :: error
       type(scene_type) :: scene
-      type(reduced_model_type) :: reduced
-      type(reduced_state_type) :: straight, resumed
-      type(array_recorder) :: a, b
-      type(run_summary) :: sa, sb
-      integer(ik) :: records, snapshots, first
       scene = massless_scene(2.5e-6_wp, 8)
       scene%t_end = 0.2_wp
       scene%damping_mass = 2.0_wp
       scene%statistics = .true.
       scene%transient = 0.05_wp
       scene%batches = 4
+      call resume_bits(scene, 40000_ik, error)
+      if (allocated(error)) return
+      ! The tube's three massless stops along the span (r = 8), checkpointed at step 6000.
+      scene = tube(0.2_wp)
+      scene%redistributed_mass = .true.
+      scene%modes = 8
+      scene%damping_mass = 2.0_wp
+      scene%statistics = .true.
+      scene%transient = 0.05_wp
+      scene%batches = 4
+      call resume_bits(scene, 6000_ik, error)
+   end subroutine test_massless_resume
+
+   !> A reduced run checkpointed at step `at` (after impacts), read back, both continued to
+   !> t_end: the records, q, d and the ledger to the bit.
+   subroutine resume_bits(scene, at, error)
+      type(scene_type), intent(inout) :: scene
+      integer(ik), intent(in) :: at
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: path = 'test_reduced_massless.checkpoint'
+      type(reduced_model_type) :: reduced
+      type(reduced_state_type) :: straight, resumed
+      type(array_recorder) :: a, b
+      type(run_summary) :: sa, sb
+      integer(ik) :: records, snapshots, first
       call validate_scene(scene, 'test scene', error)
       if (allocated(error)) return
       call prepare_reduced(scene, 'test scene', reduced, error)
       if (allocated(error)) return
-      call a%reserve(record_count(scene), 0_ik, scene%elements + 1)
-      call b%reserve(record_count(scene), 0_ik, scene%elements + 1)
+      call a%reserve(record_count(scene), 0_ik, scene%elements + 1, stop_count(scene))
+      call b%reserve(record_count(scene), 0_ik, scene%elements + 1, stop_count(scene))
       call start_reduced(scene, reduced, straight, a, error)
       if (allocated(error)) return
-      call run_reduced(scene, reduced, straight, a, sa, 40000_ik)
-      call check(error, sa%status == 'running' .and. straight%step == 40001 .and. straight%impacts > 0, &
-         & 'stopped at step 40000, after impacts')
+      call run_reduced(scene, reduced, straight, a, sa, at)
+      call check(error, sa%status == 'running' .and. straight%step == at + 1 .and. straight%impacts > 0, &
+         & 'stopped at step '//int_text(at)//', after impacts')
       if (allocated(error)) return
       call write_reduced_checkpoint(path, scene, straight, a%filled, 0_ik, error)
       if (allocated(error)) return
@@ -962,11 +981,10 @@ contains
       if (allocated(error)) return
       call check(error, sa%damped == sb%damped .and. sa%dissipated == sb%dissipated .and. &
          & sa%energy_residual == sb%energy_residual .and. sa%impacts == sb%impacts, 'the ledger and the shocks')
-   end subroutine test_massless_resume
+   end subroutine resume_bits
 
-   !> Read by the one reader (scene_from_text): damping (ratios) and restitution are accepted with
-   !> modes > 0; mass redistribution and an ensemble are refused with one message naming the file
-   !> and the keys.
+   !> Read by the one reader (scene_from_text): damping (ratios), restitution and mass
+   !> redistribution (tip stops and stops along the span) are accepted with modes > 0.
    subroutine test_validate(error)
       type(error_type), allocatable, intent(out) :: error
       character(len=*), parameter :: nl = new_line('a'), &
