@@ -267,12 +267,6 @@ contains
             & 'members > 1) is not supported; allowed: modes = 0 (the full model) for ensembles')
          return
       end if
-      if (scene%modes > 0 .and. scene%redistributed_mass .and. stop_count(scene) > 0) then
-         call fatal_error(error, source//': &mesh modes = '//itoa(scene%modes)//" with &stops mass = 'redistributed' "// &
-            & 'and stops along the span (&stops x) is not supported; allowed: modes = 0 (the full model) for '// &
-            & 'those, or the tip stops (the massless boundary of the reduced model is the tip value)')
-         return
-      end if
       if (.not. (ieee_is_finite(scene%perturbation) .and. scene%perturbation >= 0 .and. &
          & scene%perturbation <= 1.0e-3_wp*min(-scene%lower, scene%upper))) then
          call fatal_error(error, source//': &ensemble perturbation = '//fmt_real(scene%perturbation)// &

@@ -39,7 +39,10 @@
 !> modes of (S_ii - S_ib S_bi/S_bb, M^rho_ii), the interior with the massless tip condensed, so
 !> M_r = diag(I, 0), S_r = [[Lambda_c + G G^T/S_bb, G], [G^T, S_bb]] (G = Phi^T S e_tip, stored
 !> in stiffness_coupling, Lambda_c in lambda), A_r solved in closed form (massless_solve); its
-!> frequencies are the full redistributed model's r lowest. See docs/reduced.md.
+!> frequencies are the full redistributed model's r lowest. With m stops along the span the
+!> same with E_b (S_bb diagonal: no two stop nodes on one element) and a condensed interior band
+!> of kd + 1 (condense_stiffness); each stop row stepped as its equilibrium, the box QP on C_r
+!> (advance_massless_span). See docs/reduced.md.
 !>
 !> Initial data: the stop values exactly, the rest M-orthogonally projected on the
 !> fixed-interface modes: p0 = u0(b), a0 = Phi^T M (u0 - Psi p0) (and the same for v0). With
@@ -232,7 +235,7 @@ contains
       logical, intent(in), optional :: inverse_iteration
       real(wp), allocatable :: phi_i(:, :), psi_i(:, :), mt(:, :), st(:, :), col(:), w(:), sc(:, :)
       integer, allocatable :: interior(:)
-      integer :: n, m, r, ni, j, k, stat
+      integer :: n, m, r, ni, j, k, kc, stat
       logical :: by_iteration
 
       n = model%n
@@ -244,11 +247,6 @@ contains
       end if
       m = size(reduced%b)
       ni = n - m
-      if (model%redistributed .and. model%stops%m > 0) then
-         call fatal_error(error, "reduced model: &stops mass = 'redistributed' with stops along the span is not "// &
-            & 'supported; allowed: the tip stops (the massless boundary is the tip value) or modes = 0')
-         return
-      end if
       if (r < 1 .or. r > ni) then
          call fatal_error(error, 'reduced model: modes = '//fmt_int(int(r, ik))//' is out of range; allowed: 1 <= modes <= '// &
             & fmt_int(int(ni, ik)))
@@ -279,9 +277,13 @@ contains
       by_iteration = .true.
       if (present(inverse_iteration)) by_iteration = inverse_iteration .or. ni > dense_modes_limit
       if (reduced%massless) then
-         allocate (sc(kd + 1, ni))
-         sc = band_restriction(model%stiffness, interior)
-         call condense_stiffness(model%stiffness, interior, reduced%b(1), sc)
+         ! The condensed band: kd for the tip value alone, kd + 1 with a value along the span.
+         kc = kd + 1
+         if (all(reduced%b == model%tip)) kc = kd
+         allocate (sc(kc + 1, ni))
+         sc = 0
+         sc(kc - kd + 1:, :) = band_restriction(model%stiffness, interior)
+         call condense_stiffness(model%stiffness, interior, reduced%b, sc)
          call fixed_interface_modes(model%stiffness, model%mass, interior, r, by_iteration, reduced%lambda, phi_i, &
             & error, sc)
       else
@@ -338,8 +340,11 @@ contains
                reduced%stiffness_coupling(k, j) = dot_product(reduced%basis(:, k), st(:, j))
             end do
          end do
-         ! The condensed quotients phi^T (S_ii - S_ib S_bi/S_bb) phi (m = 1).
-         reduced%lambda = reduced%lambda - reduced%stiffness_coupling(:, 1)**2/reduced%stiffness_pp(1, 1)
+         ! The condensed quotients phi^T (S_ii - S_ib S_bb^{-1} S_bi) phi (S_bb diagonal: no two
+         ! stop nodes on one element).
+         do j = 1, m
+            reduced%lambda = reduced%lambda - reduced%stiffness_coupling(:, j)**2/reduced%stiffness_pp(j, j)
+         end do
       end if
 
       reduced%load = matmul(model%load, reduced%basis)
@@ -357,7 +362,10 @@ contains
          reduced%a_solver%r = r
          reduced%a_solver%m = m
          reduced%a_solver%dinv = 1/(1 + 0.5_wp*reduced%dt*reduced%damping_a + reduced%row_scale*reduced%lambda)
-         reduced%a_solver%b = reduced%stiffness_coupling/reduced%stiffness_pp(1, 1)
+         allocate (reduced%a_solver%b(r, m))
+         do j = 1, m
+            reduced%a_solver%b(:, j) = reduced%stiffness_coupling(:, j)/reduced%stiffness_pp(j, j)
+         end do
       else if (reduced%damped) then
          ! A_r = mass_scale M_r + stiffness_scale S_r: its modal block stays diagonal.
          associate (mass_scale => 1 + 0.5_wp*reduced%dt*reduced%damping_a, &
@@ -398,24 +406,26 @@ contains
       call reduced_spectrum(scene, reduced, error)
    end subroutine build_reduced
 
-   !> Solve A_r x = y in place for the massless boundary (m = 1), O(r), allocation-free:
-   !> A_r = [D + s G G^T/S_bb, s G; s G^T, s S_bb] (s = dt^2 beta, D diagonal) gives
-   !> x_a = D^{-1} (y_a - G y_p/S_bb), x_p = (y_p/s - G.x_a)/S_bb.
+   !> Solve A_r x = y in place for the massless boundary, O(r m), allocation-free:
+   !> A_r = [D + s G S_bb^{-1} G^T, s G; s G^T, s S_bb] (s = dt^2 beta, D and S_bb diagonal) gives
+   !> x_a = D^{-1} (y_a - G S_bb^{-1} y_p), x_p = S_bb^{-1} (y_p/s - G^T x_a).
    pure subroutine massless_solve(reduced, y)
       !> Reduced model (massless).
       type(reduced_model_type), intent(in) :: reduced
-      !> Right-hand side on entry, solution on return (r + 1).
+      !> Right-hand side on entry, solution on return (r + m).
       real(wp), intent(inout) :: y(:)
-      integer :: r, i
-      real(wp) :: yp, acc
+      integer :: r, i, j
       r = reduced%r
-      yp = y(r + 1)
-      acc = 0
       do i = 1, r
-         y(i) = reduced%a_solver%dinv(i)*(y(i) - reduced%a_solver%b(i, 1)*yp)
-         acc = acc + reduced%stiffness_coupling(i, 1)*y(i)
+         do j = 1, reduced%m
+            y(i) = y(i) - reduced%a_solver%b(i, j)*y(r + j)
+         end do
+         y(i) = reduced%a_solver%dinv(i)*y(i)
       end do
-      y(r + 1) = (yp/reduced%row_scale - acc)/reduced%stiffness_pp(1, 1)
+      do j = 1, reduced%m
+         y(r + j) = (y(r + j)/reduced%row_scale - dot_product(reduced%stiffness_coupling(:, j), y(1:r)))/ &
+            & reduced%stiffness_pp(j, j)
+      end do
    end subroutine massless_solve
 
    !> The m x m identity.
@@ -468,8 +478,8 @@ contains
       logical, intent(in) :: by_inverse_iteration
       real(wp), allocatable, intent(out) :: lambda(:), phi(:, :)
       type(error_type), allocatable, intent(out) :: error
-      !> The interior stiffness to use instead of S_ii (band, kd + 1 by n - m): the massless
-      !> boundary's condensed S_ii - S_ib S_bb^{-1} S_bi.
+      !> The interior stiffness to use instead of S_ii (band, its half-bandwidth kd or kd + 1, by
+      !> n - m): the massless boundary's condensed S_ii - S_ib S_bb^{-1} S_bi.
       real(wp), intent(in), optional :: stiffness_ii(:, :)
       real(wp), allocatable :: sa(:, :), ma(:, :), sb(:, :), mb(:, :), q(:, :), w(:), work(:)
       integer, allocatable :: iwork(:), ifail(:)
@@ -500,7 +510,7 @@ contains
       end if
       range = 'I'
       if (r == ni) range = 'A'
-      call dsbgvx(jobz, range, 'U', ni, kd, kd, sa, kd + 1, ma, kd + 1, q, size(q, 1), 0.0_wp, 0.0_wp, 1, r, &
+      call dsbgvx(jobz, range, 'U', ni, size(sa, 1) - 1, kd, sa, size(sa, 1), ma, kd + 1, q, size(q, 1), 0.0_wp, 0.0_wp, 1, r, &
          & 2*tiny(1.0_wp), found, w, phi, ni, work, iwork, ifail, info)
       if (info /= 0) then
          call fatal_error(error, 'reduced model: '//dsbgvx_message(info, ni))
@@ -524,12 +534,17 @@ contains
       real(wp), intent(in) :: s(:, :), m(:, :), lambda(:)
       real(wp), intent(out) :: phi(:, :)
       type(error_type), allocatable, intent(out) :: error
-      integer, parameter :: kl = kd, ku = kd, ldab = 2*kl + ku + 1, steps = 3
+      integer, parameter :: steps = 3
       real(wp), allocatable :: ab(:, :), x(:), y(:)
       integer, allocatable :: ipiv(:)
       real(wp) :: shift, golden
-      integer :: n, i, j, k, it, info, attempt
+      integer :: n, i, j, k, it, info, attempt, ks, kl, ku, ldab
       n = size(s, 2)
+      ! S's half-bandwidth (kd, or kd + 1 for the condensed stiffness with stops along the span).
+      ks = size(s, 1) - 1
+      kl = ks
+      ku = ks
+      ldab = 2*kl + ku + 1
       allocate (ab(ldab, n), x(n), y(n), ipiv(n))
       golden = (sqrt(5.0_wp) - 1)/2
       do k = 1, size(lambda)
@@ -537,8 +552,10 @@ contains
          do attempt = 1, 4
             ab = 0
             do j = 1, n
-               do i = max(1, j - kd), j
-                  ab(kl + ku + 1 + i - j, j) = s(kd + 1 + i - j, j) - shift*m(kd + 1 + i - j, j)
+               do i = max(1, j - ks), j
+                  ab(kl + ku + 1 + i - j, j) = s(ks + 1 + i - j, j)
+                  if (j - i <= kd) ab(kl + ku + 1 + i - j, j) = ab(kl + ku + 1 + i - j, j) - &
+                     & shift*m(kd + 1 + i - j, j)
                   ab(kl + ku + 1 + j - i, i) = ab(kl + ku + 1 + i - j, j)
                end do
             end do
@@ -724,10 +741,12 @@ contains
          y(r + i) = acc
       end do
       if (reduced%massless) then
-         ! (Lambda_c a + G (G.a/S_bb + p), G.a + S_bb p) (m = 1).
-         acc = dot_product(reduced%stiffness_coupling(:, 1), q(1:r))
-         y(1:r) = y(1:r) + reduced%stiffness_coupling(:, 1)*(acc/reduced%stiffness_pp(1, 1) + q(r + 1))
-         y(r + 1) = y(r + 1) + acc
+         ! (Lambda_c a + G (S_bb^{-1} G^T a + p), G^T a + S_bb p), S_bb diagonal.
+         do j = 1, reduced%m
+            acc = dot_product(reduced%stiffness_coupling(:, j), q(1:r))
+            y(1:r) = y(1:r) + reduced%stiffness_coupling(:, j)*(acc/reduced%stiffness_pp(j, j) + q(r + j))
+            y(r + j) = y(r + j) + acc
+         end do
       end if
    end subroutine reduced_stiffness_product
 
@@ -794,7 +813,7 @@ contains
       type(reduced_model_type), intent(in) :: reduced
       !> M_r and S_r (r + m, r + m).
       real(wp), allocatable, intent(out) :: mass(:, :), stiffness(:, :)
-      integer :: r, k
+      integer :: r, k, j
       r = reduced%r
       allocate (mass(reduced%size, reduced%size), stiffness(reduced%size, reduced%size))
       mass = 0
@@ -808,8 +827,12 @@ contains
       mass(r + 1:, r + 1:) = reduced%mass_pp
       stiffness(r + 1:, r + 1:) = reduced%stiffness_pp
       if (reduced%massless) then
-         stiffness(1:r, 1:r) = stiffness(1:r, 1:r) + matmul(reduced%stiffness_coupling, &
-            & transpose(reduced%stiffness_coupling))/reduced%stiffness_pp(1, 1)
+         do j = 1, reduced%m
+            do k = 1, r
+               stiffness(1:r, k) = stiffness(1:r, k) + reduced%stiffness_coupling(:, j)* &
+                  & (reduced%stiffness_coupling(k, j)/reduced%stiffness_pp(j, j))
+            end do
+         end do
          stiffness(1:r, r + 1:) = reduced%stiffness_coupling
          stiffness(r + 1:, 1:r) = transpose(reduced%stiffness_coupling)
       end if

@@ -11,6 +11,7 @@ module beamstops_reduced_massless
    implicit none
    private
    public :: coupling_dots, massless_rhs, massless_update, equilibrium_start, condense_stiffness, massless_condensation
+   public :: span_massless_rhs, span_massless_update
 
 contains
 
@@ -89,6 +90,76 @@ contains
       gd = gd + load(r + 1)*d(r + 1)
    end subroutine massless_update
 
+   !> The unconstrained increment x = A_r^{-1} rhs of the massless boundary with m stops along the
+   !> span (S_bb diagonal), each stop row its equilibrium at t_{n+1}, in O(r m), allocation-free:
+   !> s_u = (S_r q^n)_p, s_d = (S_r d^{n-1})_p, y_p = dt^2 beta (sigma_{n+1} l_p - s_u - s_d),
+   !> x_a = D^{-1} (dt^2 (weight l_a - Lambda_c a - B s_u) [- dt (C_r d^{n-1})_a] - B y_p)
+   !> (B = G S_bb^{-1}), x_p = S_bb^{-1} (y_p/(dt^2 beta) - G^T x_a).
+   pure subroutine span_massless_rhs(r, m, dinv, bg, lambda, g, sbb, load, q, d, dt2, row_scale, weight, &
+      & sigma_next, s_u, s_d, x, cd, dt)
+      !> Modes r and stops m.
+      integer, intent(in) :: r, m
+      !> D^{-1} (r), B = G S_bb^{-1} (r, m), Lambda_c (r), G (r, m), S_bb (m, m, diagonal).
+      real(wp), intent(in) :: dinv(:), bg(:, :), lambda(:), g(:, :), sbb(:, :)
+      !> l_r, q^n and d^{n-1} (r + m).
+      real(wp), intent(in) :: load(:), q(:), d(:)
+      !> dt^2, dt^2 beta, the load average weight and sigma_{n+1}.
+      real(wp), intent(in) :: dt2, row_scale, weight, sigma_next
+      !> (S_r q^n)_p and (S_r d^{n-1})_p on return (m).
+      real(wp), intent(out) :: s_u(:), s_d(:)
+      !> x (r + m).
+      real(wp), intent(out) :: x(:)
+      !> C_r d^{n-1} and dt, with damping only.
+      real(wp), intent(in), optional :: cd(:), dt
+      integer :: i, j
+      real(wp) :: acc, xi
+      do j = 1, m
+         s_u(j) = dot_product(g(:, j), q(1:r)) + sbb(j, j)*q(r + j)
+         s_d(j) = dot_product(g(:, j), d(1:r)) + sbb(j, j)*d(r + j)
+         x(r + j) = row_scale*(sigma_next*load(r + j) - (s_u(j) + s_d(j)))
+      end do
+      do i = 1, r
+         acc = weight*load(i) - lambda(i)*q(i)
+         do j = 1, m
+            acc = acc - bg(i, j)*s_u(j)
+         end do
+         xi = dt2*acc
+         if (present(cd)) xi = xi - dt*cd(i)
+         do j = 1, m
+            xi = xi - bg(i, j)*x(r + j)
+         end do
+         x(i) = dinv(i)*xi
+      end do
+      do j = 1, m
+         x(r + j) = (x(r + j)/row_scale - dot_product(g(:, j), x(1:r)))/sbb(j, j)
+      end do
+   end subroutine span_massless_rhs
+
+   !> The update with m stops along the span: d^n = d^{n-1} + x + sum_active lambda_k z_k,
+   !> q^{n+1} = q^n + d^n and gd = l_r.d^n, O((r + m) active).
+   pure subroutine span_massless_update(n_active, active, lambda, z, load, x, d, q, gd)
+      !> Active stops and their indices (n_active).
+      integer, intent(in) :: n_active, active(:)
+      !> Multipliers of all stops (m), the columns z = A_r^{-1} e_p (r + m, m), l_r and x (r + m).
+      real(wp), intent(in) :: lambda(:), z(:, :), load(:), x(:)
+      !> d^{n-1}, q^n on entry; d^n, q^{n+1} on return.
+      real(wp), intent(inout) :: d(:), q(:)
+      !> l_r.d^n.
+      real(wp), intent(out) :: gd
+      integer :: i, k
+      real(wp) :: xi
+      gd = 0
+      do i = 1, size(x)
+         xi = x(i)
+         do k = 1, n_active
+            xi = xi + lambda(active(k))*z(i, active(k))
+         end do
+         d(i) = d(i) + xi
+         q(i) = q(i) + d(i)
+         gd = gd + load(i)*d(i)
+      end do
+   end subroutine span_massless_update
+
    !> The massless boundary at the start: each stop coordinate of q^1 from the equilibrium of its
    !> row at t_1, (S_r q^1)_p = sigma_1 l_p, the modal amplitudes fixed (the full model's
    !> equilibrium_start in the reduced basis).
@@ -111,29 +182,43 @@ contains
          q(r + k) = (sigma*load(r + k) - others)/s_pp(k, k)
       end do
    end subroutine equilibrium_start
-   !> S_ii - S_ib S_ib^T/S_bb in band storage on the interior unknowns (one stop unknown b): the
-   !> stiffness of the interior with the massless stop condensed. The update touches the
-   !> neighbours of b only, within kd of each other once b is removed: the band is kept.
+   !> S_ii - S_ib S_bb^{-1} S_bi in band storage on the interior unknowns: the stiffness of the
+   !> interior with the massless stop unknowns b condensed. No two stop nodes share an element, so
+   !> their values are more than kd apart and S_bb is diagonal: the correction is one rank-1 term
+   !> S_ib_k S_bi_k/S_bkbk a stop, touching its neighbours only. Those of the tip value (2J-3, 2J-2,
+   !> 2J) stay within kd = 3 of each other once b is removed; those of a value along the span
+   !> (2i-3, 2i-2, 2i, 2i+1, 2i+2) are five consecutive interior unknowns: the condensed band
+   !> needs a half-bandwidth kd + 1 (the caller gives sc kd + 2 rows then). The band of sc is its
+   !> first dimension minus one.
    pure subroutine condense_stiffness(stiffness, interior, b, sc)
       !> S in band storage (kd + 1, n).
       real(wp), intent(in) :: stiffness(:, :)
-      !> The interior unknowns (ascending) and the stop unknown b.
-      integer, intent(in) :: interior(:), b
-      !> S_ii in band storage (kd + 1, n - 1) on entry, condensed on return.
+      !> The interior unknowns (ascending) and the stop unknowns b (no two within kd).
+      integer, intent(in) :: interior(:), b(:)
+      !> S_ii in band storage (kc + 1, n - m) on entry, condensed on return.
       real(wp), intent(inout) :: sc(:, :)
       real(wp) :: sib(size(interior)), sbb
-      integer :: ii, jj, i
-      sbb = stiffness(kd + 1, b)
-      do ii = 1, size(interior)
-         i = interior(ii)
-         sib(ii) = 0
-         if (i < b .and. b - i <= kd) sib(ii) = stiffness(kd + 1 + i - b, b)
-         if (i > b .and. i - b <= kd) sib(ii) = stiffness(kd + 1 + b - i, i)
-      end do
-      do jj = 1, size(interior)
-         if (sib(jj) == 0) cycle
-         do ii = max(1, jj - kd), jj
-            if (sib(ii) /= 0) sc(kd + 1 + ii - jj, jj) = sc(kd + 1 + ii - jj, jj) - sib(ii)*sib(jj)/sbb
+      integer :: ii, jj, i, k, kc, first, last
+      kc = size(sc, 1) - 1
+      do k = 1, size(b)
+         sbb = stiffness(kd + 1, b(k))
+         first = size(interior) + 1
+         last = 0
+         do ii = 1, size(interior)
+            i = interior(ii)
+            sib(ii) = 0
+            if (i < b(k) .and. b(k) - i <= kd) sib(ii) = stiffness(kd + 1 + i - b(k), b(k))
+            if (i > b(k) .and. i - b(k) <= kd) sib(ii) = stiffness(kd + 1 + b(k) - i, i)
+            if (sib(ii) /= 0) then
+               first = min(first, ii)
+               last = max(last, ii)
+            end if
+         end do
+         do jj = first, last
+            if (sib(jj) == 0) cycle
+            do ii = max(first, jj - kc), jj
+               if (sib(ii) /= 0) sc(kc + 1 + ii - jj, jj) = sc(kc + 1 + ii - jj, jj) - sib(ii)*sib(jj)/sbb
+            end do
          end do
       end do
    end subroutine condense_stiffness

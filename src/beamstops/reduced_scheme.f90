@@ -25,10 +25,12 @@ module beamstops_reduced_scheme
    use beamstops_contact_tip_projection, only: project_tip
    use beamstops_contact_tip_contact, only: violation
    use beamstops_contact_compliance, only: spring_force, solve_spring_tip
-   use beamstops_contact_span_stops, only: span_work_type, new_span_work, span_contact, span_settle, span_energy
+   use beamstops_contact_span_stops, only: span_work_type, new_span_work, span_contact, span_settle, span_energy, &
+      & span_energy_massless
    use beamstops_contact_box_qp, only: qp_solved, qp_message
    use beamstops_contact_mass_redistribution, only: massless_reaction
-   use beamstops_reduced_massless, only: coupling_dots, massless_rhs, massless_update, equilibrium_start
+   use beamstops_reduced_massless, only: coupling_dots, massless_rhs, massless_update, equilibrium_start, &
+      & span_massless_rhs, span_massless_update
    use beamstops_observe_observer, only: observer_type, observe_scene
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
       & col_work, col_dissipated, col_damped
@@ -380,7 +382,10 @@ contains
       logical :: contact, recording, span, enforce, damped
       type(load_rotation) :: loads
 
-      if (reduced%massless) then
+      if (reduced%massless .and. reduced%stops%m > 0) then
+         call advance_massless_span(scene, reduced, state, recorder, last, done)
+         return
+      else if (reduced%massless) then
          call advance_massless(scene, reduced, state, recorder, last, done)
          return
       end if
@@ -620,6 +625,124 @@ contains
       state%step = done + 1
    end subroutine advance_massless
 
+   !> advance_massless with m stops along the span (the full model's advance_span with massless
+   !> stop values): each stop coordinate stepped as the equilibrium of its row at t_{n+1}, the box
+   !> QP on the reduced C_r, d the primary variable (no exact fix-up), the reactions the
+   !> residuals of the stop rows' Newmark equation (massless_reaction). O(r m) a step.
+   subroutine advance_massless_span(scene, reduced, state, recorder, last, done)
+      type(scene_type), intent(in) :: scene
+      type(reduced_model_type), intent(in) :: reduced
+      type(reduced_state_type), intent(inout) :: state
+      class(recorder_type), intent(inout) :: recorder
+      integer(ik), intent(in) :: last
+      integer(ik), intent(out) :: done
+      integer(ik) :: step, next_record, next_snapshot
+      integer :: r, m, j
+      real(wp) :: sigma_next, weight, gd, r_prev, r_step, u_tip_prev, d_tip_prev, u_old_su, row(n_columns)
+      real(wp) :: phi_prev, phi_now, phi_next
+      logical :: contact, recording, enforce
+      type(load_rotation) :: loads
+
+      r = reduced%r
+      m = reduced%m
+      enforce = scene%law == law_signorini
+      call first_events(scene, state%step, next_record, next_snapshot)
+      done = state%step - 1
+      u_old_su = 0
+      u_tip_prev = 0
+      d_tip_prev = 0
+      phi_prev = support_position(real(state%step - 1, wp)*reduced%dt, scene%amplitude, scene%omega)
+      phi_now = support_position(real(state%step, wp)*reduced%dt, scene%amplitude, scene%omega)
+      call start_loads(loads, state%step + 1, reduced%dt, scene%omega, scene%centered_load)
+      do step = state%step, last
+         sigma_next = loads%sigma
+         call next_load(loads)
+         phi_next = support_position(real(step + 1, wp)*reduced%dt, scene%amplitude, scene%omega)
+         weight = reduced%beta*sigma_next + (1 - 2*reduced%beta)*state%sigma_now + reduced%beta*state%sigma_prev
+         recording = step == next_record
+         if (recording) then
+            u_old_su = stiffness_norm2(reduced, state%q)
+            u_tip_prev = tip_value_of(reduced, state%q)
+            d_tip_prev = tip_value_of(reduced, state%d)
+         end if
+         if (reduced%damped) then
+            call span_massless_rhs(r, m, reduced%a_solver%dinv, reduced%a_solver%b, reduced%lambda, &
+               & reduced%stiffness_coupling, reduced%stiffness_pp, reduced%load, state%q, state%d, reduced%dt2, &
+               & reduced%row_scale, weight, sigma_next, state%span%s_u, state%span%s_d_prev, state%x, state%cd, reduced%dt)
+         else
+            call span_massless_rhs(r, m, reduced%a_solver%dinv, reduced%a_solver%b, reduced%lambda, &
+               & reduced%stiffness_coupling, reduced%stiffness_pp, reduced%load, state%q, state%d, reduced%dt2, &
+               & reduced%row_scale, weight, sigma_next, state%span%s_u, state%span%s_d_prev, state%x)
+         end if
+         call span_contact(reduced%stops, state%span, state%q, state%d, state%x, phi_next, enforce, &
+            & state%span%info, scene%restitution, phi_prev)
+         if (state%span%info /= qp_solved) exit
+         state%n_active = 0
+         if (state%span%contact) then
+            state%n_active = state%span%qp%n_active
+            state%active(:state%n_active) = state%span%qp%active(:state%n_active)
+         end if
+         call span_massless_update(state%n_active, state%active, state%span%lambda, reduced%z, reduced%load, state%x, &
+            & state%d, state%q, gd)
+         contact = state%span%contact
+         if (enforce) call span_settle(reduced%stops, state%span, state%q, state%d, state%max_violation, .false.)
+         r_prev = state%reaction
+         do j = 1, m
+            state%span%reaction(j) = massless_reaction(reduced%beta, weight, reduced%load(r + j), state%span%s_u(j), &
+               & state%span%s_d_prev(j), dot_product(reduced%stiffness_coupling(:, j), state%d(1:r)) + &
+               & reduced%stiffness_pp(j, j)*state%d(r + j))
+         end do
+         r_step = 0
+         if (reduced%stops%tip > 0) r_step = state%span%reaction(reduced%stops%tip)
+         if (contact .and. .not. state%in_contact) state%impacts = state%impacts + 1
+         state%in_contact = contact
+         state%work = state%work + 0.5_wp*weight*(gd + state%gd_prev)
+         call span_energy_massless(reduced%stops, state%span, state%d, phi_next - phi_prev, state%dissipated, &
+            & state%work)
+         if (reduced%damped) call damping_loss(reduced, state)
+         state%reaction = r_step
+         if (recording) then
+            state%span%record_u = state%span%u_prev + reduced%stops%lift*phi_now
+            state%span%record_reaction = scene%mass_per_length*state%stop_reaction
+            call recorder%record_stops(state%span%record_u, state%span%record_reaction)
+         end if
+         state%stop_reaction = state%span%reaction
+         ! (with massless stops a free stop's row residual is not a contact: only the active ones count)
+         if (state%observer%active) call state%observer%span(real(step + 1, wp)*reduced%dt, &
+            & state%q(r + 1:) + reduced%stops%lift*phi_next, merge(state%stop_reaction, 0.0_wp, state%span%lambda /= 0), &
+            & tip_value_of(reduced, state%q), state%dissipated)
+         state%gd_prev = gd
+         state%sigma_prev = state%sigma_now
+         state%sigma_now = sigma_next
+         if (recording) then
+            next_record = next_record + scene%record_every
+            row = 0
+            row(col_t) = real(step, wp)*reduced%dt
+            row(col_u) = u_tip_prev
+            row(col_v) = (tip_value_of(reduced, state%d) + d_tip_prev)/(2*reduced%dt)
+            row(col_reaction) = scene%mass_per_length*r_prev
+            row(col_work) = scene%mass_per_length*state%work
+            row(col_dissipated) = scene%mass_per_length*state%dissipated
+            row(col_damped) = scene%mass_per_length*state%damped
+            ! M_r = diag(I, 0): d.M_r d = d_a.d_a.
+            call reduced_stiffness_product(reduced, state%q, state%sq)
+            row(col_energy) = scene%mass_per_length*energy(reduced, dot_product(state%d(1:r), state%d(1:r)), &
+               & dot_product(state%q, state%sq), dot_product(state%d, state%sq), u_old_su)
+            call recorder%record(row)
+         end if
+         if (step == next_snapshot) then
+            next_snapshot = next_snapshot + scene%snapshot_every
+            state%x = state%q - state%d
+            call physical_shape(reduced, state%x, real(step, wp)*reduced%dt, scene, state%shape)
+            call recorder%snapshot(real(step, wp)*reduced%dt, state%shape)
+         end if
+         phi_prev = phi_now
+         phi_now = phi_next
+         done = step
+      end do
+      state%step = done + 1
+   end subroutine advance_massless_span
+
    !> The tip value of a reduced vector: its tip coordinate when the tip is a stop, else T(tip, :) q.
    pure function tip_value_of(reduced, q) result(u)
       type(reduced_model_type), intent(in) :: reduced
@@ -651,10 +774,12 @@ contains
          end do
          qsq = qsq + q(r + j)*acc
       end do
-      ! The massless boundary: + (G.a)^2/S_bb + 2 p G.a (m = 1).
+      ! The massless boundary: + sum_j (G_j.a)^2/S_jj + 2 p_j G_j.a (S_bb diagonal).
       if (reduced%massless) then
-         acc = dot_product(reduced%stiffness_coupling(:, 1), q(1:r))
-         qsq = qsq + acc*(acc/reduced%stiffness_pp(1, 1) + 2*q(r + 1))
+         do j = 1, reduced%m
+            acc = dot_product(reduced%stiffness_coupling(:, j), q(1:r))
+            qsq = qsq + acc*(acc/reduced%stiffness_pp(j, j) + 2*q(r + j))
+         end do
       end if
    end function stiffness_norm2
 
