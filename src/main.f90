@@ -608,7 +608,7 @@ contains
          k = summary%statistics%find(trim(names(i)))
          if (k == 0) cycle
          associate (q => summary%statistics%quantity(k))
-            write (buf, '(1x,a,1x,es10.4," +- ",es8.2,1x,a)') trim(names(i)), q%value(1), q%half_width(1), q%unit
+            write (buf, '(1x,a,1x,es11.4," +- ",es9.2,1x,a)') trim(names(i)), q%value(1), q%half_width(1), q%unit
          end associate
          text = text//trim(buf)//';'
       end do
@@ -619,7 +619,7 @@ contains
          k = summary%ensemble%find(trim(names(i)))
          if (k == 0) cycle
          associate (q => summary%ensemble%quantity(k))
-            write (buf, '(1x,a,1x,es10.4," +- ",es8.2,1x,a)') trim(names(i)), q%value(1), q%half_width(1), q%unit
+            write (buf, '(1x,a,1x,es11.4," +- ",es9.2,1x,a)') trim(names(i)), q%value(1), q%half_width(1), q%unit
          end associate
          text = text//trim(buf)//';'
       end do
