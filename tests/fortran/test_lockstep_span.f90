@@ -5,12 +5,14 @@
 !> snapshot, the summary (ledger, shocks, statistics). Members differ in omega, amplitude, the
 !> stops' gaps, the record and snapshot cadences, and in restitution; groups of K = 3 and 5 (not
 !> multiples of the vector width), with and without contact, damped, with massless stops; a run
-!> of two blocks. Members whose stops are not on member 1's nodes are refused.
+!> of two blocks; a member whose recorder fails; an &ensemble. Members whose stops are not on
+!> member 1's nodes are refused.
 module test_lockstep_span
    use testing
    use beamstops, only: ik, scene_type, model_type, array_recorder, run_summary, validate_scene, prepare_run, &
       & simulate, record_count, snapshot_count, law_signorini, status_complete, prepare_lockstep, simulate_lockstep
-   use test_lockstep, only: same_bits, same_summary, same_records, expect_refusal
+   use beamstops_recorder, only: n_columns
+   use test_lockstep, only: same_bits, same_summary, same_records, expect_refusal, compare_run_members
    implicit none
    private
    public :: collect_lockstep_span
@@ -27,6 +29,10 @@ contains
          & new_unittest('tube: K = 5, gaps too wide for contact', test_five_free), &
          & new_unittest('tube: K = 3, Rayleigh damping a and b, contact', test_three_damped), &
          & new_unittest('tube: K = 3, massless stops (mass redistribution), contact', test_three_massless), &
+         & new_unittest('tube: K = 3, member 2''s recorder fails in its second block: it stops, the others go on '// &
+         & 'bit for bit', test_failing_member), &
+         & new_unittest('tube: &ensemble members = 6 in lockstep, the table of the members run one after the other', &
+         & test_ensemble), &
          & new_unittest('members whose stops are not on member 1''s nodes are refused', test_refused_nodes) &
          & ]
    end subroutine collect_lockstep_span
@@ -110,6 +116,66 @@ contains
       scenes%redistributed_mass = .true.
       call compare_span_group(scenes, error, contact=.true.)
    end subroutine test_three_massless
+
+   !> Member 2's recorder holds 3000 records (every 3rd step: full at step 9000, in the second
+   !> block): member 2 stops 'failed' at the end of that block, its lanes go to rest, members 1
+   !> and 3 still equal their runs alone.
+   subroutine test_failing_member(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type), allocatable :: scenes(:)
+      type(array_recorder) :: group(3), alone
+      type(run_summary) :: summaries(3), summary
+      type(model_type) :: model
+      integer :: k
+      scenes = tube_members(3, 0.4_wp, 1.0_wp)
+      scenes(2)%record_every = 3
+      do k = 1, 3
+         call validate_scene(scenes(k), 'member '//int_text(k), error)
+         if (allocated(error)) return
+      end do
+      call prepare_lockstep(scenes, 'test group', model, error)
+      if (allocated(error)) return
+      do k = 1, 3
+         call reserve(group(k), scenes(k))
+      end do
+      deallocate (group(2)%rows)
+      allocate (group(2)%rows(n_columns, 3000))
+      call simulate_lockstep(scenes, model, group, summaries, error)
+      if (allocated(error)) return
+      call check(error, summaries(2)%status == 'failed' .and. summaries(2)%steps == 16384, &
+         & 'member 2 failed at the end of its second block: '//summaries(2)%status//' after '// &
+         & int_text(summaries(2)%steps)//' steps')
+      if (allocated(error)) return
+      do k = 1, 3, 2
+         call run_alone(scenes(k), alone, summary, error)
+         if (allocated(error)) return
+         call check(error, summaries(k)%status == status_complete, 'member '//int_text(k)//' completes')
+         if (allocated(error)) return
+         call same_summary(summaries(k), summary, 'member '//int_text(k), error)
+         if (allocated(error)) return
+         call same_records(group(k), alone, 'member '//int_text(k), error)
+         if (allocated(error)) return
+      end do
+   end subroutine test_failing_member
+
+   !> An &ensemble of the tube (perturbed u0): run_members runs members 2..6 in the span loop;
+   !> its table equals that of the members run one after the other (compare_run_members).
+   subroutine test_ensemble(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(scene_type), allocatable :: scenes(:)
+      type(model_type) :: model
+      scenes = tube_members(1, 0.1_wp, 1.0_wp)
+      scene = scenes(1)
+      scene%members = 6
+      scene%perturbation = 1.0e-4_wp
+      scene%seed = 5
+      call validate_scene(scene, 'tube ensemble', error)
+      if (allocated(error)) return
+      call prepare_lockstep([scene, scene], 'test group', model, error)
+      if (allocated(error)) return
+      call compare_run_members(scene, error)
+   end subroutine test_ensemble
 
    !> Stops on other nodes, or fewer of them, or none: refused, naming the member and the key.
    subroutine test_refused_nodes(error)
