@@ -13,10 +13,10 @@
 !> - the forward pass (lockstep_matvec_rhs, with -dt C d^{n-1} lockstep_matvec_rhs_damped; the rows
 !>   of the massless unknowns by equilibrium_rows, lane by lane), the forward substitution with its
 !>   energy sums on the steps that want them (a member that does not gets 0, as forward_pass gives);
-!> - the whole back substitution (lockstep_back), x handed to the member's state (rhs) with S u^n;
+!> - the whole back substitution (lockstep_back), x handed to the member's state (rhs);
 !> - the rest of advance_span's step on the member's state, the lines of advance_span itself.
-!> A member's u, d (and C d^{n-1}) go into the lanes at the start of each step and its x and S u^n
-!> come back (O(n) copies per member and step beside the O(n) contact work). A member whose QP fails
+!> A member's u, d (and C d^{n-1}) go into the lanes at the start of each step and its x comes
+!> back (O(n) copies per member and step beside the O(n) contact work). A member whose QP fails
 !> ends its block there (advance_span's exit) and leaves the group with run_scheme's status; the
 !> others go on. Members may differ in what advance_span reads from the scene and from the parts of
 !> the model that do not enter A: the support (amplitude, omega), the stops' bounds (&stops lower,
@@ -298,7 +298,7 @@ contains
                lanes%dsu(k) = 0
                lanes%dmd(k) = 0
             end if
-            states(k)%su = lanes%su(lane(k), :, chunk(k))
+            ! x back (S u^n is not read again before end_block computes S u^{last+1})
             states(k)%rhs = lanes%rhs(lane(k), :, chunk(k))
             call member_step(scenes(k), models(k), states(k), loop(k), recorders(k), step, lanes%usu(k), &
                & lanes%dsu(k), lanes%dmd(k))
