@@ -29,7 +29,8 @@
 !> members' state and the pieces of a step both loops share are beamstops_lockstep_members'.
 !> The plain loop here (advance_members) keeps a step's per-member values in fixed-size lanes
 !> during a block (beamstops_lockstep_lanes, gathered and scattered at the block's ends).
-!> Stops along the span (SPEC 7) are refused (their QP per member is not in this path yet).
+!> Stops along the span (SPEC 7) run in the span loop of beamstops_lockstep_span (lockstep_span.f90,
+!> advance_span per member): the members share the stops' nodes, their bounds may differ.
 module beamstops_lockstep
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_kinds, only: wp, ik
@@ -53,6 +54,7 @@ module beamstops_lockstep
    use beamstops_lockstep_members, only: operators_type, members_type, lane, chunk, take_snapshot, first_events, &
       & energy
    use beamstops_lockstep_general, only: advance_members_general
+   use beamstops_lockstep_span, only: simulate_span_lockstep
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
       & col_work, col_dissipated, col_damped
    use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running
@@ -65,8 +67,8 @@ contains
 
    !> Whether K scenes can run in lockstep with `model` (built from the first of them): the
    !> same A (mesh, beam, dt, beta, Rayleigh damping, mass law), the same law and compliance
-   !> stiffness, the same number of steps, the full model (no reduced model), no stops along
-   !> the span, J >= 4 (beamstops_lockstep_physics's check_shared_physics for damping and the
+   !> stiffness, the same number of steps, the full model (no reduced model), the stops along
+   !> the span on the same nodes (or none), J >= 4 (beamstops_lockstep_physics's check_shared_physics for damping and the
    !> mass law; the restitution coefficient may differ). The message names the first member
    !> and key that differ.
    subroutine check_lockstep(scenes, model, error)
@@ -101,11 +103,8 @@ contains
          return
       end if
       do k = 1, size(scenes)
-         if (stop_count(scenes(k)) > 0) then
-            call fatal_error(error, 'lockstep: member '//fmt_int(int(k, ik))//' has stops along the span '// &
-               & '(&stops nodes or x); the lockstep path runs tip stops only: run it alone')
-            return
-         end if
+         if (k > 1) call same_stops(k)
+         if (allocated(error)) return
          if (scenes(k)%modes > 0) then
             call fatal_error(error, 'lockstep: member '//fmt_int(int(k, ik))//' is a reduced model (&mesh modes = '// &
                & fmt_int(int(scenes(k)%modes, ik))//'); the lockstep path runs the full model: run it alone')
@@ -135,6 +134,29 @@ contains
 
    contains
 
+      !> Refuse member k when its stops along the span are not on member 1's nodes: the nodes
+      !> give P, hence Z = A^{-1} P and C = P^T A^{-1} P, which the members share (their bounds
+      !> may differ).
+      subroutine same_stops(k)
+         integer, intent(in) :: k
+         integer :: m, m1
+         m = stop_count(scenes(k))
+         m1 = stop_count(scenes(1))
+         if (m /= m1) then
+            call fatal_error(error, 'lockstep: member '//fmt_int(int(k, ik))//': &stops nodes (or x) gives '// &
+               & fmt_int(int(m, ik))//' stops along the span, member 1''s '//fmt_int(int(m1, ik))// &
+               & '; lockstep members share the stops'' nodes (they shape C = P^T A^{-1} P): run it in another group')
+            return
+         end if
+         if (m == 0) return
+         if (any(scenes(k)%stop_nodes /= scenes(1)%stop_nodes)) then
+            call fatal_error(error, 'lockstep: member '//fmt_int(int(k, ik))//': &stops nodes = '// &
+               & node_list(scenes(k)%stop_nodes)//' differs from member 1''s '//node_list(scenes(1)%stop_nodes)// &
+               & '; lockstep members share the stops'' nodes (they shape C = P^T A^{-1} P; the bounds lower, '// &
+               & 'upper may differ): run it in another group')
+         end if
+      end subroutine same_stops
+
       !> Refuse member k when a value of its scene differs from member 1's.
       subroutine differ(k, group, key, value, first)
          integer, intent(in) :: k
@@ -147,6 +169,18 @@ contains
             & '; lockstep members share A = M + dt^2 beta S, the contact law and the steps: run it in another group')
       end subroutine differ
    end subroutine check_lockstep
+
+   !> The nodes of the stops along the span as text (messages): "3, 7, 10".
+   function node_list(nodes) result(text)
+      integer, intent(in) :: nodes(:)
+      character(len=:), allocatable :: text
+      integer :: i
+      text = ''
+      do i = 1, size(nodes)
+         if (i > 1) text = text//', '
+         text = text//fmt_int(int(nodes(i), ik))
+      end do
+   end function node_list
 
    !> Build the model once from the first member, refuse members that cannot join it
    !> (check_lockstep) and members beyond the stability limit of their scene (check_stability).
@@ -216,6 +250,11 @@ contains
                & fmt_int(int(model%n, ik))//', '//fmt_int(int(nk, ik))//')')
             return
          end if
+      end if
+      if (model%stops%m > 0) then
+         ! stops along the span: the span loop (beamstops_lockstep_span), advance_span per member
+         call simulate_span_lockstep(scenes, model, ops, recorders, summaries, error, initial_displacement)
+         return
       end if
       call start_members(scenes, model, recorders, ms, error, initial_displacement)
       if (allocated(error)) return

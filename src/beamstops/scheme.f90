@@ -30,7 +30,7 @@ module beamstops_scheme
       & check_divergence
    implicit none
    private
-   public :: state_type, start_state, advance, run_scheme, block_steps
+   public :: state_type, start_state, advance, run_scheme, block_steps, close_ledger
 
    !> Steps between progress reports and divergence checks.
    integer(ik), parameter :: block_steps = 8192_ik
@@ -100,9 +100,13 @@ contains
    !> The energy ledger of the summary (J): work, stops' and damping's losses, and the balance
    !> residual E^{N+1/2} - E^{1/2} - (work - dissipated - damped), E from u^{N+1}, d^N and S u^{N+1}.
    subroutine close_ledger(scene, model, state, summary)
+      !> Scene (mass per length).
       type(scene_type), intent(in) :: scene
+      !> Its model.
       type(model_type), intent(in) :: model
+      !> The state at the end of the run (its scratch vector used).
       type(state_type), intent(inout) :: state
+      !> Receives the ledger.
       type(run_summary), intent(inout) :: summary
       real(wp) :: dmd, usu, dsu, dsd, e_end
       if (.not. allocated(state%d)) return

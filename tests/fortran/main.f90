@@ -27,6 +27,7 @@ program tester
    use test_lockstep, only: collect_lockstep
    use test_batch, only: collect_batch
    use test_lockstep_general, only: collect_lockstep_general
+   use test_lockstep_span, only: collect_lockstep_span
    use test_reduced, only: collect_reduced
    use test_reduced_physics, only: collect_reduced_physics
    implicit none
@@ -75,6 +76,7 @@ program tester
       & new_testsuite('reduced_physics', collect_reduced_physics), &
       & new_testsuite('lockstep', collect_lockstep), &
       & new_testsuite('lockstep_general', collect_lockstep_general), &
+      & new_testsuite('lockstep_span', collect_lockstep_span), &
       & new_testsuite('batch', collect_batch) &
       & ]
 

@@ -29,7 +29,7 @@ module test_lockstep
    public :: collect_lockstep
    ! the helpers of the suite lockstep_general (damping, restitution, mass redistribution)
    public :: base_scene, members_of, compare_group, expect_refusal, compare_run_members, check_failing_member, &
-      & same_bits
+      & same_bits, same_summary, same_records
 
    !> Columns of a record, for messages.
    character(len=10), parameter :: column_names(n_columns) = [character(len=10) :: 't', 'u', 'v', 'reaction', &
@@ -540,7 +540,7 @@ contains
    end subroutine compare_run_members
 
    !> Members that differ in what A depends on (damping: test_lockstep_general), in the law, in
-   !> the steps, or with stops along the span are refused, the message naming the member and the key.
+   !> the steps, or with stops along the span where member 1 has none, are refused, the message naming the member and the key.
    subroutine test_refused(error)
       type(error_type), allocatable, intent(out) :: error
       type(scene_type) :: scenes(3)
@@ -570,7 +570,7 @@ contains
       scenes(2)%stop_nodes = [10, 19]
       scenes(2)%stop_lower = [-0.05_wp, -0.1_wp]
       scenes(2)%stop_upper = [0.05_wp, 0.1_wp]
-      call expect_refusal(scenes, 'member 2 has stops along the span', error)
+      call expect_refusal(scenes, 'member 2: &stops nodes (or x) gives 2 stops along the span, member 1''s 0', error)
       if (allocated(error)) return
       scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)
       scenes(2)%modes = 6

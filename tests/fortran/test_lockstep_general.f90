@@ -230,7 +230,7 @@ contains
       scenes(2)%stop_nodes = [10, 19]
       scenes(2)%stop_lower = [-0.05_wp, -0.1_wp]
       scenes(2)%stop_upper = [0.05_wp, 0.1_wp]
-      call expect_refusal(scenes, 'member 2 has stops along the span', error)
+      call expect_refusal(scenes, 'member 2: &stops nodes (or x) gives 2 stops along the span', error)
       if (allocated(error)) return
       ! restitution does not enter A: members with different e are accepted
       scenes = members_of(base_scene(19, 1.0e-5_wp, 0.5_wp, law_signorini, 0.01_wp), 3, .false.)

@@ -1,0 +1,433 @@
+!> The lockstep loop with stops along the span (SPEC 13 with SPEC 7): K members that share A and
+!> the stops' nodes (hence P, the columns Z = A^{-1} P and C = P^T A^{-1} P) advance together
+!> through the two band substitutions of a step, the member index innermost; then, member after
+!> member, the contact work of advance_span of beamstops_scheme on that member's own vectors: the
+!> trial values at the stops, the box QP on C when some are out (span_contact), the correction and
+!> the update, the stops settled on their bounds (span_settle), the ledger (move_on, span_energy,
+!> damping_loss), the observer's span_indexed hook, the records and snapshots. Each member keeps a
+!> whole one-scene state (state_type, from the one-scene start_state) and a model of its own (built
+!> from its scene: its load vector, initial velocity and its stops' bounds), so that every operation
+!> after the substitutions is the one-scene path's own routine on the same numbers.
+!>
+!> Per step and member, the operations of advance_span in the same order:
+!> - the forward pass (lockstep_matvec_rhs, with -dt C d^{n-1} lockstep_matvec_rhs_damped; the rows
+!>   of the massless unknowns by equilibrium_rows, lane by lane), the forward substitution with its
+!>   energy sums on the steps that want them (a member that does not gets 0, as forward_pass gives);
+!> - the whole back substitution (lockstep_back), x handed to the member's state (rhs);
+!> - the rest of advance_span's step on the member's state, the lines of advance_span itself.
+!> A member's u, d (and C d^{n-1}) go into the lanes at the start of each step and its x comes
+!> back (O(n) copies per member and step beside the O(n) contact work). A member whose QP fails
+!> ends its block there (advance_span's exit) and leaves the group with run_scheme's status; the
+!> others go on. Members may differ in what advance_span reads from the scene and from the parts of
+!> the model that do not enter A: the support (amplitude, omega), the stops' bounds (&stops lower,
+!> upper per stop), the restitution coefficient, the load rule, the start, the output cadence.
+module beamstops_lockstep_span
+   use beamstops_kinds, only: wp, ik
+   use beamstops_error, only: error_type
+   use beamstops_strings, only: fmt_int
+   use beamstops_scene, only: scene_type, steps_of, law_signorini
+   use beamstops_model, only: model_type, build_model
+   use beamstops_band, only: band_matvec
+   use beamstops_band_solve, only: diagonal_matvec, diagonal_row, dot
+   use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_work_columns, lockstep_matvec_rhs, &
+      & lockstep_forward, lockstep_forward_energy, lockstep_back
+   use beamstops_band_solve_lockstep_general, only: lockstep_matvec_rhs_damped
+   use beamstops_contact_mass_redistribution, only: equilibrium_rows, massless_reaction
+   use beamstops_contact_tip_contact, only: update
+   use beamstops_contact_span_stops, only: span_contact, span_correction, span_settle, span_energy, &
+      & span_energy_massless
+   use beamstops_contact_box_qp, only: qp_solved, qp_message
+   use beamstops_forcing, only: support_position, load_rotation, start_loads, next_load
+   use beamstops_state, only: state_type
+   use beamstops_scheme, only: start_state, block_steps, close_ledger
+   use beamstops_clock, only: thread_cpu_seconds
+   use beamstops_lockstep_members, only: operators_type, lane, chunk
+   use beamstops_ledger, only: energy, move_on, damping_loss, fill_row, take_snapshot, first_events
+   use beamstops_recorder, only: recorder_type, n_columns, col_energy
+   use beamstops_summary, only: run_summary, status_complete, status_failed, status_running, status_diverged, &
+      & check_divergence
+   implicit none
+   private
+   public :: simulate_span_lockstep
+
+   !> The lanes of a step (lanes, n, chunks) and the per-member values the substitutions give.
+   type :: span_lanes_type
+      real(wp), allocatable :: u(:, :, :), d(:, :, :), su(:, :, :), rhs(:, :, :), g(:, :, :), cd(:, :, :)
+      real(wp), allocatable :: partial(:, :)
+      real(wp), allocatable :: coef(:), spring(:), usu(:), dsu(:), dmd(:)
+   end type span_lanes_type
+
+   !> What a member carries from step to step within a block (advance_span's locals).
+   type :: member_loop_type
+      integer(ik) :: next_record = 0, next_snapshot = 0, done = 0
+      logical :: pending = .false., live = .false.
+      real(wp) :: u_old_su = 0, phi_prev = 0, phi_now = 0, phi_next = 0, sigma_next = 0, weight = 0
+      real(wp) :: row(n_columns) = 0
+      type(load_rotation) :: loads
+   end type member_loop_type
+
+contains
+
+   !> Run K members with stops along the span from t = 0 to their (common) end in lockstep (the
+   !> group checked by check_lockstep); each member's records, snapshots and summary are those of
+   !> simulate(scenes(k), ...) run alone. cpu_seconds of a summary is the member's share (1/K).
+   subroutine simulate_span_lockstep(scenes, model, ops, recorders, summaries, error, initial_displacement)
+      !> The members' validated scenes (K).
+      type(scene_type), intent(in) :: scenes(:)
+      !> The model built from scenes(1).
+      type(model_type), intent(in) :: model
+      !> The shared operators (S, M, C by diagonals, the factor of A).
+      type(operators_type), intent(in) :: ops
+      !> One recorder per member (K).
+      class(recorder_type), intent(inout) :: recorders(:)
+      !> One summary per member (K).
+      type(run_summary), intent(inout) :: summaries(:)
+      !> Set when a member's model or start fails.
+      type(error_type), allocatable, intent(out) :: error
+      !> Initial displacement of each member (n, K), in place of the model's.
+      real(wp), intent(in), optional :: initial_displacement(:, :)
+      type(model_type), allocatable :: models(:)
+      type(state_type), allocatable :: states(:)
+      type(span_lanes_type) :: lanes
+      logical, allocatable :: active(:)
+      integer(ik) :: steps, last, first
+      real(wp) :: t0, kinetic
+      integer :: k, nk
+
+      nk = size(scenes)
+      allocate (models(nk), states(nk), active(nk))
+      do k = 1, nk
+         if (k == 1) then
+            models(k) = model
+         else
+            call build_model(scenes(k), models(k), error)
+         end if
+         if (.not. allocated(error)) then
+            if (present(initial_displacement)) models(k)%u0 = initial_displacement(:, k)
+            call start_state(scenes(k), models(k), states(k), recorders(k), error)
+         end if
+         if (allocated(error)) then
+            error%message = 'lockstep: member '//fmt_int(int(k, ik))//': '//error%message
+            return
+         end if
+      end do
+      call new_lanes(model, nk, lanes)
+      do k = 1, nk
+         lanes%g(lane(k), :, chunk(k)) = models(k)%load
+      end do
+      steps = steps_of(scenes(1))
+      do k = 1, nk
+         summaries(k)%status = status_running
+      end do
+      active = .true.
+      t0 = thread_cpu_seconds()
+      do while (any(active))
+         first = minval(states%step, mask=active)
+         last = min(steps, first + block_steps - 1)
+         call advance_span_members(scenes, models, ops, states, lanes, recorders, active, last)
+         do k = 1, nk
+            if (.not. active(k)) cycle
+            ! run_scheme's checks between blocks
+            if (recorders(k)%failed) then
+               summaries(k)%status = status_failed
+               summaries(k)%message = 'the recorder could not write'
+            else if (states(k)%span%info /= qp_solved) then
+               summaries(k)%status = status_failed
+               summaries(k)%message = qp_message(states(k)%span%info)//' at t = '// &
+                  & trim(real_text(real(states(k)%step, wp)*model%dt))//' s'
+            else
+               call band_matvec(models(k)%mass, states(k)%d, states(k)%scratch)
+               kinetic = 0.5_wp*dot_product(states(k)%d, states(k)%scratch)/model%dt2
+               call check_divergence(scenes(k), kinetic, states(k)%energy0, states(k)%work, states(k)%dissipated, &
+                  & real(states(k)%step - 1, wp)*model%dt, summaries(k))
+            end if
+            if (summaries(k)%status == status_running) then
+               if (states(k)%observer%active) call states(k)%observer%drain()
+               call recorders(k)%progress(states(k)%step - 1, steps)
+               if (states(k)%step <= steps) cycle
+            end if
+            call finish_member(scenes(k), models(k), states(k), summaries(k), (thread_cpu_seconds() - t0)/nk)
+            active(k) = .false.
+            lanes%u(lane(k), :, chunk(k)) = 0
+            lanes%d(lane(k), :, chunk(k)) = 0
+            lanes%g(lane(k), :, chunk(k)) = 0
+            if (allocated(lanes%cd)) lanes%cd(lane(k), :, chunk(k)) = 0
+         end do
+      end do
+   end subroutine simulate_span_lockstep
+
+   !> run_scheme's summary of a member that leaves the group (counts, close_ledger, the observer's
+   !> shocks and statistics).
+   subroutine finish_member(scene, model, state, summary, cpu_seconds)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      type(run_summary), intent(inout) :: summary
+      real(wp), intent(in) :: cpu_seconds
+      summary%cpu_seconds = cpu_seconds
+      summary%steps = state%step - 1
+      summary%t_final = real(summary%steps, wp)*model%dt
+      summary%impacts = state%impacts
+      summary%max_violation = state%max_violation
+      summary%contact_phases = state%impacts
+      call close_ledger(scene, model, state, summary)
+      if (summary%status == status_running .and. state%step > steps_of(scene)) summary%status = status_complete
+      if (state%observer%active .and. summary%status /= status_running) then
+         call state%observer%finish(summary%shocks, summary%statistics)
+         summary%impacts = state%observer%shocks%shock_count()
+      end if
+   end subroutine finish_member
+
+   !> The lanes of the group, zero (padding lanes stay at rest).
+   subroutine new_lanes(model, nk, lanes)
+      type(model_type), intent(in) :: model
+      integer, intent(in) :: nk
+      type(span_lanes_type), intent(out) :: lanes
+      integer :: chunks, p, n
+      n = model%n
+      chunks = (nk + lockstep_lanes - 1)/lockstep_lanes
+      p = chunks*lockstep_lanes
+      allocate (lanes%u(lockstep_lanes, n, chunks), lanes%d(lockstep_lanes, n, chunks), &
+         & lanes%su(lockstep_lanes, n, chunks), lanes%rhs(lockstep_lanes, n, chunks), &
+         & lanes%g(lockstep_lanes, n, chunks), lanes%partial(lockstep_lanes, lockstep_work_columns))
+      allocate (lanes%coef(p), lanes%spring(p), lanes%usu(p), lanes%dsu(p), lanes%dmd(p))
+      lanes%u = 0
+      lanes%d = 0
+      lanes%su = 0
+      lanes%rhs = 0
+      lanes%g = 0
+      lanes%partial = 0
+      lanes%coef = 0
+      lanes%spring = 0
+      lanes%usu = 0
+      lanes%dsu = 0
+      lanes%dmd = 0
+      if (model%damped) then
+         allocate (lanes%cd(lockstep_lanes, n, chunks))
+         lanes%cd = 0
+      end if
+   end subroutine new_lanes
+
+   !> Advance every active member from its state's step through step `last` (advance_span of
+   !> beamstops_scheme per member, the substitutions in lockstep). A member whose QP fails stops
+   !> at the step before (its state's step says where, its span%info why).
+   subroutine advance_span_members(scenes, models, ops, states, lanes, recorders, active, last)
+      type(scene_type), intent(in) :: scenes(:)
+      type(model_type), intent(in) :: models(:)
+      type(operators_type), intent(in) :: ops
+      type(state_type), intent(inout) :: states(:)
+      type(span_lanes_type), intent(inout) :: lanes
+      class(recorder_type), intent(inout) :: recorders(:)
+      logical, intent(in) :: active(:)
+      integer(ik), intent(in) :: last
+      type(member_loop_type) :: loop(size(scenes))
+      integer(ik) :: step, first
+      integer :: k, nk, c, chunks, lo, hi
+      logical :: energy_wanted, damped, massless
+
+      nk = size(scenes)
+      chunks = size(lanes%u, 3)
+      damped = models(1)%damped
+      massless = models(1)%redistributed
+      first = huge(1_ik)
+      do k = 1, nk
+         if (.not. active(k)) cycle
+         associate (state => states(k), lp => loop(k), scene => scenes(k), model => models(k))
+            lp%live = .true.
+            call first_events(scene, state%step, lp%next_record, lp%next_snapshot)
+            lp%pending = .false.
+            lp%u_old_su = 0
+            lp%done = state%step - 1
+            lp%phi_prev = support_position(real(state%step - 1, wp)*model%dt, scene%amplitude, scene%omega)
+            lp%phi_now = support_position(real(state%step, wp)*model%dt, scene%amplitude, scene%omega)
+            call start_loads(lp%loads, state%step + 1, model%dt, scene%omega, scene%centered_load)
+            first = min(first, state%step)
+         end associate
+      end do
+      do step = first, last
+         if (.not. any(loop%live)) exit
+         energy_wanted = .false.
+         do k = 1, nk
+            if (.not. loop(k)%live) cycle
+            associate (state => states(k), lp => loop(k), scene => scenes(k), model => models(k))
+               lp%sigma_next = lp%loads%sigma
+               call next_load(lp%loads)
+               lp%phi_next = support_position(real(step + 1, wp)*model%dt, scene%amplitude, scene%omega)
+               lp%weight = model%beta*lp%sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
+               lanes%coef(k) = model%dt2*lp%weight
+               lanes%u(lane(k), :, chunk(k)) = state%u
+               lanes%d(lane(k), :, chunk(k)) = state%d
+               if (damped) lanes%cd(lane(k), :, chunk(k)) = state%cd
+               energy_wanted = energy_wanted .or. lp%pending .or. step == lp%next_record
+            end associate
+         end do
+         ! the forward pass of every chunk (forward_pass, spring 0)
+         do c = 1, chunks
+            lo = (c - 1)*lockstep_lanes + 1
+            hi = c*lockstep_lanes
+            if (damped) then
+               call lockstep_matvec_rhs_damped(ops%stiffness, lanes%u(:, :, c), lanes%coef(lo:hi), lanes%g(:, :, c), &
+                  & models(1)%dt2, lanes%spring(lo:hi), lanes%cd(:, :, c), models(1)%dt, lanes%su(:, :, c), &
+                  & lanes%rhs(:, :, c))
+            else
+               call lockstep_matvec_rhs(ops%stiffness, lanes%u(:, :, c), lanes%coef(lo:hi), lanes%g(:, :, c), &
+                  & models(1)%dt2, lanes%spring(lo:hi), lanes%su(:, :, c), lanes%rhs(:, :, c))
+            end if
+            if (massless) then
+               do k = lo, min(hi, nk)
+                  if (.not. loop(k)%live) cycle
+                  call equilibrium_rows(models(k)%massless, models(k)%row_scale, loop(k)%sigma_next, &
+                     & lanes%g(lane(k), :, c), lanes%su(lane(k), :, c), ops%stiffness, lanes%d(lane(k), :, c), &
+                     & lanes%rhs(lane(k), :, c))
+               end do
+            end if
+            if (energy_wanted) then
+               call lockstep_forward_energy(ops%solver, ops%mass, lanes%u(:, :, c), lanes%d(:, :, c), &
+                  & lanes%su(:, :, c), lanes%rhs(:, :, c), lanes%usu(lo:hi), lanes%dsu(lo:hi), lanes%dmd(lo:hi), &
+                  & lanes%partial)
+            else
+               call lockstep_forward(ops%solver, lanes%rhs(:, :, c))
+            end if
+            call lockstep_back(ops%solver, lanes%rhs(:, :, c), lanes%partial)
+         end do
+         ! each member's contact work, on its own state
+         do k = 1, nk
+            if (.not. loop(k)%live) cycle
+            if (.not. (energy_wanted .and. (loop(k)%pending .or. step == loop(k)%next_record))) then
+               lanes%usu(k) = 0
+               lanes%dsu(k) = 0
+               lanes%dmd(k) = 0
+            end if
+            ! x back (S u^n is not read again before end_block computes S u^{last+1})
+            states(k)%rhs = lanes%rhs(lane(k), :, chunk(k))
+            call member_step(scenes(k), models(k), states(k), loop(k), recorders(k), step, lanes%usu(k), &
+               & lanes%dsu(k), lanes%dmd(k))
+            if (.not. loop(k)%live) call end_block(scenes(k), models(k), states(k), loop(k), recorders(k))
+         end do
+      end do
+      do k = 1, nk
+         if (loop(k)%live) call end_block(scenes(k), models(k), states(k), loop(k), recorders(k))
+      end do
+   end subroutine advance_span_members
+
+   !> One member's step after the substitutions: the lines of advance_span from the record
+   !> waiting for this step's energy to the support positions moved on. A failed QP ends the
+   !> member's block (live false).
+   subroutine member_step(scene, model, state, lp, recorder, step, usu, dsu, dmd)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      type(member_loop_type), intent(inout) :: lp
+      class(recorder_type), intent(inout) :: recorder
+      integer(ik), intent(in) :: step
+      real(wp), intent(in) :: usu, dsu, dmd
+      integer :: tip, col, i
+      real(wp) :: c, gd, d_tip_prev, u_tip_prev, r_tip, r_prev
+      logical :: contact, enforce
+
+      tip = model%tip
+      enforce = scene%law == law_signorini
+      if (lp%pending) then
+         lp%row(col_energy) = scene%mass_per_length*energy(model, dmd, usu, dsu, lp%u_old_su)
+         call recorder%record_stops(state%span%record_u, state%span%record_reaction)
+         call recorder%record(lp%row)
+         lp%pending = .false.
+      end if
+      lp%u_old_su = usu
+      d_tip_prev = state%d(tip)
+      u_tip_prev = state%u(tip)
+      if (model%redistributed) then
+         do i = 1, model%stops%m
+            state%span%s_u(i) = diagonal_row(model%stiffness_diagonals, state%u, model%stops%unknown(i))
+            state%span%s_d_prev(i) = diagonal_row(model%stiffness_diagonals, state%d, model%stops%unknown(i))
+         end do
+      end if
+      call span_contact(model%stops, state%span, state%u, state%d, state%rhs, lp%phi_next, enforce, state%span%info, &
+         & scene%restitution, lp%phi_prev)
+      if (state%span%info /= qp_solved) then
+         lp%live = .false.
+         return
+      end if
+      call span_correction(model%stops, state%span, model%solver, state%rhs, c, col)
+      if (col > 0) then
+         call update(state%rhs, c, model%stops%z(:, col), state%d, state%u)
+      else
+         call update(state%rhs, 0.0_wp, model%z, state%d, state%u)
+      end if
+      gd = dot(model%load, state%d)
+      contact = state%span%contact
+      if (enforce) call span_settle(model%stops, state%span, state%u, state%d, state%max_violation, &
+         & .not. model%redistributed)
+      r_prev = state%reaction
+      r_tip = 0
+      if (model%redistributed) then
+         do i = 1, model%stops%m
+            state%span%reaction(i) = massless_reaction(model%beta, lp%weight, model%load(model%stops%unknown(i)), &
+               & state%span%s_u(i), state%span%s_d_prev(i), &
+               & diagonal_row(model%stiffness_diagonals, state%d, model%stops%unknown(i)))
+         end do
+         if (model%stops%tip > 0) r_tip = state%span%reaction(model%stops%tip)
+      else
+         if (model%stops%tip > 0) r_tip = state%span%lambda(model%stops%tip)/model%dt2
+      end if
+      call move_on(state, contact, gd, lp%weight, r_tip, lp%sigma_next)
+      if (model%redistributed) then
+         call span_energy_massless(model%stops, state%span, state%d, lp%phi_next - lp%phi_prev, state%dissipated, &
+            & state%work)
+      else
+         call span_energy(model%stops, state%span, state%d, model%dt2, lp%phi_next - lp%phi_prev, state%dissipated, &
+            & state%work)
+      end if
+      if (model%damped) call damping_loss(model, state)
+      if (step == lp%next_record) then
+         lp%next_record = lp%next_record + scene%record_every
+         call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_prev, lp%row)
+         state%span%record_u = state%span%u_prev + model%stops%lift*lp%phi_now
+         state%span%record_reaction = scene%mass_per_length*state%stop_reaction
+         lp%pending = .true.
+      end if
+      if (model%redistributed) then
+         state%stop_reaction = state%span%reaction
+      else
+         state%stop_reaction = state%span%lambda/model%dt2
+      end if
+      if (state%observer%active) call state%observer%span_indexed(real(step + 1, wp)*model%dt, state%u, &
+         & model%stops%unknown, model%stops%lift, lp%phi_next, state%stop_reaction, state%span%lambda, &
+         & state%u(tip), state%dissipated)
+      if (step == lp%next_snapshot) then
+         lp%next_snapshot = lp%next_snapshot + scene%snapshot_every
+         call take_snapshot(scene, model, state, step, recorder)
+      end if
+      lp%done = step
+      lp%phi_prev = lp%phi_now
+      lp%phi_now = lp%phi_next
+   end subroutine member_step
+
+   !> The end of a member's block (advance_span's and advance's): S u^{last+1}, the waiting
+   !> record completed, the state's step moved on.
+   subroutine end_block(scene, model, state, lp, recorder)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      type(state_type), intent(inout) :: state
+      type(member_loop_type), intent(inout) :: lp
+      class(recorder_type), intent(inout) :: recorder
+      call diagonal_matvec(model%stiffness_diagonals, state%u, state%su)
+      if (lp%pending) then
+         call diagonal_matvec(model%mass_diagonals, state%d, state%scratch)
+         lp%row(col_energy) = scene%mass_per_length*energy(model, dot(state%d, state%scratch), &
+            & dot(state%u, state%su), dot(state%d, state%su), lp%u_old_su)
+         call recorder%record_stops(state%span%record_u, state%span%record_reaction)
+         call recorder%record(lp%row)
+         lp%pending = .false.
+      end if
+      lp%live = .false.
+      state%step = lp%done + 1
+   end subroutine end_block
+
+   !> Text of a real for messages.
+   function real_text(x) result(s)
+      real(wp), intent(in) :: x
+      character(len=32) :: s
+      write (s, '(g0.6)') x
+   end function real_text
+end module beamstops_lockstep_span
