@@ -15,7 +15,7 @@ program beamstops_main
    use beamstops_files, only: file_exists, remove_file, same_file
    use beamstops_recorder_hdf5, only: partial_path, check_output_path
    use beamstops_run, only: continue_run, continue_reduced
-   use beamstops_batch, only: lockstep_groups, simulate_group
+   use beamstops_batch, only: lockstep_groups, simulate_group, min_group_members
    use beamstops_reduced, only: reduced_model_type, build_reduced, check_stability_reduced
    use beamstops_reduced_scheme, only: reduced_state_type, start_reduced
    use beamstops_reduced_checkpoint, only: read_reduced_checkpoint
@@ -459,7 +459,8 @@ contains
    !> `beamstops run A.nml B.nml ...`: every file read, every scene prepared and every output
    !> path checked before anything runs (one bad file: its message, nothing runs, exit status 1
    !> or 4). The scenes are partitioned into lockstep groups by the engine's rule
-   !> (lockstep_groups); a group runs in lockstep, a scene that joins no other runs alone (as
+   !> (lockstep_groups); a group of at least min_group_members runs in lockstep, the scenes of a
+   !> smaller one (a scene that joins no other, too) run alone one after the other (as
    !> `beamstops run FILE.nml`), and each writes its own output exactly as it would alone, with
    !> its summary line. Exit status: 0 when every scene completed, else the largest of the
    !> scenes' statuses (3 diverged or failed, 4 an output could not be written).
@@ -499,16 +500,20 @@ contains
       block
          integer, allocatable :: sizes(:)
          sizes = [(count(group == g), g=1, maxval(group))]
-         write (error_unit, '(a,i0,a,i0,a,i0,a,i0,a)') 'beamstops: ', n, ' scenes: ', sum(sizes, sizes > 1), &
-            & ' in ', count(sizes > 1), ' lockstep group(s), ', count(sizes == 1), ' alone'
+         write (error_unit, '(a,i0,a,i0,a,i0,a,i0,a)') 'beamstops: ', n, ' scenes: ', &
+            & sum(sizes, sizes >= min_group_members), ' in ', count(sizes >= min_group_members), &
+            & ' lockstep group(s), ', sum(sizes, sizes < min_group_members), ' alone'
       end block
       progress = c_isatty(2_c_int) == 1
       status = 0
       do g = 1, maxval(group)
          members = pack([(i, i=1, n)], group == g)
-         if (size(members) == 1) then
-            i = members(1)
-            status(i) = run_to_file(scenes(i), models(i), paths(i)%text, restart, progress)
+         if (size(members) < min_group_members) then
+            ! too few to gain from lockstep: one after the other, as alone
+            do j = 1, size(members)
+               i = members(j)
+               status(i) = run_to_file(scenes(i), models(i), paths(i)%text, restart, progress)
+            end do
          else
             call run_group_to_files(scenes, models, paths, members, progress, status)
          end if

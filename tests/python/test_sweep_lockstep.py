@@ -45,6 +45,8 @@ SCENES = {
     "c": "&mesh elements = 10 /\n&time dt = 4e-5, t_end = 0.4 /\n&support omega = 20 /\n",
     "d": "&mesh elements = 10 /\n&time dt = 5e-5, t_end = 0.4 /\n&support omega = 17 /\n"
          "&ensemble members = 3, perturbation = 1e-5 /\n",
+    "e": "&mesh elements = 10 /\n&time dt = 5e-5, t_end = 0.4, load_rule = 'paper' /\n&support omega = 25 /\n"
+         "&stops upper = 0.08, restitution = 0.5 /\n",
 }
 
 
@@ -56,16 +58,20 @@ def write_scenes(folder: Path, names: str) -> list[str]:
 
 
 def test_several_scenes_write_the_files_each_writes_alone(tmp_path: Path, program: str) -> None:
-    files = write_scenes(tmp_path / "together", "abcd")
+    files = write_scenes(tmp_path / "together", "abcde")
     done = subprocess.run([program, "run", *files], cwd=tmp_path / "together", capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
-    # the engine's partition: a, b, d share A (one lockstep group), c runs alone
-    assert "4 scenes: 3 in 1 lockstep group(s), 1 alone" in done.stderr
+    # the engine's partition: a, b, d, e share A (one lockstep group), c runs alone
+    assert "5 scenes: 4 in 1 lockstep group(s), 1 alone" in done.stderr
     # one summary line per scene, naming its output
     assert [line.split(":")[0] for line in done.stdout.splitlines() if "steps," in line] == \
-        ["a.h5", "b.h5", "d.h5", "c.h5"]
+        ["a.h5", "b.h5", "d.h5", "e.h5", "c.h5"]
+    # fewer than four that share A gain nothing from lockstep: they run one after the other
+    few = subprocess.run([program, "run", *files[:3]], cwd=tmp_path / "together", capture_output=True, text=True)
+    assert few.returncode == 0, few.stderr
+    assert "3 scenes: 0 in 0 lockstep group(s), 3 alone" in few.stderr
     alone = tmp_path / "alone"
-    for name in "abcd":
+    for name in "abcde":
         write_scenes(alone, name)
         single = subprocess.run([program, "run", f"{name}.nml"], cwd=alone, capture_output=True, text=True)
         assert single.returncode == 0, single.stderr
