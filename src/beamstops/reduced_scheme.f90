@@ -498,14 +498,8 @@ contains
          state%sigma_now = sigma_next
          if (recording) then
             next_record = next_record + scene%record_every
-            row = 0
-            row(col_t) = real(step, wp)*reduced%dt
-            row(col_u) = u_tip_prev
-            row(col_v) = (tip_value_of(reduced, state%d) + d_tip_prev)/(2*reduced%dt)
-            row(col_reaction) = scene%mass_per_length*r_prev
-            row(col_work) = scene%mass_per_length*state%work
-            row(col_dissipated) = scene%mass_per_length*state%dissipated
-            row(col_damped) = scene%mass_per_length*state%damped
+            call fill_row(scene, reduced, state, step, u_tip_prev, tip_value_of(reduced, state%d), d_tip_prev, &
+               & r_prev, row)
             call energy_terms(reduced%r, reduced%m, reduced%lambda, reduced%coupling, state%q, state%d, state%acc, &
                & usu, dsu, dmd)
             call stop_energy_terms(reduced, state%q, state%d, usu, dsu, dmd)
@@ -514,9 +508,7 @@ contains
          end if
          if (step == next_snapshot) then
             next_snapshot = next_snapshot + scene%snapshot_every
-            state%x = state%q - state%d
-            call physical_shape(reduced, state%x, real(step, wp)*reduced%dt, scene, state%shape)
-            call recorder%snapshot(real(step, wp)*reduced%dt, state%shape)
+            call take_snapshot(scene, reduced, state, step, recorder)
          end if
          done = step
       end do
@@ -600,14 +592,7 @@ contains
          state%sigma_now = sigma_next
          if (recording) then
             next_record = next_record + scene%record_every
-            row = 0
-            row(col_t) = real(step, wp)*reduced%dt
-            row(col_u) = u_tip_prev
-            row(col_v) = (state%d(pt) + d_tip_prev)/(2*reduced%dt)
-            row(col_reaction) = scene%mass_per_length*r_prev
-            row(col_work) = scene%mass_per_length*state%work
-            row(col_dissipated) = scene%mass_per_length*state%dissipated
-            row(col_damped) = scene%mass_per_length*state%damped
+            call fill_row(scene, reduced, state, step, u_tip_prev, state%d(pt), d_tip_prev, r_prev, row)
             ! M_r = diag(I, 0): d.M_r d = d_a.d_a.
             call reduced_stiffness_product(reduced, state%q, state%sq)
             row(col_energy) = scene%mass_per_length*energy(reduced, dot_product(state%d(1:r), state%d(1:r)), &
@@ -616,9 +601,7 @@ contains
          end if
          if (step == next_snapshot) then
             next_snapshot = next_snapshot + scene%snapshot_every
-            state%x = state%q - state%d
-            call physical_shape(reduced, state%x, real(step, wp)*reduced%dt, scene, state%shape)
-            call recorder%snapshot(real(step, wp)*reduced%dt, state%shape)
+            call take_snapshot(scene, reduced, state, step, recorder)
          end if
          done = step
       end do
@@ -716,14 +699,8 @@ contains
          state%sigma_now = sigma_next
          if (recording) then
             next_record = next_record + scene%record_every
-            row = 0
-            row(col_t) = real(step, wp)*reduced%dt
-            row(col_u) = u_tip_prev
-            row(col_v) = (tip_value_of(reduced, state%d) + d_tip_prev)/(2*reduced%dt)
-            row(col_reaction) = scene%mass_per_length*r_prev
-            row(col_work) = scene%mass_per_length*state%work
-            row(col_dissipated) = scene%mass_per_length*state%dissipated
-            row(col_damped) = scene%mass_per_length*state%damped
+            call fill_row(scene, reduced, state, step, u_tip_prev, tip_value_of(reduced, state%d), d_tip_prev, &
+               & r_prev, row)
             ! M_r = diag(I, 0): d.M_r d = d_a.d_a.
             call reduced_stiffness_product(reduced, state%q, state%sq)
             row(col_energy) = scene%mass_per_length*energy(reduced, dot_product(state%d(1:r), state%d(1:r)), &
@@ -732,9 +709,7 @@ contains
          end if
          if (step == next_snapshot) then
             next_snapshot = next_snapshot + scene%snapshot_every
-            state%x = state%q - state%d
-            call physical_shape(reduced, state%x, real(step, wp)*reduced%dt, scene, state%shape)
-            call recorder%snapshot(real(step, wp)*reduced%dt, state%shape)
+            call take_snapshot(scene, reduced, state, step, recorder)
          end if
          phi_prev = phi_now
          phi_now = phi_next
@@ -742,6 +717,37 @@ contains
       end do
       state%step = done + 1
    end subroutine advance_massless_span
+
+   !> The record row of step n (t_n, u, v, reaction, work, stops, damping), the energy column 0
+   !> (each loop completes it from its own terms). d_tip_now is the tip's value of d^n.
+   pure subroutine fill_row(scene, reduced, state, step, u_tip_prev, d_tip_now, d_tip_prev, r_prev, row)
+      type(scene_type), intent(in) :: scene
+      type(reduced_model_type), intent(in) :: reduced
+      type(reduced_state_type), intent(in) :: state
+      integer(ik), intent(in) :: step
+      real(wp), intent(in) :: u_tip_prev, d_tip_now, d_tip_prev, r_prev
+      real(wp), intent(out) :: row(n_columns)
+      row = 0
+      row(col_t) = real(step, wp)*reduced%dt
+      row(col_u) = u_tip_prev
+      row(col_v) = (d_tip_now + d_tip_prev)/(2*reduced%dt)
+      row(col_reaction) = scene%mass_per_length*r_prev
+      row(col_work) = scene%mass_per_length*state%work
+      row(col_dissipated) = scene%mass_per_length*state%dissipated
+      row(col_damped) = scene%mass_per_length*state%damped
+   end subroutine fill_row
+
+   !> Snapshot of u^n = q^{n+1} - d^n at t_n, expanded to the nodes.
+   subroutine take_snapshot(scene, reduced, state, step, recorder)
+      type(scene_type), intent(in) :: scene
+      type(reduced_model_type), intent(in) :: reduced
+      type(reduced_state_type), intent(inout) :: state
+      integer(ik), intent(in) :: step
+      class(recorder_type), intent(inout) :: recorder
+      state%x = state%q - state%d
+      call physical_shape(reduced, state%x, real(step, wp)*reduced%dt, scene, state%shape)
+      call recorder%snapshot(real(step, wp)*reduced%dt, state%shape)
+   end subroutine take_snapshot
 
    !> The tip value of a reduced vector: its tip coordinate when the tip is a stop, else T(tip, :) q.
    pure function tip_value_of(reduced, q) result(u)
