@@ -204,3 +204,27 @@ def test_restart_without_partial_output_starts_over(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stderr
     assert "lost.h5.partial" in done.stderr and "starting from t = 0" in done.stderr
     assert beamstops.load(tmp_path / "lost.h5").attrs["steps"] == 50000
+
+
+def test_a_resume_after_a_failed_attempt_keeps_no_stale_message(tmp_path: Path) -> None:
+    # An attempt that failed after a checkpoint (here: its end written by hand, as `finish`
+    # writes a failed run's) leaves status 'failed' and its message in OUT.h5.partial; the
+    # resumed run that completes must be the uninterrupted run, without that message.
+    reference = write_scene(tmp_path, "reference", t_end=0.2)
+    assert run("run", reference, cwd=tmp_path).returncode == 0
+    scene = write_scene(tmp_path, "killed", t_end=0.2)
+    process = subprocess.Popen([PROGRAM, "run", str(scene)], cwd=tmp_path, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+    checkpoint = tmp_path / "killed.h5.checkpoint"
+    while process.poll() is None and not checkpoint.exists():
+        time.sleep(0.001)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    if not checkpoint.exists():
+        pytest.skip("the run ended before its first checkpoint")
+    with h5py.File(tmp_path / "killed.h5.partial", "r+") as f:
+        f.attrs["status"] = "failed"
+        f.attrs["message"] = "killed.h5: cannot write to killed.h5.partial"
+    done = run("run", scene, "--restart", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert_identical(tmp_path / "killed.h5", tmp_path / "reference.h5")

@@ -288,6 +288,7 @@ contains
       !> Set when the file cannot be opened or lacks a series.
       type(error_type), allocatable, intent(out) :: error
       integer :: hdferr, i
+      logical :: stale
       call prepare(self, path, scene, model)
       call h5fopen_f(self%partial, H5F_ACC_RDWR_F, self%file, hdferr)
       if (hdferr /= 0) then
@@ -311,6 +312,11 @@ contains
       self%snaps_written = snapshots
       self%stops_written = records
       call attribute_text(self, 'status', status_running)
+      ! An attempt that failed after the checkpoint left its message in the file: the file is
+      ! running again, and its end writes the message it has (none for a complete run).
+      call h5aexists_f(self%file, 'message', stale, hdferr)
+      if (hdferr == 0 .and. stale) call h5adelete_f(self%file, 'message', hdferr)
+      if (hdferr /= 0) call fail(self, 'cannot clear the message of the failed attempt in '//self%partial)
       if (self%failed) call fatal_error(error, self%message)
 
    contains
