@@ -80,7 +80,6 @@ contains
       type(band_solver), intent(in) :: solver
       !> Right-hand side b (n), replaced by D^{-2} w.
       real(wp), intent(inout), contiguous :: b(:)
-      real(wp) :: xa, xb, xc
       integer :: j, n
       n = solver%n
       associate (off => solver%off, inv_d2 => solver%inv_d2)
@@ -91,18 +90,41 @@ contains
             b = b*inv_d2
             return
          end if
-         call first_rows(off, inv_d2, b, xa, xb, xc)
-         do j = kd + 1, n - 2, 3
-            xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
-            b(j) = xa*inv_d2(j)
-            xb = row(b(j + 1), off(1, j + 1), off(2, j + 1), off(3, j + 1), xb, xc, xa)
-            b(j + 1) = xb*inv_d2(j + 1)
-            xc = row(b(j + 2), off(1, j + 2), off(2, j + 2), off(3, j + 2), xc, xa, xb)
-            b(j + 2) = xc*inv_d2(j + 2)
-         end do
-         call last_rows(off, inv_d2, j, n, b, xa, xb, xc)
+         call forward_rows(n, off, inv_d2, b)
       end associate
    end subroutine forward_substitution
+
+   !> The rows of forward_substitution for n >= kd, all in one routine of explicit-shape arrays:
+   !> the compiler keeps the three running values in registers and every array at a fixed
+   !> stride, and the first and last rows are written out (no call, no loop of their own on the
+   !> chain).
+   pure subroutine forward_rows(n, off, inv_d2, b)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: off(kd, n), inv_d2(n)
+      real(wp), intent(inout) :: b(n)
+      real(wp) :: xa, xb, xc
+      integer :: j
+      xa = b(1)
+      xb = b(2) - off(3, 2)*xa
+      xc = b(3) - off(2, 3)*xa - off(3, 3)*xb
+      b(1) = xa*inv_d2(1)
+      b(2) = xb*inv_d2(2)
+      b(3) = xc*inv_d2(3)
+      do j = kd + 1, n - 2, 3
+         xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
+         b(j) = xa*inv_d2(j)
+         xb = row(b(j + 1), off(1, j + 1), off(2, j + 1), off(3, j + 1), xb, xc, xa)
+         b(j + 1) = xb*inv_d2(j + 1)
+         xc = row(b(j + 2), off(1, j + 2), off(2, j + 2), off(3, j + 2), xc, xa, xb)
+         b(j + 2) = xc*inv_d2(j + 2)
+      end do
+      if (j <= n) then
+         xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
+         b(j) = xa*inv_d2(j)
+      end if
+      if (j + 1 <= n) b(j + 1) = row(b(j + 1), off(1, j + 1), off(2, j + 1), off(3, j + 1), xb, xc, xa) &
+         & *inv_d2(j + 1)
+   end subroutine forward_rows
 
    !> forward_substitution with, in the shadow of its chain, the dot products of the discrete
    !> energy: usu = u.su, dsu = d.su and dmd = d.M d = sum_j d_j (M_jj d_j + 2 sum_k M_j-k,j d_j-k)
@@ -245,47 +267,48 @@ contains
       type(band_solver), intent(in) :: solver
       !> D^{-2} w (n), replaced by x.
       real(wp), intent(inout), contiguous :: b(:)
-      real(wp) :: xa, xb, xc
-      integer :: i, n
-      n = solver%n
-      call back_substitution_edge(solver, b)
-      if (n <= kd) return
-      associate (off => solver%off)
-         xa = b(n)
-         xb = b(n - 1)
-         xc = b(n - 2)
-         do i = n - kd, 3, -3
-            xa = row(b(i), off(1, i + 3), off(2, i + 2), off(3, i + 1), xa, xb, xc)
-            b(i) = xa
-            xb = row(b(i - 1), off(1, i + 2), off(2, i + 1), off(3, i), xb, xc, xa)
-            b(i - 1) = xb
-            xc = row(b(i - 2), off(1, i + 1), off(2, i), off(3, i - 1), xc, xa, xb)
-            b(i - 2) = xc
-         end do
-         ! The first rows (fewer than three): xa, xb, xc hold x_{i+3}, x_{i+2}, x_{i+1}.
-         if (i >= 1) then
-            xa = row(b(i), off(1, i + 3), off(2, i + 2), off(3, i + 1), xa, xb, xc)
-            b(i) = xa
-         end if
-         if (i - 1 >= 1) b(i - 1) = row(b(i - 1), off(1, i + 2), off(2, i + 1), off(3, i), xb, xc, xa)
-      end associate
-   end subroutine back_substitution
-
-   !> The first kd rows of the back substitution (x_n, x_{n-1}, x_{n-2}); all of them when
-   !> n <= kd. The time loop needs the tip value (row n-1) before it finishes the substitution.
-   pure subroutine back_substitution_edge(solver, b)
-      !> Solver from prepare_solver.
-      type(band_solver), intent(in) :: solver
-      !> D^{-2} w (n); its last kd rows replaced by those of x.
-      real(wp), intent(inout), contiguous :: b(:)
       integer :: i, j, n
       n = solver%n
-      do i = n - 1, max(n - kd + 1, 1), -1
-         do j = min(n, i + kd), i + 1, -1
-            b(i) = b(i) - solver%off(kd + 1 + i - j, j)*b(j)
+      if (n <= kd) then
+         do i = n - 1, 1, -1
+            do j = n, i + 1, -1
+               b(i) = b(i) - solver%off(kd + 1 + i - j, j)*b(j)
+            end do
          end do
+         return
+      end if
+      call back_rows(n, solver%off, b)
+   end subroutine back_substitution
+
+   !> The rows of back_substitution for n > kd in one routine of explicit-shape arrays (as
+   !> forward_rows): x_n, x_{n-1}, x_{n-2} written out (each row farthest value first, as every
+   !> other row), then three rows a turn.
+   pure subroutine back_rows(n, off, b)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: off(kd, n)
+      real(wp), intent(inout) :: b(n)
+      real(wp) :: xa, xb, xc
+      integer :: i
+      xa = b(n)
+      xb = b(n - 1) - off(3, n)*xa
+      xc = b(n - 2) - off(2, n)*xa - off(3, n - 1)*xb
+      b(n - 1) = xb
+      b(n - 2) = xc
+      do i = n - kd, 3, -3
+         xa = row(b(i), off(1, i + 3), off(2, i + 2), off(3, i + 1), xa, xb, xc)
+         b(i) = xa
+         xb = row(b(i - 1), off(1, i + 2), off(2, i + 1), off(3, i), xb, xc, xa)
+         b(i - 1) = xb
+         xc = row(b(i - 2), off(1, i + 1), off(2, i), off(3, i - 1), xc, xa, xb)
+         b(i - 2) = xc
       end do
-   end subroutine back_substitution_edge
+      ! The first rows (fewer than three): xa, xb, xc hold x_{i+3}, x_{i+2}, x_{i+1}.
+      if (i >= 1) then
+         xa = row(b(i), off(1, i + 3), off(2, i + 2), off(3, i + 1), xa, xb, xc)
+         b(i) = xa
+      end if
+      if (i - 1 >= 1) b(i - 1) = row(b(i - 1), off(1, i + 2), off(2, i + 1), off(3, i), xb, xc, xa)
+   end subroutine back_rows
 
    !> One row of a substitution, b - o3 x3 - o2 x2 - o1 x1, with x1 the nearest value:
    !> subtracted last, it is the only input the row waits for.

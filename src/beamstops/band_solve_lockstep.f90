@@ -9,10 +9,8 @@
 !> Bit for bit: every routine performs, for each lane, the floating-point operations of its
 !> one-member counterpart in beamstops_band_solve, in the same order, with the same expressions
 !> and the same multiply-adds. The one-member routines are what the compiler made of them, and
-!> in three places it rounds a product before adding it (gfortran 12, -O3, znver3: where a
+!> in two places it rounds a product before adding it (gfortran 12, -O3, znver3: where a
 !> running sum is a reduction it vectorizes in order, or a chain it keeps apart from multiply-adds):
-!> - back_substitution's first rows n-1 and n-2 (back_substitution_edge's loops): each product
-!>   rounded before it is subtracted;
 !> - forward_substitution_energy's three sums over the rows after its last triple of rows, when
 !>   there are two (n - 3 = 2 mod 3): each term rounded before it is added (one row: a
 !>   multiply-add); the sums start with u1 s1 + u2 s2 + u3 s3 as fma(u3, s3, fma(u1, s1, u2 s2));
@@ -216,24 +214,18 @@ contains
 
    !> Back substitution (I + N) x = b of every lane (beamstops_band_solve's back_substitution,
    !> its edge rows included).
-   pure subroutine lockstep_back(solver, b, work)
+   pure subroutine lockstep_back(solver, b)
       !> Solver from prepare_solver.
       type(band_solver), intent(in) :: solver
       !> D^{-2} w (lanes, n), replaced by x.
       real(wp), intent(inout) :: b(lockstep_lanes, solver%n)
-      !> Work array (lanes, lockstep_work_columns).
-      real(wp), intent(out) :: work(lockstep_lanes, lockstep_work_columns)
       real(wp) :: xa(lockstep_lanes), xb(lockstep_lanes), xc(lockstep_lanes)
       integer :: i, k, n
       n = solver%n
       associate (off => solver%off)
-         ! the edge rows, each product rounded before its subtraction
-         work(:, 1) = off(3, n)*b(:, n)
-         call subtract_rounded(b(:, n - 1), work(:, 1), solver%inv_d2(1))
-         work(:, 1) = off(2, n)*b(:, n)
-         call subtract_rounded(b(:, n - 2), work(:, 1), solver%inv_d2(1))
-         work(:, 1) = off(3, n - 1)*b(:, n - 1)
-         call subtract_rounded(b(:, n - 2), work(:, 1), solver%inv_d2(1))
+         ! the edge rows, farthest value first (as back_rows)
+         b(:, n - 1) = b(:, n - 1) - off(3, n)*b(:, n)
+         b(:, n - 2) = b(:, n - 2) - off(2, n)*b(:, n) - off(3, n - 1)*b(:, n - 1)
 !GCC$ ivdep
 !GCC$ vector
          do k = 1, lockstep_lanes
@@ -274,23 +266,17 @@ contains
    !> The first rows of lockstep_back, x_n, x_{n-1} and x_{n-2} of every lane (beamstops_band_solve's
    !> back_substitution_edge): the tip value x_{n-1} that the contact law needs before the rest
    !> of the substitution, lockstep_back_update.
-   pure subroutine lockstep_back_edge(solver, b, work)
+   pure subroutine lockstep_back_edge(solver, b)
       !> Solver from prepare_solver.
       type(band_solver), intent(in) :: solver
       !> D^{-2} w (lanes, n); its last kd rows replaced by those of x.
       real(wp), intent(inout) :: b(lockstep_lanes, solver%n)
-      !> Work array (lanes, lockstep_work_columns).
-      real(wp), intent(out) :: work(lockstep_lanes, lockstep_work_columns)
       integer :: n
       n = solver%n
       associate (off => solver%off)
-         ! each product rounded before its subtraction
-         work(:, 1) = off(3, n)*b(:, n)
-         call subtract_rounded(b(:, n - 1), work(:, 1), solver%inv_d2(1))
-         work(:, 1) = off(2, n)*b(:, n)
-         call subtract_rounded(b(:, n - 2), work(:, 1), solver%inv_d2(1))
-         work(:, 1) = off(3, n - 1)*b(:, n - 1)
-         call subtract_rounded(b(:, n - 2), work(:, 1), solver%inv_d2(1))
+         ! farthest value first (as back_rows)
+         b(:, n - 1) = b(:, n - 1) - off(3, n)*b(:, n)
+         b(:, n - 2) = b(:, n - 2) - off(2, n)*b(:, n) - off(3, n - 1)*b(:, n - 1)
       end associate
    end subroutine lockstep_back_edge
 

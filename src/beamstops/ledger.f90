@@ -12,7 +12,7 @@ module beamstops_ledger
    use beamstops_band_solve, only: diagonal_matvec, dot
    implicit none
    private
-   public :: energy, move_on, damping_loss, fill_row, take_snapshot, physical_shape, first_events
+   public :: energy, move_on, book_step, shift_loads, damping_loss, fill_row, take_snapshot, physical_shape, first_events
 
 contains
 
@@ -38,14 +38,35 @@ contains
       logical, intent(in) :: contact
       !> g.d^n, the load average weight of the step, its reaction (per unit mass) and sigma_{n+1}.
       real(wp), intent(in) :: gd, weight, r_step, sigma_next
+      call book_step(state, contact, gd, weight, r_step)
+      call shift_loads(state, sigma_next)
+   end subroutine move_on
+
+   !> move_on without the load averages: impacts, the work of the load and the reaction of the
+   !> step (a loop that moves the load averages on at once may book the step later).
+   pure subroutine book_step(state, contact, gd, weight, r_step)
+      !> State after the update of the step.
+      type(state_type), intent(inout) :: state
+      !> Whether the stops act during the step.
+      logical, intent(in) :: contact
+      !> g.d^n, the load average weight of the step and its reaction (per unit mass).
+      real(wp), intent(in) :: gd, weight, r_step
       if (contact .and. .not. state%in_contact) state%impacts = state%impacts + 1
       state%in_contact = contact
       state%work = state%work + 0.5_wp*weight*(gd + state%gd_prev)
       state%reaction = r_step
       state%gd_prev = gd
+   end subroutine book_step
+
+   !> The load averages moved on: sigma_{n-1} <- sigma_n <- sigma_{n+1}.
+   pure subroutine shift_loads(state, sigma_next)
+      !> State after the step.
+      type(state_type), intent(inout) :: state
+      !> sigma_{n+1}.
+      real(wp), intent(in) :: sigma_next
       state%sigma_prev = state%sigma_now
       state%sigma_now = sigma_next
-   end subroutine move_on
+   end subroutine shift_loads
 
    !> The energy the Rayleigh damping takes in step n (SPEC 8), once d^n is final:
    !>   (1/(4 dt)) (d^n + d^{n-1}).C (d^n + d^{n-1}) = (d^n.C d^n + 2 d^n.C d^{n-1} + d^{n-1}.C d^{n-1})/(4 dt)

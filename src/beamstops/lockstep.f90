@@ -622,7 +622,7 @@ contains
             else
                lanes(c)%u_old_su = 0
             end if
-            call lockstep_back_edge(ops%solver, ms%rhs(:, :, c), ms%partial)
+            call lockstep_back_edge(ops%solver, ms%rhs(:, :, c))
             call lanes_contact(lanes(c), law, ms%u(:, tip, c), ms%d(:, tip, c), ms%rhs(:, tip, c), z_tip, model%dt2, &
                & model%beta)
             call lockstep_back_update(ops%solver, ms%rhs(:, :, c), lanes(c)%c, model%z, ms%d(:, :, c), ms%u(:, :, c))

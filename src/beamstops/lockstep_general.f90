@@ -124,7 +124,7 @@ contains
          do c = 1, ms%chunks
             lo = (c - 1)*lockstep_lanes + 1
             hi = c*lockstep_lanes
-            call lockstep_back(ops%solver, ms%rhs(:, :, c), ms%partial)
+            call lockstep_back(ops%solver, ms%rhs(:, :, c))
             ms%d_tip_prev(lo:hi) = ms%d(:, tip, c)
             ms%u_tip_prev(lo:hi) = ms%u(:, tip, c)
             if (massless) then

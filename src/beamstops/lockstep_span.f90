@@ -288,7 +288,7 @@ contains
             else
                call lockstep_forward(ops%solver, lanes%rhs(:, :, c))
             end if
-            call lockstep_back(ops%solver, lanes%rhs(:, :, c), lanes%partial)
+            call lockstep_back(ops%solver, lanes%rhs(:, :, c))
          end do
          ! each member's contact work, on its own state
          do k = 1, nk

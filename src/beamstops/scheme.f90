@@ -18,12 +18,13 @@ module beamstops_scheme
    use beamstops_state, only: state_type
    use beamstops_clock, only: thread_cpu_seconds
    use beamstops_forcing, only: load_average, support_position, load_rotation, start_loads, next_load
-   use beamstops_contact_tip_contact, only: spring_term, tip_step, tip_step_massless, update
+   use beamstops_contact_tip_contact, only: spring_term, tip_step, tip_step_massless, update, tip_outcome, tip_update, &
+      & fix_tip, settle_tip
    use beamstops_contact_span_stops, only: new_span_work, span_contact, span_correction, span_settle, span_energy, &
       & span_energy_massless
    use beamstops_contact_box_qp, only: qp_solved, qp_message
    use beamstops_recorder, only: recorder_type, n_columns, col_energy
-   use beamstops_ledger, only: energy, move_on, damping_loss, fill_row, take_snapshot, first_events
+   use beamstops_ledger, only: energy, move_on, shift_loads, damping_loss, fill_row, take_snapshot, first_events
    use beamstops_contact_mass_redistribution, only: equilibrium_rows, massless_reaction
    use beamstops_start, only: start_state
    use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running, &
@@ -217,8 +218,12 @@ contains
    !> chain of the two triangular solves, 2n multiply-adds in a row, bounds a step) and the
    !> products and dot products vectorized over S and M by diagonals; the load averages by
    !> rotation (load_rotation) instead of a sine a step. S u^{n+1} is computed once, by the next
-   !> forward pass: the record of a step, whose energy needs it, is handed to the recorder
-   !> one step later (at the end of the call for the last step).
+   !> forward pass. Between the back substitution and the next forward pass only what that pass
+   !> waits for: the contact law, the update, the tip set on the stop and the load averages
+   !> moved on. The books of the step (g.d^n, the ledger, the observer, the record and the
+   !> snapshot: settle_held) wait until the next forward pass is under way, where they run in
+   !> the shadow of its chain; the record's energy comes from that pass's dot products. Same
+   !> operations on the same values as tip_step then close_step: the same bits.
    subroutine advance_fused(scene, model, state, recorder, last)
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
@@ -226,56 +231,94 @@ contains
       class(recorder_type), intent(inout) :: recorder
       integer(ik), intent(in) :: last
       integer(ik) :: step, next_record, next_snapshot
-      integer :: tip
-      real(wp) :: sigma_next, weight, d_tip_prev, u_tip_prev
-      real(wp) :: usu, dsu, u_old_su, dmd, r_prev, row(n_columns)
-      logical :: pending
+      real(wp) :: sigma_next, weight, held_weight, d_tip_free
+      real(wp) :: sums(4)
+      logical :: held
+      type(tip_outcome) :: outcome
       type(load_rotation) :: loads
 
-      tip = model%tip
       call first_events(scene, state%step, next_record, next_snapshot)
-      pending = .false.
-      u_old_su = 0
-      dmd = 0
+      held = .false.
+      held_weight = 0
+      d_tip_free = 0
+      ! sums: u.S u, d.S u and d.M d of this step's forward pass, and u.S u of the one before
+      sums = 0
       call start_loads(loads, state%step + 1, model%dt, scene%omega, scene%centered_load)
       do step = state%step, last
          sigma_next = loads%sigma
          call next_load(loads)
          weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
          call forward_pass(model%stiffness_diagonals, model%mass_diagonals, model%solver, model%load, state%u, state%d, &
-            & model%dt2*weight, model%dt2, spring_term(scene, model, state), pending .or. step == next_record, &
-            & state%su, state%rhs, usu, dsu, dmd)
-         if (pending) then
-            ! usu = u^n.S u^n, dsu = d^{n-1}.S u^n and dmd = d^{n-1}.M d^{n-1} complete the energy
-            ! of step n-1.
-            row(col_energy) = scene%mass_per_length*energy(model, dmd, usu, dsu, u_old_su)
-            call recorder%record(row)
-            pending = .false.
-         end if
-         u_old_su = usu
+            & model%dt2*weight, model%dt2, spring_term(scene, model, state), &
+            & (held .and. step - 1 == next_record) .or. step == next_record, &
+            & state%su, state%rhs, sums(1), sums(2), sums(3))
+         if (held) call settle_held(scene, model, state, recorder, step - 1, outcome, d_tip_free, held_weight, sums, &
+            & next_record, next_snapshot)
+         sums(4) = sums(1)
          call back_substitution(model%solver, state%rhs)
-         call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
-         if (state%observer%active) call state%observer%tip(real(step + 1, wp)*model%dt, state%u(tip), &
-            & merge(state%reaction, 0.0_wp, state%in_contact), state%dissipated)
-         if (step == next_record) then
-            next_record = next_record + scene%record_every
-            call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_prev, row)
-            pending = .true.
-         end if
-         if (step == next_snapshot) then
-            next_snapshot = next_snapshot + scene%snapshot_every
-            call take_snapshot(scene, model, state, step, recorder)
-         end if
+         call tip_update(scene, model, state, outcome)
+         d_tip_free = state%d(model%tip)
+         call fix_tip(scene, model, state, outcome%contact, outcome%tip_value, outcome%u_tip_prev, .true.)
+         call shift_loads(state, sigma_next)
+         held = .true.
+         held_weight = weight
       end do
-      ! The state carries S u^{last+1}; it also completes a waiting record.
+      ! The state carries S u^{last+1}; the books of the last step, its record's energy from it.
       call diagonal_matvec(model%stiffness_diagonals, state%u, state%su)
-      if (pending) then
-         call diagonal_matvec(model%mass_diagonals, state%d, state%scratch)
-         row(col_energy) = scene%mass_per_length*energy(model, dot(state%d, state%scratch), dot(state%u, state%su), &
-            & dot(state%d, state%su), u_old_su)
-         call recorder%record(row)
+      if (held) then
+         if (last == next_record) then
+            call diagonal_matvec(model%mass_diagonals, state%d, state%scratch)
+            sums(1:3) = [dot(state%u, state%su), dot(state%d, state%su), dot(state%d, state%scratch)]
+         end if
+         call settle_held(scene, model, state, recorder, last, outcome, d_tip_free, held_weight, sums, &
+            & next_record, next_snapshot)
       end if
    end subroutine advance_fused
+
+   !> The books of step n of advance_fused, done while the forward pass of step n+1 runs (it
+   !> leaves u^{n+1} and d^n alone): g.d^n with d^n_tip as the update left it (before fix_tip,
+   !> as in tip_step), settle_tip, the observer, the record row (its energy from `sums`) and the
+   !> snapshot.
+   subroutine settle_held(scene, model, state, recorder, step, outcome, d_tip_free, weight, sums, next_record, &
+      & next_snapshot)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      !> Its model.
+      type(model_type), intent(in) :: model
+      !> State after step n (u^{n+1}, d^n; the load averages already moved on).
+      type(state_type), intent(inout) :: state
+      !> Receives the records.
+      class(recorder_type), intent(inout) :: recorder
+      !> Step n.
+      integer(ik), intent(in) :: step
+      !> The step's contact, reaction and tip values (tip_update).
+      type(tip_outcome), intent(in) :: outcome
+      !> d^n_tip before fix_tip and the load average weight of the step.
+      real(wp), intent(in) :: d_tip_free, weight
+      !> u^{n+1}.S u^{n+1}, d^n.S u^{n+1}, d^n.M d^n and u^n.S u^n (when step n is recorded).
+      real(wp), intent(in) :: sums(4)
+      !> The next step recorded and the next snapshot, moved on past step n.
+      integer(ik), intent(inout) :: next_record, next_snapshot
+      real(wp) :: gd, d_tip, r_prev, row(n_columns)
+      d_tip = state%d(model%tip)
+      state%d(model%tip) = d_tip_free
+      gd = dot(model%load, state%d)
+      state%d(model%tip) = d_tip
+      r_prev = state%reaction
+      call settle_tip(scene, model, state, outcome, gd, weight)
+      if (state%observer%active) call state%observer%tip(real(step + 1, wp)*model%dt, state%u(model%tip), &
+         & merge(state%reaction, 0.0_wp, state%in_contact), state%dissipated)
+      if (step == next_record) then
+         next_record = next_record + scene%record_every
+         call fill_row(scene, model, state, step, outcome%u_tip_prev, outcome%d_tip_prev, r_prev, row)
+         row(col_energy) = scene%mass_per_length*energy(model, sums(3), sums(1), sums(2), sums(4))
+         call recorder%record(row)
+      end if
+      if (step == next_snapshot) then
+         next_snapshot = next_snapshot + scene%snapshot_every
+         call take_snapshot(scene, model, state, step, recorder)
+      end if
+   end subroutine settle_held
 
    !> advance_fused with Rayleigh damping (SPEC 8) and/or mass redistribution (SPEC 10): with
    !> damping, rhs gains -dt C d^{n-1} and each step ends with damping_loss (C d^n, the energy

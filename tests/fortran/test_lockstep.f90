@@ -303,7 +303,7 @@ contains
                if (.not. all(same_bits(v, b(k, :)))) call test_failed(error, where//'forward substitution, lane '//int_text(k))
             end do
             b = x
-            call lockstep_back(solver, b, work)
+            call lockstep_back(solver, b)
             do k = 1, lanes
                v = x(k, :)
                call back_substitution(solver, v)
@@ -335,7 +335,7 @@ contains
             end do
             ! the back substitution with the update riding on it: back substitution, then update
             b = x
-            call lockstep_back_edge(solver, b, work)
+            call lockstep_back_edge(solver, b)
             y = d
             ub = u
             call lockstep_back_update(solver, b, c, model%z, y, ub)

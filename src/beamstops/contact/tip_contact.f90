@@ -14,10 +14,21 @@ module beamstops_contact_tip_contact
    use beamstops_contact_mass_redistribution, only: massless_reaction
    use beamstops_contact_tip_projection, only: project_tip
    use beamstops_contact_compliance, only: spring_force, solve_spring_tip
-   use beamstops_ledger, only: move_on
+   use beamstops_ledger, only: book_step, shift_loads
    implicit none
    private
    public :: spring_term, contact_law, tip_step, tip_step_massless, close_step, update, violation
+   public :: tip_outcome, tip_update, settle_tip, fix_tip
+
+   !> What the books of a step at the tip (settle_tip) need once the update is done.
+   type :: tip_outcome
+      !> Whether the stops act during the step.
+      logical :: contact = .false.
+      !> The reaction of the step per unit mass and the tip value of the contact law.
+      real(wp) :: r_step = 0, tip_value = 0
+      !> d^{n-1}_tip and u^n_tip.
+      real(wp) :: d_tip_prev = 0, u_tip_prev = 0
+   end type tip_outcome
 
 contains
 
@@ -109,17 +120,36 @@ contains
       real(wp), intent(in) :: weight, sigma_next
       !> u^n_tip, d^{n-1}_tip and the reaction recorded with u^n.
       real(wp), intent(out) :: u_tip_prev, d_tip_prev, r_prev
-      real(wp) :: trial, c, tip_value, r_step
-      logical :: contact
-      d_tip_prev = state%d(model%tip)
-      u_tip_prev = state%u(model%tip)
-      trial = u_tip_prev + (d_tip_prev + state%rhs(model%tip))
-      call contact_law(scene, model, state, trial, c, tip_value, r_step, contact)
-      call update(state%rhs, c, model%z, state%d, state%u)
+      type(tip_outcome) :: outcome
+      real(wp) :: gd
+      call tip_update(scene, model, state, outcome)
       r_prev = state%reaction
-      call close_step(scene, model, state, contact, tip_value, dot(model%load, state%d), weight, r_step, &
-         & d_tip_prev, u_tip_prev, sigma_next, .true.)
+      gd = dot(model%load, state%d)
+      call fix_tip(scene, model, state, outcome%contact, outcome%tip_value, outcome%u_tip_prev, .true.)
+      call settle_tip(scene, model, state, outcome, gd, weight)
+      call shift_loads(state, sigma_next)
+      u_tip_prev = outcome%u_tip_prev
+      d_tip_prev = outcome%d_tip_prev
    end subroutine tip_step
+
+   !> The contact law at the tip and the update of d and u (tip_step's first part; fix_tip then
+   !> sets the tip exactly on the stop, settle_tip books the step).
+   subroutine tip_update(scene, model, state, outcome)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      !> Model.
+      type(model_type), intent(in) :: model
+      !> State: rhs holds A^{-1} rhs on entry; u^{n+1} and d^n on return.
+      type(state_type), intent(inout) :: state
+      !> The step's contact, reaction and tip values (for fix_tip and settle_tip).
+      type(tip_outcome), intent(out) :: outcome
+      real(wp) :: trial, c
+      outcome%d_tip_prev = state%d(model%tip)
+      outcome%u_tip_prev = state%u(model%tip)
+      trial = outcome%u_tip_prev + (outcome%d_tip_prev + state%rhs(model%tip))
+      call contact_law(scene, model, state, trial, c, outcome%tip_value, outcome%r_step, outcome%contact)
+      call update(state%rhs, c, model%z, state%d, state%u)
+   end subroutine tip_update
 
    !> tip_step with a massless tip (mass redistribution, SPEC 10): the same law and update (the
    !> tip's row of rhs already holds its equilibrium), then the reaction of the step as the
@@ -168,18 +198,50 @@ contains
       real(wp), intent(in) :: tip_value, gd, weight, r_step, d_tip_prev, u_tip_prev, sigma_next
       !> Whether a tip in contact is set exactly on the stop (not with a massless tip).
       logical, intent(in) :: exact
-      integer :: tip
-      tip = model%tip
-      if (scene%law == law_signorini .and. contact .and. exact) then
-         ! The tip exactly on the stop, and d^n its exact increment (a tip resting on a stop
-         ! then has exactly zero velocity).
-         state%u(tip) = tip_value
-         state%d(tip) = tip_value - u_tip_prev
-      end if
-      if (scene%law /= law_none) state%max_violation = max(state%max_violation, violation(state%u(tip), scene))
-      call move_on(state, contact, gd, weight, r_step, sigma_next)
-      state%dissipated = state%dissipated - 0.5_wp*r_step*(state%d(tip) + d_tip_prev)
+      call fix_tip(scene, model, state, contact, tip_value, u_tip_prev, exact)
+      call settle_tip(scene, model, state, tip_outcome(contact, r_step, tip_value, d_tip_prev, u_tip_prev), gd, weight)
+      call shift_loads(state, sigma_next)
    end subroutine close_step
+
+   !> The tip exactly on the stop after a Signorini contact, and d^n its exact increment (a tip
+   !> resting on a stop then has exactly zero velocity); with `exact` false (a massless tip) nothing.
+   pure subroutine fix_tip(scene, model, state, contact, tip_value, u_tip_prev, exact)
+      !> Scene (law).
+      type(scene_type), intent(in) :: scene
+      !> Model (tip).
+      type(model_type), intent(in) :: model
+      !> State after the update.
+      type(state_type), intent(inout) :: state
+      !> Whether the stops act.
+      logical, intent(in) :: contact
+      !> Tip value of the law and u^n_tip.
+      real(wp), intent(in) :: tip_value, u_tip_prev
+      !> Whether a tip in contact is set exactly on the stop.
+      logical, intent(in) :: exact
+      if (scene%law == law_signorini .and. contact .and. exact) then
+         state%u(model%tip) = tip_value
+         state%d(model%tip) = tip_value - u_tip_prev
+      end if
+   end subroutine fix_tip
+
+   !> The books of a step at the tip once u^{n+1} and d^n are final (they may wait while the next
+   !> step's forward pass runs; the load averages are moved on apart, shift_loads): the violation
+   !> of the stops, impacts, work and reaction (book_step) and the energy taken by the stops.
+   pure subroutine settle_tip(scene, model, state, outcome, gd, weight)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      !> Model.
+      type(model_type), intent(in) :: model
+      !> State after the update (u^{n+1}, d^n).
+      type(state_type), intent(inout) :: state
+      !> The step's contact, reaction and tip values before it.
+      type(tip_outcome), intent(in) :: outcome
+      !> g.d^n and the load average weight of the step.
+      real(wp), intent(in) :: gd, weight
+      if (scene%law /= law_none) state%max_violation = max(state%max_violation, violation(state%u(model%tip), scene))
+      call book_step(state, outcome%contact, gd, weight, outcome%r_step)
+      state%dissipated = state%dissipated - 0.5_wp*outcome%r_step*(state%d(model%tip) + outcome%d_tip_prev)
+   end subroutine settle_tip
 
    !> Violation of the stops by a tip value (m).
    pure function violation(u_tip, scene) result(v)
