@@ -8,7 +8,7 @@
 !> to round-off without contact; and the checks of &mesh modes.
 module test_reduced
    use testing
-   use test_support, only: run_recorded, band_eigenvalues, dense_eigenvalues, solve_spd, int_text
+   use test_support, only: run_recorded, band_eigenvalues, dense_eigenvalues, solve_spd, int_text, tube, balance_defect
    use beamstops, only: ik, scene_type, array_recorder, run_summary, law_none, law_signorini, law_compliance, &
       & validate_scene, record_count, stop_count, status_complete, model_type, build_model, prepare_run, simulate
    use beamstops_band, only: cholesky_factor, cholesky_solve, band_to_dense
@@ -49,23 +49,6 @@ contains
    end subroutine collect_reduced
 
    ! ---------------------------------------------------------------- helpers
-
-   !> The tube of input/tube_supports.nml (supports at 1/3, 2/3, stops at the tip), J = 30.
-   function tube_scene(t_end) result(scene)
-      real(wp), intent(in) :: t_end
-      type(scene_type) :: scene
-      scene%law = law_signorini
-      scene%beta = 0.25_wp
-      scene%elements = 30
-      scene%dt = 2e-5_wp
-      scene%t_end = t_end
-      scene%length = 1.5_wp
-      scene%amplitude = 0.002_wp
-      scene%omega = 40.0_wp
-      scene%stop_nodes = [10, 20, 30]
-      scene%stop_lower = [-0.002_wp, -0.002_wp, -0.004_wp]
-      scene%stop_upper = [0.002_wp, 0.002_wp, 0.004_wp]
-   end function tube_scene
 
    !> Validate, prepare and run a reduced scene (scene%modes > 0), every record kept.
    subroutine run_reduced_recorded(scene, rec, summary, error)
@@ -201,7 +184,7 @@ contains
    subroutine test_full_supports(error)
       type(error_type), allocatable, intent(out) :: error
       type(scene_type) :: scene
-      scene = tube_scene(0.2_wp)
+      scene = tube(0.2_wp)
       scene%stop_nodes = [10, 20]
       scene%stop_lower = [-0.002_wp, -0.002_wp]
       scene%stop_upper = [0.002_wp, 0.002_wp]
@@ -222,7 +205,7 @@ contains
 
    subroutine test_full_span(error)
       type(error_type), allocatable, intent(out) :: error
-      call compare_full(tube_scene(0.2_wp), 0.05_wp, 1e-10_wp, 1e-6_wp, error)
+      call compare_full(tube(0.2_wp), 0.05_wp, 1e-10_wp, 1e-6_wp, error)
    end subroutine test_full_span
 
    !> Rayleigh-Ritz: the k-th eigenvalue of (S_r, M_r) is at least the full one, does not grow
@@ -244,7 +227,7 @@ contains
       real(wp), parameter :: rel = 1e-10_wp
       character(len=:), allocatable :: line
       scenes(1)%dt = 1e-5_wp
-      scenes(2) = tube_scene(0.1_wp)
+      scenes(2) = tube(0.1_wp)
       do s = 1, 2
          call build_model(scenes(s), model, error)
          if (allocated(error)) return
@@ -309,7 +292,7 @@ contains
       real(wp) :: diff, worst
       worst = 0
       scenes(1)%dt = 1e-5_wp
-      scenes(2) = tube_scene(0.1_wp)
+      scenes(2) = tube(0.1_wp)
       do s = 1, 2
          call build_model(scenes(s), model, error)
          if (allocated(error)) return
@@ -350,7 +333,7 @@ contains
       type(reduced_model_type) :: reduced
       real(wp), allocatable :: mm(:, :), ss(:, :), mr(:, :), sr(:, :), tmt(:, :), tst(:, :)
       integer :: j
-      scene = tube_scene(0.1_wp)
+      scene = tube(0.1_wp)
       scene%modes = 12
       call build_model(scene, model, error)
       if (allocated(error)) return
@@ -449,7 +432,7 @@ contains
       integer(ik) :: j, contacts
       integer :: i
       real(wp) :: u, react, tol, worst, escale
-      scene = tube_scene(0.3_wp)
+      scene = tube(0.3_wp)
       scene%modes = 8
       call run_reduced_recorded(scene, rec, summary, error)
       if (allocated(error)) return
@@ -472,18 +455,14 @@ contains
          end do
       end do
       escale = maxval(abs(rec%rows(col_energy, :rec%filled)))
-      worst = 0
-      do j = 1, rec%filled
-         worst = max(worst, abs((rec%rows(col_energy, j) - rec%rows(col_energy, 1)) &
-            & - (rec%rows(col_work, j) - rec%rows(col_dissipated, j))))
-      end do
+      worst = balance_defect(rec)
       call note('stop-steps with a reaction '//int_text(contacts)//', impacts '//int_text(summary%impacts)// &
          & ', energy taken '//real_text(rec%rows(col_dissipated, rec%filled))//' J, balance defect / max |E| '// &
-         & real_text(worst/escale))
+         & real_text(worst))
       call check(error, contacts > 50, 'the stops act'); if (allocated(error)) return
       call check(error, summary%max_violation, 0.0_wp, 'max_violation', thr=0.0_wp); if (allocated(error)) return
       call check(error, rec%rows(col_dissipated, rec%filled) > 0, 'the stops took energy'); if (allocated(error)) return
-      call check(error, worst/escale, 0.0_wp, 'balance defect', thr=1e-10_wp)
+      call check(error, worst, 0.0_wp, 'balance defect', thr=1e-10_wp)
    end subroutine test_span_kkt
 
    !> Law none, r = 5 and r = 30, beta = 1/4 and 1/2, 1 s: max |(E_n - E_0) - W_n| / max |E|.
@@ -495,7 +474,6 @@ contains
       real(wp), parameter :: betas(2) = [0.25_wp, 0.5_wp]
       integer, parameter :: rs(2) = [5, 30]
       integer :: i, k
-      integer(ik) :: j
       real(wp) :: worst, escale
       do k = 1, 2
          do i = 1, 2
@@ -508,15 +486,12 @@ contains
             call run_reduced_recorded(scene, rec, summary, error)
             if (allocated(error)) return
             escale = maxval(abs(rec%rows(col_energy, :rec%filled)))
-            worst = 0
-            do j = 1, rec%filled
-               worst = max(worst, abs((rec%rows(col_energy, j) - rec%rows(col_energy, 1)) - rec%rows(col_work, j)))
-            end do
+            worst = balance_defect(rec)
             call note('beta = '//real_text(betas(k))//', r = '//int_text(rs(i))//': balance defect / max |E| '// &
-               & real_text(worst/escale))
+               & real_text(worst))
             call check(error, rec%rows(col_dissipated, rec%filled), 0.0_wp, 'no energy taken', thr=0.0_wp)
             if (allocated(error)) return
-            call check(error, worst/escale, 0.0_wp, 'balance defect', thr=1e-12_wp)
+            call check(error, worst, 0.0_wp, 'balance defect', thr=1e-12_wp)
             if (allocated(error)) return
          end do
       end do
@@ -534,7 +509,7 @@ contains
       real(wp), allocatable :: mm(:, :), ss(:, :), phi(:, :), gram(:, :), res(:, :)
       real(wp) :: worst_lambda, worst_gram, worst_res, diff
       integer :: s, k, r
-      scenes(1) = tube_scene(0.1_wp)
+      scenes(1) = tube(0.1_wp)
       scenes(2)%dt = 1e-5_wp
       scenes(2)%t_end = 0.1_wp
       do s = 1, 2
@@ -625,7 +600,7 @@ contains
       integer(ik) :: j, k
       integer :: i, pass
       real(wp) :: diff
-      scene = tube_scene(0.1_wp)
+      scene = tube(0.1_wp)
       scene%snapshot_every = 500
       call validate_scene(scene, 'test scene', error)
       if (allocated(error)) return
