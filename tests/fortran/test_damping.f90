@@ -3,7 +3,7 @@
 module test_damping
    use testing
    use test_support, only: run_recorded, same_columns, band_eigenvalues, balance_defect
-   use physics_support, only: tube_scene, open_run, modes, peaks
+   use physics_support, only: tube_scene, open_run, modes, tip_decrement
    use beamstops, only: ik, scene_type, model_type, build_model, state_type, array_recorder, run_summary, &
       & law_none, law_signorini, steps_of
    use beamstops_scheme, only: advance
@@ -52,8 +52,7 @@ contains
       type(model_type) :: model
       type(state_type) :: state
       type(array_recorder) :: rec
-      real(wp), allocatable :: kappa(:), v(:, :), tp(:), yp(:)
-      integer :: k
+      real(wp), allocatable :: kappa(:), v(:, :)
       decrement = 0
       scene = quiet_scene(8, dt, 1.2_wp)
       scene%damping_by_ratio = .true.
@@ -65,13 +64,7 @@ contains
       call open_run(scene, model, state, rec, error, u0=0.01_wp*v(:, 1)/v(model%tip, 1), v0=0*v(:, 1))
       if (allocated(error)) return
       call advance(scene, model, state, rec, steps_of(scene))
-      call peaks(rec%rows(col_t, 1:rec%filled), rec%rows(col_u, 1:rec%filled), tp, yp)
-      k = size(yp)
-      if (k < 3) then
-         call test_failed(error, 'fewer than 3 peaks')
-         return
-      end if
-      decrement = log(yp(1)/yp(k))/(k - 1)
+      call tip_decrement(rec, decrement, error)
    end subroutine decay
 
    subroutine test_decrement(error)

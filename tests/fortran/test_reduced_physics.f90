@@ -11,7 +11,7 @@ module test_reduced_physics
    use test_support, only: int_text, run_recorded, band_eigenvalues, tube, balance_defect
    use beamstops_model, only: model_type, build_model
    use test_reduced, only: run_reduced_recorded, compare_full
-   use physics_support, only: peaks
+   use physics_support, only: tip_decrement
    use beamstops, only: ik, scene_type, array_recorder, run_summary, law_none, law_signorini, law_compliance, validate_scene, &
       & steps_of, scene_from_text, record_count, stop_count, status_complete
    use beamstops_forcing, only: load_average
@@ -126,9 +126,9 @@ contains
       type(reduced_model_type) :: reduced
       type(array_recorder) :: rec
       type(run_summary) :: summary
-      real(wp), allocatable :: mr(:, :), sr(:, :), w(:), work(:), tp(:), yp(:)
+      real(wp), allocatable :: mr(:, :), sr(:, :), w(:), work(:)
       real(wp) :: omega, zeta
-      integer :: s, info, k
+      integer :: s, info
       decrement = 0
       expected = 0
       scene%elements = 8
@@ -160,13 +160,7 @@ contains
       call rec%reserve(steps_of(scene) + 1, 0_ik, scene%elements + 1)
       call simulate_reduced(scene, reduced, rec, summary, error)
       if (allocated(error)) return
-      call peaks(rec%rows(col_t, 1:rec%filled), rec%rows(col_u, 1:rec%filled), tp, yp)
-      k = size(yp)
-      if (k < 3) then
-         call test_failed(error, 'fewer than 3 peaks')
-         return
-      end if
-      decrement = log(yp(1)/yp(k))/(k - 1)
+      call tip_decrement(rec, decrement, error)
    end subroutine decay
 
    subroutine test_decrement(error)
