@@ -32,7 +32,7 @@ module test_lockstep
    public :: members_of, compare_group, expect_refusal, compare_run_members, check_failing_member, &
       & same_bits, same_summary, same_records
    ! and of the suite lockstep_span (stops along the span)
-   public :: compare_members, reserve, run_alone
+   public :: compare_members
 
    !> Columns of a record, for messages.
    character(len=10), parameter :: column_names(n_columns) = [character(len=10) :: 't', 'u', 'v', 'reaction', &
@@ -428,18 +428,24 @@ contains
          & error)
    end subroutine test_failing_member
 
-   !> test_failing_member on three given members (t_end 0.25 s at dt = 1e-5 s).
-   subroutine check_failing_member(scenes, error)
+   !> test_failing_member on three given members: member 2's 3000 records fill up within the
+   !> loop's second block (as with t_end 0.25 s at dt = 1e-5 s); `stops`: as reserve.
+   subroutine check_failing_member(scenes, error, stops)
       type(scene_type), intent(in) :: scenes(3)
       type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: stops
       type(array_recorder) :: group(3), alone
       type(run_summary) :: summaries(3), summary
       type(model_type) :: model
       integer :: k
+      do k = 1, 3
+         call validate_scene(scenes(k), 'member '//int_text(k), error)
+         if (allocated(error)) return
+      end do
       call prepare_lockstep(scenes, 'test group', model, error)
       if (allocated(error)) return
       do k = 1, 3
-         call reserve(group(k), scenes(k))
+         call reserve(group(k), scenes(k), stops)
       end do
       deallocate (group(2)%rows)
       allocate (group(2)%rows(n_columns, 3000))
@@ -450,7 +456,7 @@ contains
          & int_text(summaries(2)%steps)//' steps')
       if (allocated(error)) return
       do k = 1, 3, 2
-         call run_alone(scenes(k), alone, summary, error)
+         call run_alone(scenes(k), alone, summary, error, stops)
          if (allocated(error)) return
          call check(error, summaries(k)%status == status_complete, 'member '//int_text(k)//' completes')
          if (allocated(error)) return

@@ -9,11 +9,8 @@
 !> member 1's nodes are refused.
 module test_lockstep_span
    use testing
-   use beamstops, only: scene_type, model_type, array_recorder, run_summary, validate_scene, status_complete, &
-      & prepare_lockstep, simulate_lockstep
-   use beamstops_recorder, only: n_columns
-   use test_lockstep, only: same_summary, same_records, expect_refusal, compare_run_members, compare_members, &
-      & reserve, run_alone
+   use beamstops, only: scene_type, model_type, run_summary, validate_scene, prepare_lockstep
+   use test_lockstep, only: expect_refusal, compare_run_members, compare_members, check_failing_member
    use test_support, only: tube
    implicit none
    private
@@ -108,39 +105,9 @@ contains
    subroutine test_failing_member(error)
       type(error_type), allocatable, intent(out) :: error
       type(scene_type), allocatable :: scenes(:)
-      type(array_recorder) :: group(3), alone
-      type(run_summary) :: summaries(3), summary
-      type(model_type) :: model
-      integer :: k
       scenes = tube_members(3, 0.4_wp, 1.0_wp)
       scenes(2)%record_every = 3
-      do k = 1, 3
-         call validate_scene(scenes(k), 'member '//int_text(k), error)
-         if (allocated(error)) return
-      end do
-      call prepare_lockstep(scenes, 'test group', model, error)
-      if (allocated(error)) return
-      do k = 1, 3
-         call reserve(group(k), scenes(k), stops=.true.)
-      end do
-      deallocate (group(2)%rows)
-      allocate (group(2)%rows(n_columns, 3000))
-      call simulate_lockstep(scenes, model, group, summaries, error)
-      if (allocated(error)) return
-      call check(error, summaries(2)%status == 'failed' .and. summaries(2)%steps == 16384, &
-         & 'member 2 failed at the end of its second block: '//summaries(2)%status//' after '// &
-         & int_text(summaries(2)%steps)//' steps')
-      if (allocated(error)) return
-      do k = 1, 3, 2
-         call run_alone(scenes(k), alone, summary, error, stops=.true.)
-         if (allocated(error)) return
-         call check(error, summaries(k)%status == status_complete, 'member '//int_text(k)//' completes')
-         if (allocated(error)) return
-         call same_summary(summaries(k), summary, 'member '//int_text(k), error)
-         if (allocated(error)) return
-         call same_records(group(k), alone, 'member '//int_text(k), error)
-         if (allocated(error)) return
-      end do
+      call check_failing_member(scenes, error, stops=.true.)
    end subroutine test_failing_member
 
    !> An &ensemble of the tube (perturbed u0): run_members runs members 2..6 in the span loop;

@@ -22,7 +22,7 @@ module test_reduced
    private
    public :: collect_reduced
    ! (for the suite reduced_physics)
-   public :: run_reduced_recorded, compare_full
+   public :: run_reduced_recorded, compare_full, free_reduced
 
 contains
 
@@ -49,6 +49,18 @@ contains
    end subroutine collect_reduced
 
    ! ---------------------------------------------------------------- helpers
+
+   !> The paper's beam without stops (law none), dt = 1e-4, 1 s, with beta and r modes.
+   function free_reduced(beta, modes) result(scene)
+      real(wp), intent(in) :: beta
+      integer, intent(in) :: modes
+      type(scene_type) :: scene
+      scene%law = law_none
+      scene%beta = beta
+      scene%dt = 1e-4_wp
+      scene%t_end = 1.0_wp
+      scene%modes = modes
+   end function free_reduced
 
    !> Validate, prepare and run a reduced scene (scene%modes > 0), every record kept.
    subroutine run_reduced_recorded(scene, rec, summary, error)
@@ -477,12 +489,7 @@ contains
       real(wp) :: worst, escale
       do k = 1, 2
          do i = 1, 2
-            scene = scene_type()
-            scene%law = law_none
-            scene%beta = betas(k)
-            scene%dt = 1e-4_wp
-            scene%t_end = 1.0_wp
-            scene%modes = rs(i)
+            scene = free_reduced(betas(k), rs(i))
             call run_reduced_recorded(scene, rec, summary, error)
             if (allocated(error)) return
             escale = maxval(abs(rec%rows(col_energy, :rec%filled)))

@@ -10,7 +10,7 @@ module test_reduced_physics
    use testing
    use test_support, only: int_text, run_recorded, band_eigenvalues, tube, balance_defect
    use beamstops_model, only: model_type, build_model
-   use test_reduced, only: run_reduced_recorded, compare_full
+   use test_reduced, only: run_reduced_recorded, compare_full, free_reduced
    use physics_support, only: tip_decrement
    use beamstops, only: ik, scene_type, array_recorder, run_summary, law_none, law_signorini, law_compliance, validate_scene, &
       & steps_of, scene_from_text, record_count, stop_count, status_complete
@@ -196,12 +196,7 @@ contains
       real(wp) :: worst, escale
       do k = 1, 2
          do i = 1, 2
-            scene = scene_type()
-            scene%law = law_none
-            scene%beta = betas(k)
-            scene%dt = 1e-4_wp
-            scene%t_end = 1.0_wp
-            scene%modes = rs(i)
+            scene = free_reduced(betas(k), rs(i))
             scene%damping_mass = 3.0_wp
             scene%damping_stiffness = 2.0e-5_wp
             call run_reduced_recorded(scene, rec, summary, error)
@@ -730,12 +725,7 @@ contains
       do l = 1, 2
          do k = 1, 2
             do i = 1, 2
-               scene = scene_type()
-               scene%law = law_none
-               scene%beta = betas(k)
-               scene%dt = 1e-4_wp
-               scene%t_end = 1.0_wp
-               scene%modes = rs(i)
+               scene = free_reduced(betas(k), rs(i))
                scene%redistributed_mass = .true.
                scene%damping_mass = dampings(l)
                call run_reduced_recorded(scene, rec, summary, error)
