@@ -22,7 +22,7 @@ module test_reduced
    private
    public :: collect_reduced
    ! (for the suite reduced_physics)
-   public :: run_reduced_recorded, compare_full, free_reduced
+   public :: run_reduced_recorded, compare_full, free_reduced, tip_step_residual
 
 contains
 
@@ -381,7 +381,7 @@ contains
       type(reduced_state_type) :: state
       type(array_recorder) :: rec
       real(wp), allocatable :: mr(:, :), sr(:, :), ar(:, :), q_old(:), d_old(:), rho(:)
-      real(wp) :: weight, scale, worst_rows, tip, reaction, tol_u
+      real(wp) :: scale, worst_rows, tip, reaction, tol_u
       integer(ik) :: step, done, steps, contacts
       integer :: pt, r
       scene%law = law_signorini
@@ -406,14 +406,7 @@ contains
          q_old = state%q
          d_old = state%d
          call advance_reduced(scene, reduced, state, rec, step, done)
-         weight = scene%beta*load_average(step + 1, scene%dt, scene%omega, .true.) &
-            & + (1 - 2*scene%beta)*load_average(step, scene%dt, scene%omega, .true.) &
-            & + scene%beta*load_average(step - 1, scene%dt, scene%omega, .true.)
-         rho = matmul(ar, state%d - d_old) - scene%dt**2*(weight*reduced%load - matmul(sr, q_old))
-         ! The size of the terms whose round-off the residual carries, row by row.
-         ! (q: the tip set exactly onto a stop changes d there by the round-off of q.)
-         scale = maxval(matmul(abs(ar), abs(state%d) + abs(d_old) + abs(state%q)) + scene%dt**2*(matmul(abs(sr), abs(q_old)) &
-            & + abs(weight*reduced%load)))
+         call tip_step_residual(scene, reduced, ar, sr, step, q_old, d_old, state, rho, scale)
          worst_rows = max(worst_rows, maxval(abs(rho(:pt - 1)))/scale)
          tip = state%q(pt)
          reaction = rho(pt)/scene%dt**2
@@ -433,6 +426,31 @@ contains
       call check(error, contacts > 10, 'the tip meets the stops'); if (allocated(error)) return
       call check(error, worst_rows, 0.0_wp, 'residual of the rows off the tip', thr=1e-14_wp)
    end subroutine test_kkt_steps
+
+   !> The residual rho = A_r (d^n - d^{n-1}) - dt^2 (G^n l_r - S_r q^n) of the step `step` of a
+   !> reduced run with stops at the tip (from q_old, d_old to the state's q, d), and the size of the
+   !> terms whose round-off it carries (q: the tip set exactly onto a stop changes d there by the
+   !> round-off of q).
+   subroutine tip_step_residual(scene, reduced, ar, sr, step, q_old, d_old, state, rho, scale)
+      type(scene_type), intent(in) :: scene
+      type(reduced_model_type), intent(in) :: reduced
+      !> A_r = M_r + dt^2 beta S_r, and S_r.
+      real(wp), intent(in) :: ar(:, :), sr(:, :)
+      integer(ik), intent(in) :: step
+      !> q^n and d^{n-1} before the step.
+      real(wp), intent(in) :: q_old(:), d_old(:)
+      !> The state after the step.
+      type(reduced_state_type), intent(in) :: state
+      real(wp), allocatable, intent(out) :: rho(:)
+      real(wp), intent(out) :: scale
+      real(wp) :: weight
+      weight = scene%beta*load_average(step + 1, scene%dt, scene%omega, .true.) &
+         & + (1 - 2*scene%beta)*load_average(step, scene%dt, scene%omega, .true.) &
+         & + scene%beta*load_average(step - 1, scene%dt, scene%omega, .true.)
+      rho = matmul(ar, state%d - d_old) - scene%dt**2*(weight*reduced%load - matmul(sr, q_old))
+      scale = maxval(matmul(abs(ar), abs(state%d) + abs(d_old) + abs(state%q)) + scene%dt**2*(matmul(abs(sr), abs(q_old)) &
+         & + abs(weight*reduced%load)))
+   end subroutine tip_step_residual
 
    !> The tube with r = 8: in the records, each stop within its bounds and a reaction only on a
    !> bound; the energy the stops take grows, the balance E - E0 = W - D closes.

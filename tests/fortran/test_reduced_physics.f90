@@ -10,7 +10,7 @@ module test_reduced_physics
    use testing
    use test_support, only: int_text, run_recorded, band_eigenvalues, tube, balance_defect
    use beamstops_model, only: model_type, build_model
-   use test_reduced, only: run_reduced_recorded, compare_full, free_reduced
+   use test_reduced, only: run_reduced_recorded, compare_full, free_reduced, tip_step_residual
    use physics_support, only: tip_decrement
    use beamstops, only: ik, scene_type, array_recorder, run_summary, law_none, law_signorini, law_compliance, validate_scene, &
       & steps_of, scene_from_text, record_count, stop_count, status_complete
@@ -236,7 +236,7 @@ contains
       type(reduced_state_type) :: state
       type(array_recorder) :: rec
       real(wp), allocatable :: mr(:, :), sr(:, :), ar(:, :), q_old(:), d_old(:), rho(:)
-      real(wp) :: weight, scale, worst_rows, w, reaction, tol_u
+      real(wp) :: scale, worst_rows, w, reaction, tol_u
       integer(ik) :: step, done, steps, contacts
       integer :: pt
       scene%law = law_signorini
@@ -263,12 +263,7 @@ contains
          q_old = state%q
          d_old = state%d
          call advance_reduced(scene, reduced, state, rec, step, done)
-         weight = scene%beta*load_average(step + 1, scene%dt, scene%omega, .true.) &
-            & + (1 - 2*scene%beta)*load_average(step, scene%dt, scene%omega, .true.) &
-            & + scene%beta*load_average(step - 1, scene%dt, scene%omega, .true.)
-         rho = matmul(ar, state%d - d_old) - scene%dt**2*(weight*reduced%load - matmul(sr, q_old))
-         scale = maxval(matmul(abs(ar), abs(state%d) + abs(d_old) + abs(state%q)) + scene%dt**2*(matmul(abs(sr), &
-            & abs(q_old)) + abs(weight*reduced%load)))
+         call tip_step_residual(scene, reduced, ar, sr, step, q_old, d_old, state, rho, scale)
          worst_rows = max(worst_rows, maxval(abs(rho(:pt - 1)))/scale)
          w = (state%q(pt) + e*(q_old(pt) - d_old(pt)))/(1 + e)
          reaction = rho(pt)/scene%dt**2
