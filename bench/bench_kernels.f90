@@ -31,6 +31,7 @@ program bench_kernels
    use beamstops_scheme, only: state_type, start_state, advance
    use beamstops_clock, only: thread_cpu_seconds
    use bench_null_recorder, only: null_recorder
+   use bench_support, only: runtime_one, median, put, argument, int_argument, fail
    implicit none
 
    character(len=64) :: what
@@ -240,14 +241,6 @@ contains
       scene%output_file = 'unused.h5'
    end subroutine paper_scene
 
-   !> 1, but not known to the compiler.
-   function runtime_one() result(one)
-      real(wp) :: one
-      character(len=8) :: text
-      call get_environment_variable('BEAMSTOPS_BENCH_NEVER_SET', text)
-      one = merge(2.0_wp, 1.0_wp, text == 'two')
-   end function runtime_one
-
    !> -fma_throughput, for min_of (the best rate is the least of its negatives).
    function negated_throughput() result(y)
       real(wp) :: y
@@ -270,53 +263,4 @@ contains
          m = min(m, f())
       end do
    end function min_of
-
-   function median(t) result(m)
-      real(wp), intent(in) :: t(:)
-      real(wp) :: m, s(size(t)), v
-      integer :: i, j
-      s = t
-      do i = 2, size(s)
-         v = s(i)
-         j = i - 1
-         do while (j >= 1)
-            if (s(j) <= v) exit
-            s(j + 1) = s(j)
-            j = j - 1
-         end do
-         s(j + 1) = v
-      end do
-      m = 0.5_wp*(s((size(s) + 1)/2) + s(size(s)/2 + 1))
-   end function median
-
-   subroutine put(key, value)
-      character(len=*), intent(in) :: key
-      real(wp), intent(in) :: value
-      print '(a, 1x, es16.9)', key, value
-   end subroutine put
-
-   function argument(i, default) result(text)
-      integer, intent(in) :: i
-      character(len=*), intent(in) :: default
-      character(len=64) :: text
-      text = default
-      if (command_argument_count() >= i) call get_command_argument(i, text)
-   end function argument
-
-   function int_argument(i, default) result(value)
-      integer, intent(in) :: i, default
-      integer :: value, status
-      character(len=64) :: text
-      value = default
-      if (command_argument_count() < i) return
-      call get_command_argument(i, text)
-      read (text, *, iostat=status) value
-      if (status /= 0) call fail('not an integer: '//trim(text))
-   end function int_argument
-
-   subroutine fail(message)
-      character(len=*), intent(in) :: message
-      write (error_unit, '(a)') 'bench_kernels: '//message
-      error stop 1
-   end subroutine fail
 end program bench_kernels

@@ -22,7 +22,6 @@
 !> its operations (20 n multiply-adds per member-step, 760 at J = 19; 30 n when recorded) over
 !> the peak rate of independent multiply-adds, both measured here by tiny kernels.
 program bench_lockstep
-   use, intrinsic :: iso_fortran_env, only: error_unit
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type
    use beamstops_scene, only: scene_type, law_signorini
@@ -32,6 +31,7 @@ program bench_lockstep
    use beamstops_lockstep, only: prepare_lockstep, simulate_lockstep
    use beamstops_clock, only: thread_cpu_seconds
    use bench_null_recorder, only: null_recorder
+   use bench_support, only: runtime_one, median, put, int_argument, fail
    implicit none
 
    integer, parameter :: groups(5) = [1, 2, 4, 8, 16]
@@ -239,53 +239,4 @@ contains
       per_ns = real(count, wp)*width/(1.0e9_wp*(thread_cpu_seconds() - t0))
       if (sum(acc) == 12345) print *, acc(1)
    end function fma_throughput
-
-   !> 1, but not known to the compiler.
-   function runtime_one() result(one)
-      real(wp) :: one
-      character(len=8) :: text
-      call get_environment_variable('BEAMSTOPS_BENCH_NEVER_SET', text)
-      one = merge(2.0_wp, 1.0_wp, text == 'two')
-   end function runtime_one
-
-   function median(t) result(m)
-      real(wp), intent(in) :: t(:)
-      real(wp) :: m, s(size(t)), v
-      integer :: i, j
-      s = t
-      do i = 2, size(s)
-         v = s(i)
-         j = i - 1
-         do while (j >= 1)
-            if (s(j) <= v) exit
-            s(j + 1) = s(j)
-            j = j - 1
-         end do
-         s(j + 1) = v
-      end do
-      m = 0.5_wp*(s((size(s) + 1)/2) + s(size(s)/2 + 1))
-   end function median
-
-   subroutine put(key, value)
-      character(len=*), intent(in) :: key
-      real(wp), intent(in) :: value
-      print '(a, 1x, es16.9)', key, value
-   end subroutine put
-
-   function int_argument(i, default) result(value)
-      integer, intent(in) :: i, default
-      integer :: value, status
-      character(len=64) :: text
-      value = default
-      if (command_argument_count() < i) return
-      call get_command_argument(i, text)
-      read (text, *, iostat=status) value
-      if (status /= 0) call fail('not an integer: '//trim(text))
-   end function int_argument
-
-   subroutine fail(message)
-      character(len=*), intent(in) :: message
-      write (error_unit, '(a)') 'bench_lockstep: '//message
-      error stop 1
-   end subroutine fail
 end program bench_lockstep

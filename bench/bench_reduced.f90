@@ -38,6 +38,7 @@ program bench_reduced
    use beamstops_reduced, only: reduced_model_type, build_reduced, stop_unknowns
    use beamstops_reduced_scheme, only: simulate_reduced
    use bench_null_recorder, only: null_recorder
+   use bench_support, only: argument, int_argument
    use beamstops_clock, only: thread_cpu_seconds
    implicit none
 
@@ -352,27 +353,6 @@ contains
       integer, intent(in) :: value
       write (*, '(a, 1x, i0)') key, value
    end subroutine put_int
-
-   function argument(i, default) result(s)
-      integer, intent(in) :: i
-      character(len=*), intent(in) :: default
-      character(len=64) :: s
-      if (command_argument_count() >= i) then
-         call get_command_argument(i, s)
-      else
-         s = default
-      end if
-   end function argument
-
-   function int_argument(i, default) result(v)
-      integer, intent(in) :: i, default
-      integer :: v
-      character(len=64) :: s
-      v = default
-      if (command_argument_count() < i) return
-      call get_command_argument(i, s)
-      read (s, *) v
-   end function int_argument
 
    function real_argument(i, default) result(v)
       integer, intent(in) :: i

@@ -9,15 +9,15 @@ module beamstops_checkpoint
    use beamstops_attributes, only: attribute_list, kind_real, kind_text
    use beamstops_model, only: model_type
    use beamstops_state, only: state_type
+   use beamstops_loop_scalars, only: n_loop_scalars, loop_scalars_vector, restore_loop_scalars
+   use beamstops_observe_observer, only: observer_type
    use beamstops_files, only: rename_file, remove_file
    use beamstops_recorder_hdf5_vector, only: write_vector, read_vector
    implicit none
    private
    public :: write_checkpoint, read_checkpoint, checkpoint_path, scene_signature, is_checkpoint
    ! (the reduced model's checkpoints, beamstops_reduced_checkpoint, share the file's frame)
-   public :: create_checkpoint, commit_checkpoint, open_checkpoint, close_checkpoint
-
-   integer, parameter :: n_scalars = 16
+   public :: create_checkpoint, commit_checkpoint, open_checkpoint, close_checkpoint, write_observer, read_observer
 
 contains
 
@@ -87,13 +87,12 @@ contains
       integer(ik), intent(in) :: records, snapshots
       !> Set when the file cannot be written.
       type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: observer(:)
       integer(hid_t) :: file
       logical :: ok(6)
       call create_checkpoint(path, file, error)
       if (allocated(error)) return
       call write_vector(file, 'signature', scene_signature(scene), ok(1))
-      call write_vector(file, 'scalars', scalars_of(state, records, snapshots), ok(2))
+      call write_vector(file, 'scalars', loop_scalars_vector(state%loop_scalars_type, records, snapshots), ok(2))
       call write_vector(file, 'u', state%u, ok(3))
       call write_vector(file, 'd', state%d, ok(4))
       call write_vector(file, 'su', state%su, ok(5))
@@ -101,13 +100,45 @@ contains
       if (allocated(state%stop_reaction)) call write_vector(file, 'stop_reaction', state%stop_reaction, ok(6))
       ! The energy the damping took (its other terms are rebuilt from d on resume).
       if (ok(6) .and. allocated(state%cd)) call write_vector(file, 'damped', [state%damped], ok(6))
-      if (ok(6) .and. state%observer%active) then
-         call state%observer%pack(observer)
-         call write_vector(file, 'observer_length', [real(size(observer), wp)], ok(6))
-         if (ok(6)) call write_vector(file, 'observer', observer, ok(6))
-      end if
+      if (ok(6)) call write_observer(file, state%observer, ok(6))
       call commit_checkpoint(path, file, all(ok), error)
    end subroutine write_checkpoint
+
+   !> Write an observer (when active) to a checkpoint: datasets `observer_length` and `observer`.
+   subroutine write_observer(file, observer, ok)
+      !> The checkpoint's temporary file (create_checkpoint).
+      integer(hid_t), intent(in) :: file
+      !> The loop's observer.
+      type(observer_type), intent(in) :: observer
+      !> Whether the writes succeeded (true when inactive).
+      logical, intent(out) :: ok
+      real(wp), allocatable :: values(:)
+      ok = .true.
+      if (.not. observer%active) return
+      call observer%pack(values)
+      call write_vector(file, 'observer_length', [real(size(values), wp)], ok)
+      if (ok) call write_vector(file, 'observer', values, ok)
+   end subroutine write_observer
+
+   !> Read the observer that write_observer wrote (a run with &statistics enabled).
+   subroutine read_observer(file, observer, ok)
+      !> The checkpoint (open_checkpoint).
+      integer(hid_t), intent(in) :: file
+      !> The loop's observer, restored (active).
+      type(observer_type), intent(inout) :: observer
+      !> Whether the reads succeeded and gave an observer.
+      logical, intent(out) :: ok
+      real(wp), allocatable :: values(:)
+      real(wp) :: length(1)
+      type(error_type), allocatable :: failure
+      call read_vector(file, 'observer_length', length, ok)
+      if (.not. ok) return
+      allocate (values(nint(length(1))))
+      call read_vector(file, 'observer', values, ok)
+      if (.not. ok) return
+      call observer%unpack(values, failure)
+      ok = .not. allocated(failure)
+   end subroutine read_observer
 
    !> Create the temporary file of the checkpoint `path` (path.tmp), to be written and then
    !> moved in place by commit_checkpoint.
@@ -205,9 +236,8 @@ contains
       integer(ik), intent(out) :: records, snapshots
       !> Set when the file is unreadable or belongs to another scene.
       type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: signature(:), observer(:)
-      type(error_type), allocatable :: failure
-      real(wp) :: scalars(n_scalars), damped(1)
+      real(wp), allocatable :: signature(:)
+      real(wp) :: scalars(n_loop_scalars), damped(1)
       integer(hid_t) :: file
       integer :: n
       logical :: ok(6)
@@ -230,51 +260,9 @@ contains
          call read_vector(file, 'damped', damped, ok(6))
          state%damped = damped(1)
       end if
-      if (ok(6) .and. scene%statistics) then
-         call read_vector(file, 'observer_length', damped, ok(6))
-         if (ok(6)) then
-            allocate (observer(nint(damped(1))))
-            call read_vector(file, 'observer', observer, ok(6))
-         end if
-         if (ok(6)) then
-            call state%observer%unpack(observer, failure)
-            ok(6) = .not. allocated(failure)
-         end if
-      end if
+      if (ok(6) .and. scene%statistics) call read_observer(file, state%observer, ok(6))
       call close_checkpoint(path, file, all(ok), signature, scene, error)
       if (allocated(error)) return
-      call restore_scalars(scalars, state, records, snapshots)
+      call restore_loop_scalars(scalars, state%loop_scalars_type, records, snapshots)
    end subroutine read_checkpoint
-
-   !> The state's scalars, the record counts included, as one vector (integers are exact in it).
-   pure function scalars_of(state, records, snapshots) result(v)
-      type(state_type), intent(in) :: state
-      integer(ik), intent(in) :: records, snapshots
-      real(wp) :: v(n_scalars)
-      v = [real(state%step, wp), state%sigma_prev, state%sigma_now, state%gd_prev, state%p_prev, state%p_now, &
-         & state%work, state%dissipated, state%energy0, state%reaction, merge(1.0_wp, 0.0_wp, state%in_contact), &
-         & real(state%impacts, wp), state%cpu_seconds, state%max_violation, real(records, wp), real(snapshots, wp)]
-   end function scalars_of
-
-   pure subroutine restore_scalars(v, state, records, snapshots)
-      real(wp), intent(in) :: v(n_scalars)
-      type(state_type), intent(inout) :: state
-      integer(ik), intent(out) :: records, snapshots
-      state%step = nint(v(1), ik)
-      state%sigma_prev = v(2)
-      state%sigma_now = v(3)
-      state%gd_prev = v(4)
-      state%p_prev = v(5)
-      state%p_now = v(6)
-      state%work = v(7)
-      state%dissipated = v(8)
-      state%energy0 = v(9)
-      state%reaction = v(10)
-      state%in_contact = v(11) /= 0
-      state%impacts = nint(v(12), ik)
-      state%cpu_seconds = v(13)
-      state%max_violation = v(14)
-      records = nint(v(15), ik)
-      snapshots = nint(v(16), ik)
-   end subroutine restore_scalars
 end module beamstops_checkpoint

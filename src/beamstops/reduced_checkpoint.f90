@@ -10,7 +10,8 @@ module beamstops_reduced_checkpoint
    use beamstops_error, only: error_type
    use beamstops_scene, only: scene_type, stop_count
    use beamstops_checkpoint, only: scene_signature, create_checkpoint, commit_checkpoint, open_checkpoint, &
-      & close_checkpoint
+      & close_checkpoint, write_observer, read_observer
+   use beamstops_loop_scalars, only: n_loop_scalars, loop_scalars_vector, restore_loop_scalars
    use beamstops_recorder_hdf5_vector, only: write_vector, read_vector
    use beamstops_reduced, only: reduced_model_type
    use beamstops_reduced_scheme, only: reduced_state_type, resume_reduced
@@ -18,7 +19,8 @@ module beamstops_reduced_checkpoint
    private
    public :: write_reduced_checkpoint, read_reduced_checkpoint
 
-   integer, parameter :: n_scalars = 17
+   !> The dataset `scalars`: the loop's (loop_scalars_vector), then the energy the damping took.
+   integer, parameter :: n_scalars = n_loop_scalars + 1
 
 contains
 
@@ -34,22 +36,18 @@ contains
       integer(ik), intent(in) :: records, snapshots
       !> Set when the file cannot be written.
       type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: observer(:)
       integer(hid_t) :: file
       logical :: ok(5)
       call create_checkpoint(path, file, error)
       if (allocated(error)) return
       call write_vector(file, 'signature', scene_signature(scene), ok(1))
-      call write_vector(file, 'scalars', scalars_of(state, records, snapshots), ok(2))
+      call write_vector(file, 'scalars', [loop_scalars_vector(state%loop_scalars_type, records, snapshots), &
+         & state%damped], ok(2))
       call write_vector(file, 'q', state%q, ok(3))
       call write_vector(file, 'd', state%d, ok(4))
       ok(5) = .true.
       if (allocated(state%stop_reaction)) call write_vector(file, 'stop_reaction', state%stop_reaction, ok(5))
-      if (ok(5) .and. state%observer%active) then
-         call state%observer%pack(observer)
-         call write_vector(file, 'observer_length', [real(size(observer), wp)], ok(5))
-         if (ok(5)) call write_vector(file, 'observer', observer, ok(5))
-      end if
+      if (ok(5)) call write_observer(file, state%observer, ok(5))
       call commit_checkpoint(path, file, all(ok), error)
    end subroutine write_reduced_checkpoint
 
@@ -68,9 +66,8 @@ contains
       integer(ik), intent(out) :: records, snapshots
       !> Set when the file is unreadable or belongs to another scene.
       type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: signature(:), observer(:)
-      type(error_type), allocatable :: failure
-      real(wp) :: scalars(n_scalars), length(1)
+      real(wp), allocatable :: signature(:)
+      real(wp) :: scalars(n_scalars)
       integer(hid_t) :: file
       logical :: ok(5)
       records = 0
@@ -86,54 +83,11 @@ contains
       call read_vector(file, 'd', state%d, ok(4))
       ok(5) = .true.
       if (allocated(state%stop_reaction)) call read_vector(file, 'stop_reaction', state%stop_reaction, ok(5))
-      if (ok(5) .and. scene%statistics) then
-         call read_vector(file, 'observer_length', length, ok(5))
-         if (ok(5)) then
-            allocate (observer(nint(length(1))))
-            call read_vector(file, 'observer', observer, ok(5))
-         end if
-         if (ok(5)) then
-            call state%observer%unpack(observer, failure)
-            ok(5) = .not. allocated(failure)
-         end if
-      end if
+      if (ok(5) .and. scene%statistics) call read_observer(file, state%observer, ok(5))
       call close_checkpoint(path, file, all(ok), signature, scene, error)
       if (allocated(error)) return
-      call restore_scalars(scalars, state, records, snapshots)
+      call restore_loop_scalars(scalars(:n_loop_scalars), state%loop_scalars_type, records, snapshots)
+      state%damped = scalars(n_scalars)
       call resume_reduced(reduced, state, error)
    end subroutine read_reduced_checkpoint
-
-   !> The state's scalars, the record counts included, as one vector (integers are exact in it).
-   pure function scalars_of(state, records, snapshots) result(v)
-      type(reduced_state_type), intent(in) :: state
-      integer(ik), intent(in) :: records, snapshots
-      real(wp) :: v(n_scalars)
-      v = [real(state%step, wp), state%sigma_prev, state%sigma_now, state%gd_prev, state%p_prev, state%p_now, &
-         & state%work, state%dissipated, state%energy0, state%reaction, merge(1.0_wp, 0.0_wp, state%in_contact), &
-         & real(state%impacts, wp), state%cpu_seconds, state%max_violation, real(records, wp), real(snapshots, wp), &
-         & state%damped]
-   end function scalars_of
-
-   pure subroutine restore_scalars(v, state, records, snapshots)
-      real(wp), intent(in) :: v(n_scalars)
-      type(reduced_state_type), intent(inout) :: state
-      integer(ik), intent(out) :: records, snapshots
-      state%step = nint(v(1), ik)
-      state%sigma_prev = v(2)
-      state%sigma_now = v(3)
-      state%gd_prev = v(4)
-      state%p_prev = v(5)
-      state%p_now = v(6)
-      state%work = v(7)
-      state%dissipated = v(8)
-      state%energy0 = v(9)
-      state%reaction = v(10)
-      state%in_contact = v(11) /= 0
-      state%impacts = nint(v(12), ik)
-      state%cpu_seconds = v(13)
-      state%max_violation = v(14)
-      records = nint(v(15), ik)
-      snapshots = nint(v(16), ik)
-      state%damped = v(17)
-   end subroutine restore_scalars
 end module beamstops_reduced_checkpoint

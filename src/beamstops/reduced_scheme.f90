@@ -20,6 +20,7 @@ module beamstops_reduced_scheme
    use beamstops_reduced, only: reduced_model_type, block_solver_type, block_solve, reduced_stiffness_product, &
       & reduced_mass_product, reduced_damping_product
    use beamstops_clock, only: thread_cpu_seconds
+   use beamstops_loop_scalars, only: loop_scalars_type
    use beamstops_ledger, only: first_events
    use beamstops_forcing, only: load_average, support_position, load_rotation, start_loads, next_load
    use beamstops_contact_tip_projection, only: project_tip
@@ -44,10 +45,8 @@ module beamstops_reduced_scheme
    !> Steps between progress reports and divergence checks.
    integer(ik), parameter :: reduced_block_steps = 8192_ik
 
-   !> Everything the reduced loop carries from step n to step n + 1.
-   type :: reduced_state_type
-      !> Index n of the next step (the step that computes q^{n+1}).
-      integer(ik) :: step = 1
+   !> Everything the reduced loop carries from step n to step n + 1 (its scalars: the parent type's).
+   type, extends(loop_scalars_type) :: reduced_state_type
       !> q^n and d^{n-1} = q^n - q^{n-1} (r + m).
       real(wp), allocatable :: q(:), d(:)
       !> S_r q^n, and the right-hand side / increment of a step (r + m).
@@ -60,33 +59,12 @@ module beamstops_reduced_scheme
       integer :: n_active = 0
       !> Snapshot buffer: physical displacement at the nodes x_0..x_J (J + 1).
       real(wp), allocatable :: shape(:)
-      !> Load averages sigma_{n-1}, sigma_n.
-      real(wp) :: sigma_prev = 0, sigma_now = 0
-      !> l_r . d^{n-1}.
-      real(wp) :: gd_prev = 0
-      !> Spring forces p(u^{n-1}), p(u^n) at the tip (compliance).
-      real(wp) :: p_prev = 0, p_now = 0
-      !> Work of the load, energy taken by the stops and by the damping so far, per unit mass.
-      real(wp) :: work = 0, dissipated = 0, damped = 0
-      !> With damping: C_r d^{n-1} (r + m; unallocated without damping) and d^{n-1}.C_r d^{n-1}.
+      !> With damping: C_r d^{n-1} (r + m; unallocated without damping).
       real(wp), allocatable :: cd(:)
-      real(wp) :: dcd_prev = 0
-      !> E^{1/2} per unit mass (reference of the divergence check).
-      real(wp) :: energy0 = 0
-      !> Reaction per unit mass at the tip of the step that gave q^n.
-      real(wp) :: reaction = 0
-      !> The same for each stop along the span (m; unallocated without them).
+      !> Reaction per unit mass of each stop along the span (m; unallocated without them).
       real(wp), allocatable :: stop_reaction(:)
       !> Stops along the span: the program on C_r and its work arrays.
       type(span_work_type) :: span
-      !> Whether the previous step was in contact.
-      logical :: in_contact = .false.
-      !> Impacts so far.
-      integer(ik) :: impacts = 0
-      !> CPU time of the loop so far (s).
-      real(wp) :: cpu_seconds = 0
-      !> Largest violation of the stops so far (m).
-      real(wp) :: max_violation = 0
       !> The shock log and the running statistics (&statistics enabled).
       type(observer_type) :: observer
    end type reduced_state_type

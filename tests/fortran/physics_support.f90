@@ -5,10 +5,11 @@ module physics_support
    use beamstops, only: ik, scene_type, model_type, build_model, state_type, start_state, array_recorder, &
       & steps_of, record_count
    use beamstops_scheme, only: advance
+   use beamstops_recorder, only: col_t, col_u
    use beamstops_lapack, only: dsbgv, dsbgv_message
    implicit none
    private
-   public :: tube_scene, open_run, step_once, modes, peaks
+   public :: tube_scene, open_run, step_once, modes, peaks, tip_decrement
 
 contains
 
@@ -110,4 +111,25 @@ contains
          end if
       end do
    end subroutine peaks
+
+   !> Log decrement of the recorded tip displacement over its peaks: log(y_1/y_k)/(k - 1) for
+   !> the k peaks (peaks); an error with fewer than 3.
+   subroutine tip_decrement(rec, decrement, error)
+      !> The records of a free decay.
+      type(array_recorder), intent(in) :: rec
+      !> Log decrement per period.
+      real(wp), intent(out) :: decrement
+      !> Set with fewer than 3 peaks.
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: tp(:), yp(:)
+      integer :: k
+      decrement = 0
+      call peaks(rec%rows(col_t, 1:rec%filled), rec%rows(col_u, 1:rec%filled), tp, yp)
+      k = size(yp)
+      if (k < 3) then
+         call fatal_error(error, 'fewer than 3 peaks')
+         return
+      end if
+      decrement = log(yp(1)/yp(k))/(k - 1)
+   end subroutine tip_decrement
 end module physics_support

@@ -3,14 +3,16 @@
 module test_support
    use testing, only: int_text   ! public here too, for the suites that take it from this module
    use beamstops, only: wp, ik, error_type, fatal_error, scene_type, validate_scene, model_type, &
-      & prepare_run, simulate, record_count, array_recorder, run_summary, status_complete, stop_count
+      & prepare_run, simulate, record_count, array_recorder, run_summary, status_complete, stop_count, &
+      & law_signorini, law_compliance
    use beamstops_lapack, only: dsbgv, dsygv, dsbgv_message, dsygv_message
-   use beamstops_recorder, only: n_columns
+   use beamstops_recorder, only: n_columns, col_energy, col_work, col_dissipated, col_damped
    implicit none
    private
    public :: band_eigenvalues, dense_eigenvalues, run_recorded, same_columns, int_text
    public :: basis_coefficients, product_integral, poly, exact_element, dense_assembly, lift, lift_prime
    public :: simpson_load, solve_spd
+   public :: base_scene, tube, balance_defect
 
 
 contains
@@ -253,6 +255,58 @@ contains
       if (rec%filled /= record_count(scene)) call fatal_error(error, 'the run recorded '//int_text(rec%filled)// &
          & ' rows, record_count gives '//int_text(record_count(scene)))
    end subroutine run_recorded
+
+   !> The paper's beam on J elements with dt, beta, a contact law and t_end (the stops' stiffness
+   !> 1e8 per unit mass with compliance).
+   function base_scene(elements, dt, beta, law, t_end) result(scene)
+      !> Number of elements J.
+      integer, intent(in) :: elements
+      !> Time step (s), beta, duration (s).
+      real(wp), intent(in) :: dt, beta, t_end
+      !> Contact law (law_none, law_signorini, law_compliance).
+      integer, intent(in) :: law
+      type(scene_type) :: scene
+      scene%elements = elements
+      scene%dt = dt
+      scene%beta = beta
+      scene%law = law
+      scene%t_end = t_end
+      if (law == law_compliance) scene%stiffness_per_mass = 1.0e8_wp
+   end function base_scene
+
+   !> The tube of input/tube_supports.nml (supports at 1/3 and 2/3, stops at the tip; Signorini,
+   !> J = 30, dt = 2e-5, beta = 1/4), to t_end.
+   function tube(t_end) result(scene)
+      !> Duration (s).
+      real(wp), intent(in) :: t_end
+      type(scene_type) :: scene
+      scene%law = law_signorini
+      scene%beta = 0.25_wp
+      scene%elements = 30
+      scene%dt = 2e-5_wp
+      scene%t_end = t_end
+      scene%length = 1.5_wp
+      scene%amplitude = 0.002_wp
+      scene%omega = 40.0_wp
+      scene%stop_nodes = [10, 20, 30]
+      scene%stop_lower = [-0.002_wp, -0.002_wp, -0.004_wp]
+      scene%stop_upper = [0.002_wp, 0.002_wp, 0.004_wp]
+   end function tube
+
+   !> The energy balance's defect over the records, max |(E_n - E_0) - (W_n - D_n - damped_n)|,
+   !> relative to max |E|.
+   function balance_defect(rec) result(defect)
+      !> The records of a run.
+      type(array_recorder), intent(in) :: rec
+      real(wp) :: defect
+      integer(ik) :: j
+      defect = 0
+      do j = 1, rec%filled
+         defect = max(defect, abs((rec%rows(col_energy, j) - rec%rows(col_energy, 1)) - (rec%rows(col_work, j) &
+            & - rec%rows(col_dissipated, j) - rec%rows(col_damped, j))))
+      end do
+      defect = defect/maxval(abs(rec%rows(col_energy, 1:rec%filled)))
+   end function balance_defect
 
    !> Fail with "[what: ]column c differs" at the first record column whose rows differ between
    !> two recorders (each compared as its filled rows).

@@ -2,8 +2,8 @@
 !> with the damping's column, and zero damping equal to the undamped engine.
 module test_damping
    use testing
-   use test_support, only: run_recorded, same_columns, band_eigenvalues
-   use physics_support, only: tube_scene, open_run, modes, peaks
+   use test_support, only: run_recorded, same_columns, band_eigenvalues, balance_defect
+   use physics_support, only: tube_scene, open_run, modes, tip_decrement
    use beamstops, only: ik, scene_type, model_type, build_model, state_type, array_recorder, run_summary, &
       & law_none, law_signorini, steps_of
    use beamstops_scheme, only: advance
@@ -52,8 +52,7 @@ contains
       type(model_type) :: model
       type(state_type) :: state
       type(array_recorder) :: rec
-      real(wp), allocatable :: kappa(:), v(:, :), tp(:), yp(:)
-      integer :: k
+      real(wp), allocatable :: kappa(:), v(:, :)
       decrement = 0
       scene = quiet_scene(8, dt, 1.2_wp)
       scene%damping_by_ratio = .true.
@@ -65,13 +64,7 @@ contains
       call open_run(scene, model, state, rec, error, u0=0.01_wp*v(:, 1)/v(model%tip, 1), v0=0*v(:, 1))
       if (allocated(error)) return
       call advance(scene, model, state, rec, steps_of(scene))
-      call peaks(rec%rows(col_t, 1:rec%filled), rec%rows(col_u, 1:rec%filled), tp, yp)
-      k = size(yp)
-      if (k < 3) then
-         call test_failed(error, 'fewer than 3 peaks')
-         return
-      end if
-      decrement = log(yp(1)/yp(k))/(k - 1)
+      call tip_decrement(rec, decrement, error)
    end subroutine decay
 
    subroutine test_decrement(error)
@@ -128,19 +121,6 @@ contains
       end do
    end subroutine test_ratio_form
 
-   !> max |(E_n - E_0) - (W_n - D_n - damped_n)| / max |E| over the records.
-   function defect(rec) result(worst)
-      type(array_recorder), intent(in) :: rec
-      real(wp) :: worst
-      integer(ik) :: j
-      worst = 0
-      do j = 1, rec%filled
-         worst = max(worst, abs((rec%rows(col_energy, j) - rec%rows(col_energy, 1)) - (rec%rows(col_work, j) &
-            & - rec%rows(col_dissipated, j) - rec%rows(col_damped, j))))
-      end do
-      worst = worst/maxval(abs(rec%rows(col_energy, 1:rec%filled)))
-   end function defect
-
    subroutine test_balance(error)
       type(error_type), allocatable, intent(out) :: error
       type(scene_type) :: scene
@@ -156,9 +136,9 @@ contains
       scene%damping_stiffness = 1.0e-4_wp
       call run_recorded(scene, fused, summary, error)
       if (allocated(error)) return
-      call note('fused: defect '//real_text(defect(fused))//', damped '// &
+      call note('fused: defect '//real_text(balance_defect(fused))//', damped '// &
          & real_text(fused%rows(col_damped, fused%filled))//' J, work '//real_text(fused%rows(col_work, fused%filled))//' J')
-      call check(error, defect(fused) < 1.0e-12_wp, 'fused path: balance within 1e-12 of max |E|')
+      call check(error, balance_defect(fused) < 1.0e-12_wp, 'fused path: balance within 1e-12 of max |E|')
       if (allocated(error)) return
       call check(error, fused%rows(col_damped, fused%filled) > 0, 'the damping takes energy')
       if (allocated(error)) return
@@ -174,7 +154,7 @@ contains
       if (allocated(error)) return
       state%lapack_solve = .true.
       call advance(scene, model, state, reference, steps_of(scene))
-      call check(error, defect(reference) < 1.0e-12_wp, 'reference path: balance within 1e-12 of max |E|')
+      call check(error, balance_defect(reference) < 1.0e-12_wp, 'reference path: balance within 1e-12 of max |E|')
       if (allocated(error)) return
       gap = maxval(abs(fused%rows(col_u, 1:fused%filled) - reference%rows(col_u, 1:reference%filled)))
       call note('fused vs reference, tip: '//real_text(gap)//' m')
@@ -214,12 +194,12 @@ contains
       scene%damping_ratio = [0.02_wp, 0.0_wp]
       call run_recorded(scene, rec, summary, error)
       if (allocated(error)) return
-      call note('tube, zeta = 0.02: defect '//real_text(defect(rec))//', damped '// &
+      call note('tube, zeta = 0.02: defect '//real_text(balance_defect(rec))//', damped '// &
          & real_text(rec%rows(col_damped, rec%filled))//' J, stops '//real_text(rec%rows(col_dissipated, rec%filled))// &
          & ' J, '//int_text(summary%impacts)//' contact phases')
       call check(error, summary%impacts > 0, 'the stops act')
       if (allocated(error)) return
-      call check(error, defect(rec) < 1.0e-10_wp, 'balance within 1e-10 of max |E|')
+      call check(error, balance_defect(rec) < 1.0e-10_wp, 'balance within 1e-10 of max |E|')
    end subroutine test_span_balance
 
    subroutine test_resume(error)

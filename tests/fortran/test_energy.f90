@@ -2,7 +2,7 @@
 !> energy taken by the stops, nondecreasing for the Signorini scheme.
 module test_energy
    use testing
-   use test_support, only: run_recorded
+   use test_support, only: run_recorded, base_scene
    use beamstops, only: ik, scene_type, array_recorder, run_summary, law_none, law_signorini, law_compliance
    use beamstops_recorder, only: col_t, col_energy, col_work, col_dissipated
    implicit none
@@ -30,19 +30,6 @@ contains
    ! evaluated afresh at each record (it does not accumulate). S has entries ~ k2/h^3, so the
    ! round-off grows like J^3: 5e-14 (J = 4), 4e-13 (J = 8), 2e-12 (J = 12) and 1.2e-11 (J = 19)
    ! of max |E| measured on the free run. Hence 1e-12 at J = 8 and 1e-10 at J = 19.
-
-   !> A scene of the suite.
-   function energy_scene(law, beta, dt, t_end, elements) result(scene)
-      integer, intent(in) :: law, elements
-      real(wp), intent(in) :: beta, dt, t_end
-      type(scene_type) :: scene
-      scene%law = law
-      scene%beta = beta
-      scene%dt = dt
-      scene%t_end = t_end
-      scene%elements = elements
-      if (law == law_compliance) scene%stiffness_per_mass = 1e8_wp
-   end function energy_scene
 
    !> max over the records of |(E_n - E_0) - (W_n - D_n)| / max |E| must be <= thr.
    subroutine check_balance(rec, what, thr, error)
@@ -98,19 +85,19 @@ contains
       real(wp), intent(in) :: beta, dt, t_end
       character(len=*), intent(in) :: what
       type(error_type), allocatable, intent(out) :: error
-      call balance_case(energy_scene(law, beta, dt, t_end, 8), what//', J = 8', 1e-12_wp, error)
+      call balance_case(base_scene(8, dt, beta, law, t_end), what//', J = 8', 1e-12_wp, error)
       if (allocated(error)) return
-      call balance_case(energy_scene(law, beta, dt, t_end, 19), what//', J = 19', 1e-10_wp, error)
+      call balance_case(base_scene(19, dt, beta, law, t_end), what//', J = 19', 1e-10_wp, error)
    end subroutine balance_on_both_meshes
 
    subroutine test_free_8(error)
       type(error_type), allocatable, intent(out) :: error
-      call balance_case(energy_scene(law_none, 0.25_wp, 5e-5_wp, 2.0_wp, 8), 'law none, J = 8', 1e-12_wp, error)
+      call balance_case(base_scene(8, 5e-5_wp, 0.25_wp, law_none, 2.0_wp), 'law none, J = 8', 1e-12_wp, error)
    end subroutine test_free_8
 
    subroutine test_free_19(error)
       type(error_type), allocatable, intent(out) :: error
-      call balance_case(energy_scene(law_none, 0.25_wp, 5e-5_wp, 2.0_wp, 19), 'law none, J = 19', 1e-10_wp, error)
+      call balance_case(base_scene(19, 5e-5_wp, 0.25_wp, law_none, 2.0_wp), 'law none, J = 19', 1e-10_wp, error)
    end subroutine test_free_19
 
    subroutine test_signorini_dissipation(error)
@@ -119,7 +106,7 @@ contains
       type(run_summary) :: summary
       real(wp) :: increment, smallest
       integer(ik) :: j
-      call run_recorded(energy_scene(law_signorini, 0.5_wp, 5e-5_wp, 2.0_wp, 19), rec, summary, error)
+      call run_recorded(base_scene(19, 5e-5_wp, 0.5_wp, law_signorini, 2.0_wp), rec, summary, error)
       if (allocated(error)) return
       call check(error, summary%impacts > 0, 'impacts > 0'); if (allocated(error)) return
       smallest = huge(1.0_wp)

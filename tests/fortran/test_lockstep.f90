@@ -24,12 +24,15 @@ module test_lockstep
       & lockstep_forward, lockstep_forward_energy, lockstep_back, lockstep_dot, lockstep_update, lockstep_back_edge, &
       & lockstep_back_update
    use beamstops_contact_tip_contact, only: update
+   use test_support, only: base_scene
    implicit none
    private
    public :: collect_lockstep
    ! the helpers of the suite lockstep_general (damping, restitution, mass redistribution)
-   public :: base_scene, members_of, compare_group, expect_refusal, compare_run_members, check_failing_member, &
+   public :: members_of, compare_group, expect_refusal, compare_run_members, check_failing_member, &
       & same_bits, same_summary, same_records
+   ! and of the suite lockstep_span (stops along the span)
+   public :: compare_members
 
    !> Columns of a record, for messages.
    character(len=10), parameter :: column_names(n_columns) = [character(len=10) :: 't', 'u', 'v', 'reaction', &
@@ -59,19 +62,6 @@ contains
          & new_unittest('members that do not share A are refused', test_refused) &
          & ]
    end subroutine collect_lockstep
-
-   !> The paper's scene on J elements, dt, beta, a law, t_end.
-   function base_scene(elements, dt, beta, law, t_end) result(scene)
-      integer, intent(in) :: elements, law
-      real(wp), intent(in) :: dt, beta, t_end
-      type(scene_type) :: scene
-      scene%elements = elements
-      scene%dt = dt
-      scene%beta = beta
-      scene%law = law
-      scene%t_end = t_end
-      if (law == law_compliance) scene%stiffness_per_mass = 1.0e8_wp
-   end function base_scene
 
    !> K members of a base scene, member k varied by k: omega, amplitude, stops, cadences; the
    !> load rule and the start of some members switched when `vary_rules`.
@@ -106,9 +96,26 @@ contains
       type(scene_type), intent(in) :: scenes(:)
       type(error_type), allocatable, intent(out) :: error
       logical, intent(in), optional :: contact
+      type(run_summary) :: summaries(size(scenes))
+      call compare_members(scenes, summaries, error)
+      if (allocated(error)) return
+      if (present(contact)) then
+         if (contact) call check(error, sum(summaries%impacts) > 0, 'some member hit a stop (impacts: '// &
+            & int_text(sum(summaries%impacts))//')')
+      end if
+   end subroutine compare_group
+
+   !> Run the members in lockstep and each alone; compare them to the bit: status, summary,
+   !> records, snapshots and, with `stops`, the records of the stops along the span.
+   subroutine compare_members(scenes, summaries, error, stops)
+      type(scene_type), intent(in) :: scenes(:)
+      !> The lockstep run's summaries.
+      type(run_summary), intent(out) :: summaries(:)
+      type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: stops
       type(array_recorder), allocatable :: group(:)
       type(array_recorder) :: alone
-      type(run_summary) :: summaries(size(scenes)), summary
+      type(run_summary) :: summary
       type(model_type) :: model
       integer :: k, nk
       character(len=:), allocatable :: who
@@ -122,13 +129,13 @@ contains
       if (allocated(error)) return
       allocate (group(nk))
       do k = 1, nk
-         call reserve(group(k), scenes(k))
+         call reserve(group(k), scenes(k), stops)
       end do
       call simulate_lockstep(scenes, model, group, summaries, error)
       if (allocated(error)) return
       do k = 1, nk
          who = 'member '//int_text(k)//' of '//int_text(nk)
-         call run_alone(scenes(k), alone, summary, error)
+         call run_alone(scenes(k), alone, summary, error, stops)
          if (allocated(error)) return
          call check(error, summaries(k)%status == status_complete .and. summary%status == status_complete, &
             & who//': both runs complete ('//summaries(k)%status//', '//summary%status//')')
@@ -137,30 +144,49 @@ contains
          if (allocated(error)) return
          call same_records(group(k), alone, who, error)
          if (allocated(error)) return
+         if (.not. with_stops(stops)) cycle
+         call check(error, group(k)%stops_filled == alone%stops_filled .and. alone%stops_filled == alone%filled, &
+            & who//': '//int_text(group(k)%stops_filled)//' and '//int_text(alone%stops_filled)//' records of the stops')
+         if (allocated(error)) return
+         call check(error, all(same_bits(group(k)%stops_u, alone%stops_u)) .and. &
+            & all(same_bits(group(k)%stops_reaction, alone%stops_reaction)), who//': the stops'' records')
+         if (allocated(error)) return
       end do
-      if (present(contact)) then
-         if (contact) call check(error, sum(summaries%impacts) > 0, 'some member hit a stop (impacts: '// &
-            & int_text(sum(summaries%impacts))//')')
-      end if
-   end subroutine compare_group
+   end subroutine compare_members
 
-   !> Room for every record and snapshot of a scene.
-   subroutine reserve(rec, scene)
+   !> Whether the optional `stops` is present and true.
+   pure function with_stops(stops) result(yes)
+      logical, intent(in), optional :: stops
+      logical :: yes
+      yes = .false.
+      if (present(stops)) yes = stops
+   end function with_stops
+
+   !> Room for every record and snapshot of a scene (with `stops`, for the records of its stops
+   !> along the span too).
+   subroutine reserve(rec, scene, stops)
       type(array_recorder), intent(inout) :: rec
       type(scene_type), intent(in) :: scene
-      call rec%reserve(record_count(scene), snapshot_count(scene), scene%elements + 1)
+      logical, intent(in), optional :: stops
+      if (with_stops(stops)) then
+         call rec%reserve(record_count(scene), snapshot_count(scene), scene%elements + 1, size(scene%stop_nodes))
+      else
+         call rec%reserve(record_count(scene), snapshot_count(scene), scene%elements + 1)
+      end if
    end subroutine reserve
 
-   !> The scene run alone: prepare_run and simulate (the one-scene fused path).
-   subroutine run_alone(scene, rec, summary, error)
+   !> The scene run alone: prepare_run and simulate (the one-scene fused path; advance_span with
+   !> stops along the span), every record kept (`stops`: as reserve).
+   subroutine run_alone(scene, rec, summary, error, stops)
       type(scene_type), intent(in) :: scene
       type(array_recorder), intent(out) :: rec
       type(run_summary), intent(out) :: summary
       type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: stops
       type(model_type) :: model
       call prepare_run(scene, 'test scene', model, error)
       if (allocated(error)) return
-      call reserve(rec, scene)
+      call reserve(rec, scene, stops)
       call simulate(scene, model, rec, summary, error)
    end subroutine run_alone
 
@@ -402,18 +428,24 @@ contains
          & error)
    end subroutine test_failing_member
 
-   !> test_failing_member on three given members (t_end 0.25 s at dt = 1e-5 s).
-   subroutine check_failing_member(scenes, error)
+   !> test_failing_member on three given members: member 2's 3000 records fill up within the
+   !> loop's second block (as with t_end 0.25 s at dt = 1e-5 s); `stops`: as reserve.
+   subroutine check_failing_member(scenes, error, stops)
       type(scene_type), intent(in) :: scenes(3)
       type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: stops
       type(array_recorder) :: group(3), alone
       type(run_summary) :: summaries(3), summary
       type(model_type) :: model
       integer :: k
+      do k = 1, 3
+         call validate_scene(scenes(k), 'member '//int_text(k), error)
+         if (allocated(error)) return
+      end do
       call prepare_lockstep(scenes, 'test group', model, error)
       if (allocated(error)) return
       do k = 1, 3
-         call reserve(group(k), scenes(k))
+         call reserve(group(k), scenes(k), stops)
       end do
       deallocate (group(2)%rows)
       allocate (group(2)%rows(n_columns, 3000))
@@ -424,7 +456,7 @@ contains
          & int_text(summaries(2)%steps)//' steps')
       if (allocated(error)) return
       do k = 1, 3, 2
-         call run_alone(scenes(k), alone, summary, error)
+         call run_alone(scenes(k), alone, summary, error, stops)
          if (allocated(error)) return
          call check(error, summaries(k)%status == status_complete, 'member '//int_text(k)//' completes')
          if (allocated(error)) return

@@ -14,7 +14,8 @@ module test_lockstep_general
    use beamstops_band_solve_lockstep, only: lockstep_lanes
    use beamstops_band_solve_lockstep_general, only: lockstep_row
    use beamstops_model, only: build_model
-   use test_lockstep, only: base_scene, members_of, compare_group, expect_refusal, compare_run_members, &
+   use test_support, only: base_scene
+   use test_lockstep, only: members_of, compare_group, expect_refusal, compare_run_members, &
       & check_failing_member, same_bits
    implicit none
    private

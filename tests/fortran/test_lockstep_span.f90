@@ -9,10 +9,9 @@
 !> member 1's nodes are refused.
 module test_lockstep_span
    use testing
-   use beamstops, only: ik, scene_type, model_type, array_recorder, run_summary, validate_scene, prepare_run, &
-      & simulate, record_count, snapshot_count, law_signorini, status_complete, prepare_lockstep, simulate_lockstep
-   use beamstops_recorder, only: n_columns
-   use test_lockstep, only: same_bits, same_summary, same_records, expect_refusal, compare_run_members
+   use beamstops, only: scene_type, model_type, run_summary, validate_scene, prepare_lockstep
+   use test_lockstep, only: expect_refusal, compare_run_members, compare_members, check_failing_member
+   use test_support, only: tube
    implicit none
    private
    public :: collect_lockstep_span
@@ -36,23 +35,6 @@ contains
          & new_unittest('members whose stops are not on member 1''s nodes are refused', test_refused_nodes) &
          & ]
    end subroutine collect_lockstep_span
-
-   !> The tube of input/tube_supports.nml (J = 30, dt = 2e-5, beta = 1/4), to t_end.
-   function tube(t_end) result(scene)
-      real(wp), intent(in) :: t_end
-      type(scene_type) :: scene
-      scene%law = law_signorini
-      scene%beta = 0.25_wp
-      scene%elements = 30
-      scene%dt = 2e-5_wp
-      scene%t_end = t_end
-      scene%length = 1.5_wp
-      scene%amplitude = 0.002_wp
-      scene%omega = 40.0_wp
-      scene%stop_nodes = [10, 20, 30]
-      scene%stop_lower = [-0.002_wp, -0.002_wp, -0.004_wp]
-      scene%stop_upper = [0.002_wp, 0.002_wp, 0.004_wp]
-   end function tube
 
    !> K members of the tube, member k varied by k: omega, amplitude, the gaps (times `gap`),
    !> the record and snapshot cadences.
@@ -123,39 +105,9 @@ contains
    subroutine test_failing_member(error)
       type(error_type), allocatable, intent(out) :: error
       type(scene_type), allocatable :: scenes(:)
-      type(array_recorder) :: group(3), alone
-      type(run_summary) :: summaries(3), summary
-      type(model_type) :: model
-      integer :: k
       scenes = tube_members(3, 0.4_wp, 1.0_wp)
       scenes(2)%record_every = 3
-      do k = 1, 3
-         call validate_scene(scenes(k), 'member '//int_text(k), error)
-         if (allocated(error)) return
-      end do
-      call prepare_lockstep(scenes, 'test group', model, error)
-      if (allocated(error)) return
-      do k = 1, 3
-         call reserve(group(k), scenes(k))
-      end do
-      deallocate (group(2)%rows)
-      allocate (group(2)%rows(n_columns, 3000))
-      call simulate_lockstep(scenes, model, group, summaries, error)
-      if (allocated(error)) return
-      call check(error, summaries(2)%status == 'failed' .and. summaries(2)%steps == 16384, &
-         & 'member 2 failed at the end of its second block: '//summaries(2)%status//' after '// &
-         & int_text(summaries(2)%steps)//' steps')
-      if (allocated(error)) return
-      do k = 1, 3, 2
-         call run_alone(scenes(k), alone, summary, error)
-         if (allocated(error)) return
-         call check(error, summaries(k)%status == status_complete, 'member '//int_text(k)//' completes')
-         if (allocated(error)) return
-         call same_summary(summaries(k), summary, 'member '//int_text(k), error)
-         if (allocated(error)) return
-         call same_records(group(k), alone, 'member '//int_text(k), error)
-         if (allocated(error)) return
-      end do
+      call check_failing_member(scenes, error, stops=.true.)
    end subroutine test_failing_member
 
    !> An &ensemble of the tube (perturbed u0): run_members runs members 2..6 in the span loop;
@@ -199,49 +151,14 @@ contains
    end subroutine test_refused_nodes
 
    !> Run the members in lockstep and each alone (the stops' records kept); compare them to the
-   !> bit. With `contact`, some member must have hit a stop; without, none.
+   !> bit. With `contact`, every member must have hit a stop; without, none.
    subroutine compare_span_group(scenes, error, contact)
-      type(scene_type), intent(inout) :: scenes(:)
+      type(scene_type), intent(in) :: scenes(:)
       type(error_type), allocatable, intent(out) :: error
       logical, intent(in) :: contact
-      type(array_recorder), allocatable :: group(:)
-      type(array_recorder) :: alone
-      type(run_summary) :: summaries(size(scenes)), summary
-      type(model_type) :: model
-      integer :: k, nk
-      character(len=:), allocatable :: who
-
-      nk = size(scenes)
-      do k = 1, nk
-         call validate_scene(scenes(k), 'member '//int_text(k), error)
-         if (allocated(error)) return
-      end do
-      call prepare_lockstep(scenes, 'test group', model, error)
+      type(run_summary) :: summaries(size(scenes))
+      call compare_members(scenes, summaries, error, stops=.true.)
       if (allocated(error)) return
-      allocate (group(nk))
-      do k = 1, nk
-         call reserve(group(k), scenes(k))
-      end do
-      call simulate_lockstep(scenes, model, group, summaries, error)
-      if (allocated(error)) return
-      do k = 1, nk
-         who = 'member '//int_text(k)//' of '//int_text(nk)
-         call run_alone(scenes(k), alone, summary, error)
-         if (allocated(error)) return
-         call check(error, summaries(k)%status == status_complete .and. summary%status == status_complete, &
-            & who//': both runs complete ('//summaries(k)%status//', '//summary%status//')')
-         if (allocated(error)) return
-         call same_summary(summaries(k), summary, who, error)
-         if (allocated(error)) return
-         call same_records(group(k), alone, who, error)
-         if (allocated(error)) return
-         call check(error, group(k)%stops_filled == alone%stops_filled .and. alone%stops_filled == alone%filled, &
-            & who//': '//int_text(group(k)%stops_filled)//' and '//int_text(alone%stops_filled)//' records of the stops')
-         if (allocated(error)) return
-         call check(error, all(same_bits(group(k)%stops_u, alone%stops_u)) .and. &
-            & all(same_bits(group(k)%stops_reaction, alone%stops_reaction)), who//': the stops'' records')
-         if (allocated(error)) return
-      end do
       if (contact) then
          call check(error, all(summaries%impacts > 0), 'every member hit a stop (impacts: '// &
             & int_text(sum(summaries%impacts))//' in all)')
@@ -250,24 +167,4 @@ contains
             & 'no member reached a stop (impacts: '//int_text(sum(summaries%impacts))//')')
       end if
    end subroutine compare_span_group
-
-   !> Room for every record and snapshot of a scene and for the records of its stops.
-   subroutine reserve(rec, scene)
-      type(array_recorder), intent(inout) :: rec
-      type(scene_type), intent(in) :: scene
-      call rec%reserve(record_count(scene), snapshot_count(scene), scene%elements + 1, size(scene%stop_nodes))
-   end subroutine reserve
-
-   !> The scene run alone: prepare_run and simulate (the one-scene path, advance_span).
-   subroutine run_alone(scene, rec, summary, error)
-      type(scene_type), intent(in) :: scene
-      type(array_recorder), intent(out) :: rec
-      type(run_summary), intent(out) :: summary
-      type(error_type), allocatable, intent(out) :: error
-      type(model_type) :: model
-      call prepare_run(scene, 'test scene', model, error)
-      if (allocated(error)) return
-      call reserve(rec, scene)
-      call simulate(scene, model, rec, summary, error)
-   end subroutine run_alone
 end module test_lockstep_span

@@ -8,7 +8,7 @@
 !> to round-off without contact; and the checks of &mesh modes.
 module test_reduced
    use testing
-   use test_support, only: run_recorded, band_eigenvalues, dense_eigenvalues, solve_spd, int_text
+   use test_support, only: run_recorded, band_eigenvalues, dense_eigenvalues, solve_spd, int_text, tube, balance_defect
    use beamstops, only: ik, scene_type, array_recorder, run_summary, law_none, law_signorini, law_compliance, &
       & validate_scene, record_count, stop_count, status_complete, model_type, build_model, prepare_run, simulate
    use beamstops_band, only: cholesky_factor, cholesky_solve, band_to_dense
@@ -22,7 +22,7 @@ module test_reduced
    private
    public :: collect_reduced
    ! (for the suite reduced_physics)
-   public :: run_reduced_recorded, compare_full
+   public :: run_reduced_recorded, compare_full, free_reduced, tip_step_residual
 
 contains
 
@@ -50,22 +50,17 @@ contains
 
    ! ---------------------------------------------------------------- helpers
 
-   !> The tube of input/tube_supports.nml (supports at 1/3, 2/3, stops at the tip), J = 30.
-   function tube_scene(t_end) result(scene)
-      real(wp), intent(in) :: t_end
+   !> The paper's beam without stops (law none), dt = 1e-4, 1 s, with beta and r modes.
+   function free_reduced(beta, modes) result(scene)
+      real(wp), intent(in) :: beta
+      integer, intent(in) :: modes
       type(scene_type) :: scene
-      scene%law = law_signorini
-      scene%beta = 0.25_wp
-      scene%elements = 30
-      scene%dt = 2e-5_wp
-      scene%t_end = t_end
-      scene%length = 1.5_wp
-      scene%amplitude = 0.002_wp
-      scene%omega = 40.0_wp
-      scene%stop_nodes = [10, 20, 30]
-      scene%stop_lower = [-0.002_wp, -0.002_wp, -0.004_wp]
-      scene%stop_upper = [0.002_wp, 0.002_wp, 0.004_wp]
-   end function tube_scene
+      scene%law = law_none
+      scene%beta = beta
+      scene%dt = 1e-4_wp
+      scene%t_end = 1.0_wp
+      scene%modes = modes
+   end function free_reduced
 
    !> Validate, prepare and run a reduced scene (scene%modes > 0), every record kept.
    subroutine run_reduced_recorded(scene, rec, summary, error)
@@ -201,7 +196,7 @@ contains
    subroutine test_full_supports(error)
       type(error_type), allocatable, intent(out) :: error
       type(scene_type) :: scene
-      scene = tube_scene(0.2_wp)
+      scene = tube(0.2_wp)
       scene%stop_nodes = [10, 20]
       scene%stop_lower = [-0.002_wp, -0.002_wp]
       scene%stop_upper = [0.002_wp, 0.002_wp]
@@ -222,7 +217,7 @@ contains
 
    subroutine test_full_span(error)
       type(error_type), allocatable, intent(out) :: error
-      call compare_full(tube_scene(0.2_wp), 0.05_wp, 1e-10_wp, 1e-6_wp, error)
+      call compare_full(tube(0.2_wp), 0.05_wp, 1e-10_wp, 1e-6_wp, error)
    end subroutine test_full_span
 
    !> Rayleigh-Ritz: the k-th eigenvalue of (S_r, M_r) is at least the full one, does not grow
@@ -244,7 +239,7 @@ contains
       real(wp), parameter :: rel = 1e-10_wp
       character(len=:), allocatable :: line
       scenes(1)%dt = 1e-5_wp
-      scenes(2) = tube_scene(0.1_wp)
+      scenes(2) = tube(0.1_wp)
       do s = 1, 2
          call build_model(scenes(s), model, error)
          if (allocated(error)) return
@@ -309,7 +304,7 @@ contains
       real(wp) :: diff, worst
       worst = 0
       scenes(1)%dt = 1e-5_wp
-      scenes(2) = tube_scene(0.1_wp)
+      scenes(2) = tube(0.1_wp)
       do s = 1, 2
          call build_model(scenes(s), model, error)
          if (allocated(error)) return
@@ -350,7 +345,7 @@ contains
       type(reduced_model_type) :: reduced
       real(wp), allocatable :: mm(:, :), ss(:, :), mr(:, :), sr(:, :), tmt(:, :), tst(:, :)
       integer :: j
-      scene = tube_scene(0.1_wp)
+      scene = tube(0.1_wp)
       scene%modes = 12
       call build_model(scene, model, error)
       if (allocated(error)) return
@@ -386,7 +381,7 @@ contains
       type(reduced_state_type) :: state
       type(array_recorder) :: rec
       real(wp), allocatable :: mr(:, :), sr(:, :), ar(:, :), q_old(:), d_old(:), rho(:)
-      real(wp) :: weight, scale, worst_rows, tip, reaction, tol_u
+      real(wp) :: scale, worst_rows, tip, reaction, tol_u
       integer(ik) :: step, done, steps, contacts
       integer :: pt, r
       scene%law = law_signorini
@@ -411,14 +406,7 @@ contains
          q_old = state%q
          d_old = state%d
          call advance_reduced(scene, reduced, state, rec, step, done)
-         weight = scene%beta*load_average(step + 1, scene%dt, scene%omega, .true.) &
-            & + (1 - 2*scene%beta)*load_average(step, scene%dt, scene%omega, .true.) &
-            & + scene%beta*load_average(step - 1, scene%dt, scene%omega, .true.)
-         rho = matmul(ar, state%d - d_old) - scene%dt**2*(weight*reduced%load - matmul(sr, q_old))
-         ! The size of the terms whose round-off the residual carries, row by row.
-         ! (q: the tip set exactly onto a stop changes d there by the round-off of q.)
-         scale = maxval(matmul(abs(ar), abs(state%d) + abs(d_old) + abs(state%q)) + scene%dt**2*(matmul(abs(sr), abs(q_old)) &
-            & + abs(weight*reduced%load)))
+         call tip_step_residual(scene, reduced, ar, sr, step, q_old, d_old, state, rho, scale)
          worst_rows = max(worst_rows, maxval(abs(rho(:pt - 1)))/scale)
          tip = state%q(pt)
          reaction = rho(pt)/scene%dt**2
@@ -439,6 +427,31 @@ contains
       call check(error, worst_rows, 0.0_wp, 'residual of the rows off the tip', thr=1e-14_wp)
    end subroutine test_kkt_steps
 
+   !> The residual rho = A_r (d^n - d^{n-1}) - dt^2 (G^n l_r - S_r q^n) of the step `step` of a
+   !> reduced run with stops at the tip (from q_old, d_old to the state's q, d), and the size of the
+   !> terms whose round-off it carries (q: the tip set exactly onto a stop changes d there by the
+   !> round-off of q).
+   subroutine tip_step_residual(scene, reduced, ar, sr, step, q_old, d_old, state, rho, scale)
+      type(scene_type), intent(in) :: scene
+      type(reduced_model_type), intent(in) :: reduced
+      !> A_r = M_r + dt^2 beta S_r, and S_r.
+      real(wp), intent(in) :: ar(:, :), sr(:, :)
+      integer(ik), intent(in) :: step
+      !> q^n and d^{n-1} before the step.
+      real(wp), intent(in) :: q_old(:), d_old(:)
+      !> The state after the step.
+      type(reduced_state_type), intent(in) :: state
+      real(wp), allocatable, intent(out) :: rho(:)
+      real(wp), intent(out) :: scale
+      real(wp) :: weight
+      weight = scene%beta*load_average(step + 1, scene%dt, scene%omega, .true.) &
+         & + (1 - 2*scene%beta)*load_average(step, scene%dt, scene%omega, .true.) &
+         & + scene%beta*load_average(step - 1, scene%dt, scene%omega, .true.)
+      rho = matmul(ar, state%d - d_old) - scene%dt**2*(weight*reduced%load - matmul(sr, q_old))
+      scale = maxval(matmul(abs(ar), abs(state%d) + abs(d_old) + abs(state%q)) + scene%dt**2*(matmul(abs(sr), abs(q_old)) &
+         & + abs(weight*reduced%load)))
+   end subroutine tip_step_residual
+
    !> The tube with r = 8: in the records, each stop within its bounds and a reaction only on a
    !> bound; the energy the stops take grows, the balance E - E0 = W - D closes.
    subroutine test_span_kkt(error)
@@ -449,7 +462,7 @@ contains
       integer(ik) :: j, contacts
       integer :: i
       real(wp) :: u, react, tol, worst, escale
-      scene = tube_scene(0.3_wp)
+      scene = tube(0.3_wp)
       scene%modes = 8
       call run_reduced_recorded(scene, rec, summary, error)
       if (allocated(error)) return
@@ -472,18 +485,14 @@ contains
          end do
       end do
       escale = maxval(abs(rec%rows(col_energy, :rec%filled)))
-      worst = 0
-      do j = 1, rec%filled
-         worst = max(worst, abs((rec%rows(col_energy, j) - rec%rows(col_energy, 1)) &
-            & - (rec%rows(col_work, j) - rec%rows(col_dissipated, j))))
-      end do
+      worst = balance_defect(rec)
       call note('stop-steps with a reaction '//int_text(contacts)//', impacts '//int_text(summary%impacts)// &
          & ', energy taken '//real_text(rec%rows(col_dissipated, rec%filled))//' J, balance defect / max |E| '// &
-         & real_text(worst/escale))
+         & real_text(worst))
       call check(error, contacts > 50, 'the stops act'); if (allocated(error)) return
       call check(error, summary%max_violation, 0.0_wp, 'max_violation', thr=0.0_wp); if (allocated(error)) return
       call check(error, rec%rows(col_dissipated, rec%filled) > 0, 'the stops took energy'); if (allocated(error)) return
-      call check(error, worst/escale, 0.0_wp, 'balance defect', thr=1e-10_wp)
+      call check(error, worst, 0.0_wp, 'balance defect', thr=1e-10_wp)
    end subroutine test_span_kkt
 
    !> Law none, r = 5 and r = 30, beta = 1/4 and 1/2, 1 s: max |(E_n - E_0) - W_n| / max |E|.
@@ -495,28 +504,19 @@ contains
       real(wp), parameter :: betas(2) = [0.25_wp, 0.5_wp]
       integer, parameter :: rs(2) = [5, 30]
       integer :: i, k
-      integer(ik) :: j
       real(wp) :: worst, escale
       do k = 1, 2
          do i = 1, 2
-            scene = scene_type()
-            scene%law = law_none
-            scene%beta = betas(k)
-            scene%dt = 1e-4_wp
-            scene%t_end = 1.0_wp
-            scene%modes = rs(i)
+            scene = free_reduced(betas(k), rs(i))
             call run_reduced_recorded(scene, rec, summary, error)
             if (allocated(error)) return
             escale = maxval(abs(rec%rows(col_energy, :rec%filled)))
-            worst = 0
-            do j = 1, rec%filled
-               worst = max(worst, abs((rec%rows(col_energy, j) - rec%rows(col_energy, 1)) - rec%rows(col_work, j)))
-            end do
+            worst = balance_defect(rec)
             call note('beta = '//real_text(betas(k))//', r = '//int_text(rs(i))//': balance defect / max |E| '// &
-               & real_text(worst/escale))
+               & real_text(worst))
             call check(error, rec%rows(col_dissipated, rec%filled), 0.0_wp, 'no energy taken', thr=0.0_wp)
             if (allocated(error)) return
-            call check(error, worst/escale, 0.0_wp, 'balance defect', thr=1e-12_wp)
+            call check(error, worst, 0.0_wp, 'balance defect', thr=1e-12_wp)
             if (allocated(error)) return
          end do
       end do
@@ -534,7 +534,7 @@ contains
       real(wp), allocatable :: mm(:, :), ss(:, :), phi(:, :), gram(:, :), res(:, :)
       real(wp) :: worst_lambda, worst_gram, worst_res, diff
       integer :: s, k, r
-      scenes(1) = tube_scene(0.1_wp)
+      scenes(1) = tube(0.1_wp)
       scenes(2)%dt = 1e-5_wp
       scenes(2)%t_end = 0.1_wp
       do s = 1, 2
@@ -625,7 +625,7 @@ contains
       integer(ik) :: j, k
       integer :: i, pass
       real(wp) :: diff
-      scene = tube_scene(0.1_wp)
+      scene = tube(0.1_wp)
       scene%snapshot_every = 500
       call validate_scene(scene, 'test scene', error)
       if (allocated(error)) return

@@ -8,10 +8,10 @@
 !> (u^{n+1} + e u^{n-1})/(1 + e) satisfies the KKT conditions every step in reduced coordinates.
 module test_reduced_physics
    use testing
-   use test_support, only: int_text, run_recorded, band_eigenvalues
+   use test_support, only: int_text, run_recorded, band_eigenvalues, tube, balance_defect
    use beamstops_model, only: model_type, build_model
-   use test_reduced, only: run_reduced_recorded, compare_full
-   use physics_support, only: peaks
+   use test_reduced, only: run_reduced_recorded, compare_full, free_reduced, tip_step_residual
+   use physics_support, only: tip_decrement
    use beamstops, only: ik, scene_type, array_recorder, run_summary, law_none, law_signorini, law_compliance, validate_scene, &
       & steps_of, scene_from_text, record_count, stop_count, status_complete
    use beamstops_forcing, only: load_average
@@ -66,23 +66,6 @@ contains
          & new_unittest('&mesh modes with damping, restitution and mass redistribution (tip, span) accepted', test_validate) &
          & ]
    end subroutine collect_reduced_physics
-
-   !> The tube of input/tube_supports.nml (supports at 1/3, 2/3, stops at the tip), J = 30.
-   function tube(t_end) result(scene)
-      real(wp), intent(in) :: t_end
-      type(scene_type) :: scene
-      scene%law = law_signorini
-      scene%beta = 0.25_wp
-      scene%elements = 30
-      scene%dt = 2e-5_wp
-      scene%t_end = t_end
-      scene%length = 1.5_wp
-      scene%amplitude = 0.002_wp
-      scene%omega = 40.0_wp
-      scene%stop_nodes = [10, 20, 30]
-      scene%stop_lower = [-0.002_wp, -0.002_wp, -0.004_wp]
-      scene%stop_upper = [0.002_wp, 0.002_wp, 0.004_wp]
-   end function tube
 
    !> The paper's scene with the tip stops, beta = 1/2, dt = 1e-5, 0.2 s.
    function paper_tip() result(scene)
@@ -143,9 +126,9 @@ contains
       type(reduced_model_type) :: reduced
       type(array_recorder) :: rec
       type(run_summary) :: summary
-      real(wp), allocatable :: mr(:, :), sr(:, :), w(:), work(:), tp(:), yp(:)
+      real(wp), allocatable :: mr(:, :), sr(:, :), w(:), work(:)
       real(wp) :: omega, zeta
-      integer :: s, info, k
+      integer :: s, info
       decrement = 0
       expected = 0
       scene%elements = 8
@@ -177,13 +160,7 @@ contains
       call rec%reserve(steps_of(scene) + 1, 0_ik, scene%elements + 1)
       call simulate_reduced(scene, reduced, rec, summary, error)
       if (allocated(error)) return
-      call peaks(rec%rows(col_t, 1:rec%filled), rec%rows(col_u, 1:rec%filled), tp, yp)
-      k = size(yp)
-      if (k < 3) then
-         call test_failed(error, 'fewer than 3 peaks')
-         return
-      end if
-      decrement = log(yp(1)/yp(k))/(k - 1)
+      call tip_decrement(rec, decrement, error)
    end subroutine decay
 
    subroutine test_decrement(error)
@@ -216,28 +193,18 @@ contains
       real(wp), parameter :: betas(2) = [0.25_wp, 0.5_wp]
       integer, parameter :: rs(2) = [5, 30]
       integer :: i, k
-      integer(ik) :: j
       real(wp) :: worst, escale
       do k = 1, 2
          do i = 1, 2
-            scene = scene_type()
-            scene%law = law_none
-            scene%beta = betas(k)
-            scene%dt = 1e-4_wp
-            scene%t_end = 1.0_wp
-            scene%modes = rs(i)
+            scene = free_reduced(betas(k), rs(i))
             scene%damping_mass = 3.0_wp
             scene%damping_stiffness = 2.0e-5_wp
             call run_reduced_recorded(scene, rec, summary, error)
             if (allocated(error)) return
             escale = maxval(abs(rec%rows(col_energy, :rec%filled)))
-            worst = 0
-            do j = 1, rec%filled
-               worst = max(worst, abs((rec%rows(col_energy, j) - rec%rows(col_energy, 1)) &
-                  & - (rec%rows(col_work, j) - rec%rows(col_damped, j))))
-            end do
+            worst = balance_defect(rec)
             call note('beta = '//real_text(betas(k))//', r = '//int_text(rs(i))//': damped '// &
-               & real_text(summary%damped)//' J, balance defect / max |E| '//real_text(worst/escale)// &
+               & real_text(summary%damped)//' J, balance defect / max |E| '//real_text(worst)// &
                & ', summary residual / max |E| '//real_text(summary%energy_residual/escale))
             call check(error, rec%rows(col_dissipated, rec%filled), 0.0_wp, 'no energy taken by stops', thr=0.0_wp)
             if (allocated(error)) return
@@ -249,7 +216,7 @@ contains
             call check(error, summary%damped, rec%rows(col_damped, rec%filled), 'summary damped = last record', &
                & thr=0.0_wp)
             if (allocated(error)) return
-            call check(error, worst/escale, 0.0_wp, 'balance defect', thr=1e-12_wp)
+            call check(error, worst, 0.0_wp, 'balance defect', thr=1e-12_wp)
             if (allocated(error)) return
             call check(error, summary%energy_residual/escale, 0.0_wp, 'summary residual', thr=1e-12_wp)
             if (allocated(error)) return
@@ -269,7 +236,7 @@ contains
       type(reduced_state_type) :: state
       type(array_recorder) :: rec
       real(wp), allocatable :: mr(:, :), sr(:, :), ar(:, :), q_old(:), d_old(:), rho(:)
-      real(wp) :: weight, scale, worst_rows, w, reaction, tol_u
+      real(wp) :: scale, worst_rows, w, reaction, tol_u
       integer(ik) :: step, done, steps, contacts
       integer :: pt
       scene%law = law_signorini
@@ -296,12 +263,7 @@ contains
          q_old = state%q
          d_old = state%d
          call advance_reduced(scene, reduced, state, rec, step, done)
-         weight = scene%beta*load_average(step + 1, scene%dt, scene%omega, .true.) &
-            & + (1 - 2*scene%beta)*load_average(step, scene%dt, scene%omega, .true.) &
-            & + scene%beta*load_average(step - 1, scene%dt, scene%omega, .true.)
-         rho = matmul(ar, state%d - d_old) - scene%dt**2*(weight*reduced%load - matmul(sr, q_old))
-         scale = maxval(matmul(abs(ar), abs(state%d) + abs(d_old) + abs(state%q)) + scene%dt**2*(matmul(abs(sr), &
-            & abs(q_old)) + abs(weight*reduced%load)))
+         call tip_step_residual(scene, reduced, ar, sr, step, q_old, d_old, state, rho, scale)
          worst_rows = max(worst_rows, maxval(abs(rho(:pt - 1)))/scale)
          w = (state%q(pt) + e*(q_old(pt) - d_old(pt)))/(1 + e)
          reaction = rho(pt)/scene%dt**2
@@ -623,7 +585,6 @@ contains
       real(wp), parameter :: dampings(2) = [0.0_wp, 3.0_wp]
       integer, parameter :: rs(2) = [8, 57]
       integer :: i, l
-      integer(ik) :: j
       real(wp) :: worst, escale
       do l = 1, 2
          do i = 1, 2
@@ -636,16 +597,12 @@ contains
             call run_reduced_recorded(scene, rec, summary, error)
             if (allocated(error)) return
             escale = maxval(abs(rec%rows(col_energy, :rec%filled)))
-            worst = 0
-            do j = 1, rec%filled
-               worst = max(worst, abs((rec%rows(col_energy, j) - rec%rows(col_energy, 1)) &
-                  & - (rec%rows(col_work, j) - rec%rows(col_damped, j) - rec%rows(col_dissipated, j))))
-            end do
+            worst = balance_defect(rec)
             call note('r = '//int_text(rs(i))//', a = '//real_text(dampings(l))//': balance defect / max |E| '// &
-               & real_text(worst/escale)//', summary residual / max |E| '// &
+               & real_text(worst)//', summary residual / max |E| '// &
                & real_text(summary%energy_residual/escale)//', stops'' energy '// &
                & real_text(rec%rows(col_dissipated, rec%filled))//' J')
-            call check(error, worst/escale, 0.0_wp, 'balance defect', thr=1e-10_wp)
+            call check(error, worst, 0.0_wp, 'balance defect', thr=1e-10_wp)
             if (allocated(error)) return
             call check(error, summary%energy_residual/escale, 0.0_wp, 'summary residual', thr=1e-10_wp)
             if (allocated(error)) return
@@ -759,32 +716,22 @@ contains
       real(wp), parameter :: betas(2) = [0.25_wp, 0.5_wp], dampings(2) = [0.0_wp, 3.0_wp]
       integer, parameter :: rs(2) = [5, 37]
       integer :: i, k, l
-      integer(ik) :: j
       real(wp) :: worst, escale
       do l = 1, 2
          do k = 1, 2
             do i = 1, 2
-               scene = scene_type()
-               scene%law = law_none
-               scene%beta = betas(k)
-               scene%dt = 1e-4_wp
-               scene%t_end = 1.0_wp
-               scene%modes = rs(i)
+               scene = free_reduced(betas(k), rs(i))
                scene%redistributed_mass = .true.
                scene%damping_mass = dampings(l)
                call run_reduced_recorded(scene, rec, summary, error)
                if (allocated(error)) return
                escale = maxval(abs(rec%rows(col_energy, :rec%filled)))
-               worst = 0
-               do j = 1, rec%filled
-                  worst = max(worst, abs((rec%rows(col_energy, j) - rec%rows(col_energy, 1)) &
-                     & - (rec%rows(col_work, j) - rec%rows(col_damped, j) - rec%rows(col_dissipated, j))))
-               end do
+               worst = balance_defect(rec)
                call note('beta = '//real_text(betas(k))//', r = '//int_text(rs(i))//', a = '// &
-                  & real_text(dampings(l))//': balance defect / max |E| '//real_text(worst/escale)// &
+                  & real_text(dampings(l))//': balance defect / max |E| '//real_text(worst)// &
                   & ', summary residual / max |E| '//real_text(summary%energy_residual/escale)//', tip''s energy '// &
                   & real_text(rec%rows(col_dissipated, rec%filled))//' J')
-               call check(error, worst/escale, 0.0_wp, 'balance defect', thr=1e-10_wp)
+               call check(error, worst, 0.0_wp, 'balance defect', thr=1e-10_wp)
                if (allocated(error)) return
                call check(error, summary%energy_residual/escale, 0.0_wp, 'summary residual', thr=1e-10_wp)
                if (allocated(error)) return

@@ -9,7 +9,7 @@
 !> warns of.)
 module test_scheme
    use testing
-   use test_support, only: run_recorded, exact_element, dense_assembly, lift, lift_prime, simpson_load, solve_spd
+   use test_support, only: base_scene, run_recorded, exact_element, dense_assembly, lift, lift_prime, simpson_load, solve_spd
    use beamstops, only: ik, scene_type, array_recorder, run_summary, law_none, law_signorini, law_compliance, steps_of
    use beamstops_recorder, only: col_t, col_u, col_v, col_reaction, col_energy
    implicit none
@@ -192,13 +192,8 @@ contains
       real(wp), intent(in) :: beta, dt, t_end
       logical, intent(in) :: centered
       type(scene_type) :: scene
-      scene%elements = 2
-      scene%law = law
-      scene%beta = beta
+      scene = base_scene(2, dt, beta, law, t_end)
       scene%centered_load = centered
-      scene%dt = dt
-      scene%t_end = t_end
-      if (law == law_compliance) scene%stiffness_per_mass = 1e8_wp
    end function scheme_scene
 
    subroutine test_free_centered(error)
