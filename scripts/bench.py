@@ -69,6 +69,12 @@ import scipy
 SCRIPTS = Path(__file__).resolve().parent
 sys.path.insert(0, str(SCRIPTS))
 
+# The engine factors A once; a threaded BLAS under LAPACK (OpenBLAS, where Debian's
+# liblapack.so.3 points to it) would start threads that spin after that call and take CPU time
+# and a core from the measured process. One thread, for every program this script runs.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
 import bench_ext  # noqa: E402
 import bench_lockstep  # noqa: E402
 import reference_scheme  # noqa: E402
@@ -199,7 +205,8 @@ def machine(build: Path, program: Path) -> str:
         opts = {o["name"]: o["value"] for o in json.loads(intro.read_text())}
         options = f"buildtype={opts.get('buildtype')}, native={opts.get('native')}"
     return (f"Machine: {cpu}, {os.cpu_count()} logical CPUs, {platform.system()} {platform.release()}; "
-            f"{fc.splitlines()[0] if fc else 'no gfortran'} ({options}); LAPACK/BLAS: {lapack}; "
+            f"{fc.splitlines()[0] if fc else 'no gfortran'} ({options}); LAPACK/BLAS: {lapack} "
+            f"(OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}); "
             f"Python {platform.python_version()}, numpy {np.__version__}, scipy {scipy.__version__}.")
 
 
