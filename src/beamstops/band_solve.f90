@@ -104,12 +104,7 @@ contains
       real(wp), intent(inout) :: b(n)
       real(wp) :: xa, xb, xc
       integer :: j
-      xa = b(1)
-      xb = b(2) - off(3, 2)*xa
-      xc = b(3) - off(2, 3)*xa - off(3, 3)*xb
-      b(1) = xa*inv_d2(1)
-      b(2) = xb*inv_d2(2)
-      b(3) = xc*inv_d2(3)
+      call first_rows(n, off, inv_d2, b, xa, xb, xc)
       do j = kd + 1, n - 2, 3
          xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
          b(j) = xa*inv_d2(j)
@@ -118,12 +113,7 @@ contains
          xc = row(b(j + 2), off(1, j + 2), off(2, j + 2), off(3, j + 2), xc, xa, xb)
          b(j + 2) = xc*inv_d2(j + 2)
       end do
-      if (j <= n) then
-         xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
-         b(j) = xa*inv_d2(j)
-      end if
-      if (j + 1 <= n) b(j + 1) = row(b(j + 1), off(1, j + 1), off(2, j + 1), off(3, j + 1), xb, xc, xa) &
-         & *inv_d2(j + 1)
+      call last_rows(n, off, inv_d2, j, b, xa, xb, xc)
    end subroutine forward_rows
 
    !> forward_substitution with, in the shadow of its chain, the dot products of the discrete
@@ -159,14 +149,14 @@ contains
             end do
             return
          end if
-         call first_rows(off, inv_d2, b, xa, xb, xc)
+         call first_rows(n, off, inv_d2, b, xa, xb, xc)
          usu = u(1)*su(1) + u(2)*su(2) + u(3)*su(3)
          dsu = d(1)*su(1) + d(2)*su(2) + d(3)*su(3)
          dmd = d(1)*m(1, 0)*d(1) + d(2)*(m(2, 0)*d(2) + 2*m(2, 1)*d(1)) &
             & + d(3)*(m(3, 0)*d(3) + 2*(m(3, 1)*d(2) + m(3, 2)*d(1)))
          j = kd + 1
          call energy_rows(n, off, inv_d2, m, u, d, su, b, j, xa, xb, xc, usu, dsu, dmd)
-         call last_rows(off, inv_d2, j, n, b, xa, xb, xc)
+         call last_rows(n, off, inv_d2, j, b, xa, xb, xc)
          do i = j, n
             usu = usu + u(i)*su(i)
             dsu = dsu + d(i)*su(i)
@@ -233,9 +223,10 @@ contains
 
    !> The first three rows of the forward substitution (n >= 3): b(1:3) replaced by
    !> D^{-2} w(1:3), and w(1:3) returned in xa, xb, xc for the rows that follow.
-   pure subroutine first_rows(off, inv_d2, b, xa, xb, xc)
-      real(wp), intent(in) :: off(:, :), inv_d2(:)
-      real(wp), intent(inout) :: b(:)
+   pure subroutine first_rows(n, off, inv_d2, b, xa, xb, xc)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: off(kd, n), inv_d2(n)
+      real(wp), intent(inout) :: b(n)
       real(wp), intent(out) :: xa, xb, xc
       xa = b(1)
       xb = b(2) - off(3, 2)*xa
@@ -247,10 +238,11 @@ contains
 
    !> The rows j and j+1 (those of them <= n) left after the forward substitution's loop by
    !> three; xa, xb, xc hold w_{j-3}, w_{j-2}, w_{j-1}.
-   pure subroutine last_rows(off, inv_d2, j, n, b, xa, xb, xc)
-      real(wp), intent(in) :: off(:, :), inv_d2(:)
-      integer, intent(in) :: j, n
-      real(wp), intent(inout) :: b(:)
+   pure subroutine last_rows(n, off, inv_d2, j, b, xa, xb, xc)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: off(kd, n), inv_d2(n)
+      integer, intent(in) :: j
+      real(wp), intent(inout) :: b(n)
       real(wp), intent(inout) :: xa, xb, xc
       if (j <= n) then
          xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
