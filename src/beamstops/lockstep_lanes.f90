@@ -12,7 +12,7 @@ module beamstops_lockstep_lanes
    use beamstops_kinds, only: wp, ik
    use beamstops_scene, only: law_none, law_signorini, law_compliance
    use beamstops_forcing, only: load_average
-   use beamstops_contact_compliance, only: spring_force, solve_spring_tip
+   use beamstops_contact_compliance, only: compliance_step
    use beamstops_band_solve_lockstep, only: lockstep_lanes
    implicit none
    private
@@ -148,7 +148,6 @@ contains
       real(wp), intent(in) :: u_tip(lockstep_lanes), d_tip(lockstep_lanes), x_tip(lockstep_lanes)
       !> z_tip, dt^2 and beta.
       real(wp), intent(in) :: z_tip, dt2, beta
-      real(wp) :: p_next
       integer :: i
       lanes%d_tip_prev = d_tip
       lanes%u_tip_prev = u_tip
@@ -165,14 +164,8 @@ contains
          end do
       case (law_compliance)
          do i = 1, lockstep_lanes
-            lanes%tip_value(i) = solve_spring_tip(lanes%trial(i), lanes%lower(i), lanes%upper(i), lanes%stiffness(i), &
-               & dt2*beta*z_tip)
-            p_next = spring_force(lanes%tip_value(i), lanes%lower(i), lanes%upper(i), lanes%stiffness(i))
-            lanes%c(i) = dt2*beta*p_next
-            lanes%r_step(i) = beta*p_next + (1 - 2*beta)*lanes%p_now(i) + beta*lanes%p_prev(i)
-            lanes%p_prev(i) = lanes%p_now(i)
-            lanes%p_now(i) = p_next
-            lanes%contact(i) = lanes%r_step(i) /= 0
+            call compliance_step(lanes%trial(i), lanes%lower(i), lanes%upper(i), lanes%stiffness(i), dt2, beta, z_tip, &
+               & lanes%p_prev(i), lanes%p_now(i), lanes%tip_value(i), lanes%c(i), lanes%r_step(i), lanes%contact(i))
          end do
       case default
          lanes%c = 0

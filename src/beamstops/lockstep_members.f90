@@ -17,7 +17,7 @@ module beamstops_lockstep_members
    use beamstops_band_solve, only: band_solver, band_diagonals
    use beamstops_band_solve_lockstep, only: lockstep_lanes
    use beamstops_forcing, only: load_average, support_position, restart_every
-   use beamstops_contact_compliance, only: spring_force, solve_spring_tip
+   use beamstops_contact_compliance, only: compliance_step
    use beamstops_observe_observer, only: observer_type
    use beamstops_ledger, only: energy, first_events
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
@@ -120,7 +120,7 @@ contains
       type(scene_type), intent(in) :: scenes(:)
       type(model_type), intent(in) :: model
       type(members_type), intent(inout) :: ms
-      real(wp) :: p_next, z_tip
+      real(wp) :: z_tip
       integer :: k, c, lo, hi
       z_tip = model%z(model%tip)
       select case (law)
@@ -133,14 +133,9 @@ contains
          end do
       case (law_compliance)
          do k = 1, ms%k
-            ms%tip_value(k) = solve_spring_tip(ms%trial(k), scenes(k)%lower, scenes(k)%upper, &
-               & scenes(k)%stiffness_per_mass, model%dt2*model%beta*model%z(model%tip))
-            p_next = spring_force(ms%tip_value(k), scenes(k)%lower, scenes(k)%upper, scenes(k)%stiffness_per_mass)
-            ms%c(k) = model%dt2*model%beta*p_next
-            ms%r_step(k) = model%beta*p_next + (1 - 2*model%beta)*ms%p_now(k) + model%beta*ms%p_prev(k)
-            ms%p_prev(k) = ms%p_now(k)
-            ms%p_now(k) = p_next
-            ms%contact(k) = ms%r_step(k) /= 0
+            call compliance_step(ms%trial(k), scenes(k)%lower, scenes(k)%upper, scenes(k)%stiffness_per_mass, &
+               & model%dt2, model%beta, z_tip, ms%p_prev(k), ms%p_now(k), ms%tip_value(k), ms%c(k), ms%r_step(k), &
+               & ms%contact(k))
          end do
       case default
          ms%c = 0

@@ -25,7 +25,7 @@ module beamstops_reduced_scheme
    use beamstops_forcing, only: load_average, support_position, load_rotation, start_loads, next_load
    use beamstops_contact_tip_projection, only: project_tip
    use beamstops_contact_tip_contact, only: violation
-   use beamstops_contact_compliance, only: spring_force, solve_spring_tip
+   use beamstops_contact_compliance, only: spring_force, compliance_step
    use beamstops_contact_span_stops, only: span_work_type, new_span_work, span_contact, span_settle, span_energy, &
       & span_energy_massless
    use beamstops_contact_box_qp, only: qp_solved, qp_message
@@ -1039,7 +1039,7 @@ contains
       real(wp), intent(in) :: trial
       real(wp), intent(out) :: c, tip_value, r_step
       logical, intent(out) :: contact
-      real(wp) :: p_next, z_tip, lower, upper, e, u_old
+      real(wp) :: z_tip, lower, upper, e, u_old
       integer :: pt
       pt = tip_coordinate(reduced)
       z_tip = reduced%z(pt, reduced%tip_stop)
@@ -1065,14 +1065,8 @@ contains
          contact = c /= 0
          r_step = c/reduced%dt2
       case (law_compliance)
-         tip_value = solve_spring_tip(trial, scene%lower, scene%upper, scene%stiffness_per_mass, &
-            & reduced%dt2*reduced%beta*z_tip)
-         p_next = spring_force(tip_value, scene%lower, scene%upper, scene%stiffness_per_mass)
-         c = reduced%dt2*reduced%beta*p_next
-         r_step = reduced%beta*p_next + (1 - 2*reduced%beta)*state%p_now + reduced%beta*state%p_prev
-         state%p_prev = state%p_now
-         state%p_now = p_next
-         contact = r_step /= 0
+         call compliance_step(trial, scene%lower, scene%upper, scene%stiffness_per_mass, reduced%dt2, reduced%beta, &
+            & z_tip, state%p_prev, state%p_now, tip_value, c, r_step, contact)
       case default
          c = 0
          tip_value = trial

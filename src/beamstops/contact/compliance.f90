@@ -5,7 +5,7 @@ module beamstops_contact_compliance
    use beamstops_kinds, only: wp
    implicit none
    private
-   public :: spring_force, solve_spring_tip
+   public :: spring_force, solve_spring_tip, compliance_step
 
 contains
 
@@ -46,4 +46,29 @@ contains
          y = trial
       end if
    end function solve_spring_tip
+
+   !> One step of normal compliance at the tip (SPEC 5), shared by every loop: the tip value of
+   !> the step from its trial value, the multiple c = dt^2 beta p_{n+1} of z, the Newmark-weighted
+   !> reaction of the step, and the spring forces moved on (p_{n-1} <- p_n <- p_{n+1}).
+   pure subroutine compliance_step(trial, lower, upper, stiffness, dt2, beta, z_tip, p_prev, p_now, tip_value, c, &
+      & r_step, contact)
+      !> Trial tip value, stops (m) and stiffness per unit mass (1/s^2).
+      real(wp), intent(in) :: trial, lower, upper, stiffness
+      !> dt^2, beta and z_tip = (A^{-1} e_tip)_tip.
+      real(wp), intent(in) :: dt2, beta, z_tip
+      !> Spring forces p(u^{n-1}), p(u^n) on entry, p(u^n), p(u^{n+1}) on return.
+      real(wp), intent(inout) :: p_prev, p_now
+      !> Tip value of the step, multiple of z and reaction of the step (per unit mass).
+      real(wp), intent(out) :: tip_value, c, r_step
+      !> Whether the spring acts during the step.
+      logical, intent(out) :: contact
+      real(wp) :: p_next
+      tip_value = solve_spring_tip(trial, lower, upper, stiffness, dt2*beta*z_tip)
+      p_next = spring_force(tip_value, lower, upper, stiffness)
+      c = dt2*beta*p_next
+      r_step = beta*p_next + (1 - 2*beta)*p_now + beta*p_prev
+      p_prev = p_now
+      p_now = p_next
+      contact = r_step /= 0
+   end subroutine compliance_step
 end module beamstops_contact_compliance

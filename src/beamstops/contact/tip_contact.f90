@@ -13,7 +13,7 @@ module beamstops_contact_tip_contact
    use beamstops_band_solve, only: dot, diagonal_row
    use beamstops_contact_mass_redistribution, only: massless_reaction
    use beamstops_contact_tip_projection, only: project_tip
-   use beamstops_contact_compliance, only: spring_force, solve_spring_tip
+   use beamstops_contact_compliance, only: compliance_step
    use beamstops_ledger, only: book_step, shift_loads
    implicit none
    private
@@ -74,7 +74,7 @@ contains
       real(wp), intent(out) :: c, tip_value, r_step
       !> Whether the stops act.
       logical, intent(out) :: contact
-      real(wp) :: p_next, e, u_old
+      real(wp) :: e, u_old
       select case (scene%law)
       case (law_signorini)
          if (scene%restitution > 0) then
@@ -90,14 +90,8 @@ contains
          contact = c /= 0
          r_step = c/model%dt2
       case (law_compliance)
-         tip_value = solve_spring_tip(trial, scene%lower, scene%upper, scene%stiffness_per_mass, &
-            & model%dt2*model%beta*model%z(model%tip))
-         p_next = spring_force(tip_value, scene%lower, scene%upper, scene%stiffness_per_mass)
-         c = model%dt2*model%beta*p_next
-         r_step = model%beta*p_next + (1 - 2*model%beta)*state%p_now + model%beta*state%p_prev
-         state%p_prev = state%p_now
-         state%p_now = p_next
-         contact = r_step /= 0
+         call compliance_step(trial, scene%lower, scene%upper, scene%stiffness_per_mass, model%dt2, model%beta, &
+            & model%z(model%tip), state%p_prev, state%p_now, tip_value, c, r_step, contact)
       case default
          c = 0
          tip_value = trial
