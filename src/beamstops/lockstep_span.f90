@@ -14,7 +14,7 @@
 !>   of the massless unknowns by equilibrium_rows, lane by lane), the forward substitution with its
 !>   energy sums on the steps that want them (a member that does not gets 0, as forward_pass gives);
 !> - the whole back substitution (lockstep_back), x handed to the member's state (rhs);
-!> - the rest of advance_span's step on the member's state, the lines of advance_span itself.
+!> - the rest of the step on the member's state: beamstops_span_step's span_step, the routine advance_span calls.
 !> A member's u, d (and C d^{n-1}) go into the lanes at the start of each step and its x comes
 !> back (O(n) copies per member and step beside the O(n) contact work). A member whose QP fails
 !> ends its block there (advance_span's exit) and leaves the group with run_scheme's status; the
@@ -25,26 +25,21 @@ module beamstops_lockstep_span
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type
    use beamstops_strings, only: fmt_int
-   use beamstops_scene, only: scene_type, steps_of, law_signorini
+   use beamstops_scene, only: scene_type, steps_of
    use beamstops_model, only: model_type, build_model
    use beamstops_band, only: band_matvec
-   use beamstops_band_solve, only: diagonal_matvec, diagonal_row, dot
    use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_work_columns, lockstep_matvec_rhs, &
       & lockstep_forward, lockstep_forward_energy, lockstep_back
    use beamstops_band_solve_lockstep_general, only: lockstep_matvec_rhs_damped
-   use beamstops_contact_mass_redistribution, only: equilibrium_rows, massless_reaction
-   use beamstops_contact_tip_contact, only: update
-   use beamstops_contact_span_stops, only: span_contact, span_correction, span_settle, span_energy, &
-      & span_energy_massless
+   use beamstops_contact_mass_redistribution, only: equilibrium_rows
    use beamstops_contact_box_qp, only: qp_solved, qp_message
-   use beamstops_forcing, only: support_position, load_rotation, start_loads, next_load
    use beamstops_state, only: state_type
    use beamstops_scheme, only: start_state, block_steps, close_ledger
    use beamstops_clock, only: thread_cpu_seconds
    use beamstops_lockstep_members, only: operators_type, lane, chunk
-   use beamstops_ledger, only: energy, move_on, damping_loss, fill_row, take_snapshot, first_events
-   use beamstops_recorder, only: recorder_type, n_columns, col_energy
-   use beamstops_summary, only: run_summary, status_complete, status_failed, status_running, status_diverged, &
+   use beamstops_span_step, only: span_loop_type, start_span_block, next_span_step, span_step, end_span_block
+   use beamstops_recorder, only: recorder_type
+   use beamstops_summary, only: run_summary, status_complete, status_failed, status_running, &
       & check_divergence
    implicit none
    private
@@ -57,14 +52,6 @@ module beamstops_lockstep_span
       real(wp), allocatable :: coef(:), spring(:), usu(:), dsu(:), dmd(:)
    end type span_lanes_type
 
-   !> What a member carries from step to step within a block (advance_span's locals).
-   type :: member_loop_type
-      integer(ik) :: next_record = 0, next_snapshot = 0, done = 0
-      logical :: pending = .false., live = .false.
-      real(wp) :: u_old_su = 0, phi_prev = 0, phi_now = 0, phi_next = 0, sigma_next = 0, weight = 0
-      real(wp) :: row(n_columns) = 0
-      type(load_rotation) :: loads
-   end type member_loop_type
 
 contains
 
@@ -220,7 +207,7 @@ contains
       class(recorder_type), intent(inout) :: recorders(:)
       logical, intent(in) :: active(:)
       integer(ik), intent(in) :: last
-      type(member_loop_type) :: loop(size(scenes))
+      type(span_loop_type) :: loop(size(scenes))
       integer(ik) :: step, first
       integer :: k, nk, c, chunks, lo, hi
       logical :: energy_wanted, damped, massless
@@ -232,28 +219,16 @@ contains
       first = huge(1_ik)
       do k = 1, nk
          if (.not. active(k)) cycle
-         associate (state => states(k), lp => loop(k), scene => scenes(k), model => models(k))
-            lp%live = .true.
-            call first_events(scene, state%step, lp%next_record, lp%next_snapshot)
-            lp%pending = .false.
-            lp%u_old_su = 0
-            lp%done = state%step - 1
-            lp%phi_prev = support_position(real(state%step - 1, wp)*model%dt, scene%amplitude, scene%omega)
-            lp%phi_now = support_position(real(state%step, wp)*model%dt, scene%amplitude, scene%omega)
-            call start_loads(lp%loads, state%step + 1, model%dt, scene%omega, scene%centered_load)
-            first = min(first, state%step)
-         end associate
+         call start_span_block(scenes(k), models(k), states(k), loop(k))
+         first = min(first, states(k)%step)
       end do
       do step = first, last
          if (.not. any(loop%live)) exit
          energy_wanted = .false.
          do k = 1, nk
             if (.not. loop(k)%live) cycle
-            associate (state => states(k), lp => loop(k), scene => scenes(k), model => models(k))
-               lp%sigma_next = lp%loads%sigma
-               call next_load(lp%loads)
-               lp%phi_next = support_position(real(step + 1, wp)*model%dt, scene%amplitude, scene%omega)
-               lp%weight = model%beta*lp%sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
+            call next_span_step(scenes(k), models(k), states(k), loop(k), step)
+            associate (state => states(k), lp => loop(k), model => models(k))
                lanes%coef(k) = model%dt2*lp%weight
                lanes%u(lane(k), :, chunk(k)) = state%u
                lanes%d(lane(k), :, chunk(k)) = state%d
@@ -300,129 +275,16 @@ contains
             end if
             ! x back (S u^n is not read again before end_block computes S u^{last+1})
             states(k)%rhs = lanes%rhs(lane(k), :, chunk(k))
-            call member_step(scenes(k), models(k), states(k), loop(k), recorders(k), step, lanes%usu(k), &
+            call span_step(scenes(k), models(k), states(k), loop(k), recorders(k), step, lanes%usu(k), &
                & lanes%dsu(k), lanes%dmd(k))
-            if (.not. loop(k)%live) call end_block(scenes(k), models(k), states(k), loop(k), recorders(k))
+            if (.not. loop(k)%live) call end_span_block(scenes(k), models(k), states(k), loop(k), recorders(k))
          end do
       end do
       do k = 1, nk
-         if (loop(k)%live) call end_block(scenes(k), models(k), states(k), loop(k), recorders(k))
+         if (loop(k)%live) call end_span_block(scenes(k), models(k), states(k), loop(k), recorders(k))
       end do
    end subroutine advance_span_members
 
-   !> One member's step after the substitutions: the lines of advance_span from the record
-   !> waiting for this step's energy to the support positions moved on. A failed QP ends the
-   !> member's block (live false).
-   subroutine member_step(scene, model, state, lp, recorder, step, usu, dsu, dmd)
-      type(scene_type), intent(in) :: scene
-      type(model_type), intent(in) :: model
-      type(state_type), intent(inout) :: state
-      type(member_loop_type), intent(inout) :: lp
-      class(recorder_type), intent(inout) :: recorder
-      integer(ik), intent(in) :: step
-      real(wp), intent(in) :: usu, dsu, dmd
-      integer :: tip, col, i
-      real(wp) :: c, gd, d_tip_prev, u_tip_prev, r_tip, r_prev
-      logical :: contact, enforce
-
-      tip = model%tip
-      enforce = scene%law == law_signorini
-      if (lp%pending) then
-         lp%row(col_energy) = scene%mass_per_length*energy(model, dmd, usu, dsu, lp%u_old_su)
-         call recorder%record_stops(state%span%record_u, state%span%record_reaction)
-         call recorder%record(lp%row)
-         lp%pending = .false.
-      end if
-      lp%u_old_su = usu
-      d_tip_prev = state%d(tip)
-      u_tip_prev = state%u(tip)
-      if (model%redistributed) then
-         do i = 1, model%stops%m
-            state%span%s_u(i) = diagonal_row(model%stiffness_diagonals, state%u, model%stops%unknown(i))
-            state%span%s_d_prev(i) = diagonal_row(model%stiffness_diagonals, state%d, model%stops%unknown(i))
-         end do
-      end if
-      call span_contact(model%stops, state%span, state%u, state%d, state%rhs, lp%phi_next, enforce, state%span%info, &
-         & scene%restitution, lp%phi_prev)
-      if (state%span%info /= qp_solved) then
-         lp%live = .false.
-         return
-      end if
-      call span_correction(model%stops, state%span, model%solver, state%rhs, c, col)
-      if (col > 0) then
-         call update(state%rhs, c, model%stops%z(:, col), state%d, state%u)
-      else
-         call update(state%rhs, 0.0_wp, model%z, state%d, state%u)
-      end if
-      gd = dot(model%load, state%d)
-      contact = state%span%contact
-      if (enforce) call span_settle(model%stops, state%span, state%u, state%d, state%max_violation, &
-         & .not. model%redistributed)
-      r_prev = state%reaction
-      r_tip = 0
-      if (model%redistributed) then
-         do i = 1, model%stops%m
-            state%span%reaction(i) = massless_reaction(model%beta, lp%weight, model%load(model%stops%unknown(i)), &
-               & state%span%s_u(i), state%span%s_d_prev(i), &
-               & diagonal_row(model%stiffness_diagonals, state%d, model%stops%unknown(i)))
-         end do
-         if (model%stops%tip > 0) r_tip = state%span%reaction(model%stops%tip)
-      else
-         if (model%stops%tip > 0) r_tip = state%span%lambda(model%stops%tip)/model%dt2
-      end if
-      call move_on(state, contact, gd, lp%weight, r_tip, lp%sigma_next)
-      if (model%redistributed) then
-         call span_energy_massless(model%stops, state%span, state%d, lp%phi_next - lp%phi_prev, state%dissipated, &
-            & state%work)
-      else
-         call span_energy(model%stops, state%span, state%d, model%dt2, lp%phi_next - lp%phi_prev, state%dissipated, &
-            & state%work)
-      end if
-      if (model%damped) call damping_loss(model, state)
-      if (step == lp%next_record) then
-         lp%next_record = lp%next_record + scene%record_every
-         call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_prev, lp%row)
-         state%span%record_u = state%span%u_prev + model%stops%lift*lp%phi_now
-         state%span%record_reaction = scene%mass_per_length*state%stop_reaction
-         lp%pending = .true.
-      end if
-      if (model%redistributed) then
-         state%stop_reaction = state%span%reaction
-      else
-         state%stop_reaction = state%span%lambda/model%dt2
-      end if
-      if (state%observer%active) call state%observer%span_indexed(real(step + 1, wp)*model%dt, state%u, &
-         & model%stops%unknown, model%stops%lift, lp%phi_next, state%stop_reaction, state%span%lambda, &
-         & state%u(tip), state%dissipated)
-      if (step == lp%next_snapshot) then
-         lp%next_snapshot = lp%next_snapshot + scene%snapshot_every
-         call take_snapshot(scene, model, state, step, recorder)
-      end if
-      lp%done = step
-      lp%phi_prev = lp%phi_now
-      lp%phi_now = lp%phi_next
-   end subroutine member_step
-
-   !> The end of a member's block (advance_span's and advance's): S u^{last+1}, the waiting
-   !> record completed, the state's step moved on.
-   subroutine end_block(scene, model, state, lp, recorder)
-      type(scene_type), intent(in) :: scene
-      type(model_type), intent(in) :: model
-      type(state_type), intent(inout) :: state
-      type(member_loop_type), intent(inout) :: lp
-      class(recorder_type), intent(inout) :: recorder
-      call diagonal_matvec(model%stiffness_diagonals, state%u, state%su)
-      if (lp%pending) then
-         call diagonal_matvec(model%mass_diagonals, state%d, state%scratch)
-         lp%row(col_energy) = scene%mass_per_length*energy(model, dot(state%d, state%scratch), &
-            & dot(state%u, state%su), dot(state%d, state%su), lp%u_old_su)
-         call recorder%record_stops(state%span%record_u, state%span%record_reaction)
-         call recorder%record(lp%row)
-         lp%pending = .false.
-      end if
-      lp%live = .false.
-      state%step = lp%done + 1
-   end subroutine end_block
 
    !> Text of a real for messages.
    function real_text(x) result(s)

@@ -9,24 +9,24 @@
 !> contact/tip_contact.f90. The loop allocates nothing and writes nothing: records go to a recorder.
 module beamstops_scheme
    use beamstops_kinds, only: wp, ik
-   use beamstops_scene, only: scene_type, steps_of, law_signorini
+   use beamstops_scene, only: scene_type, steps_of
    use beamstops_model, only: model_type
    use beamstops_error, only: error_type
    use beamstops_band, only: band_matvec, cholesky_solve
    use beamstops_band_solve, only: band_solver, forward_substitution, back_substitution, &
-      & forward_substitution_energy, band_diagonals, diagonal_matvec, diagonal_row, dot
+      & forward_substitution_energy, band_diagonals, diagonal_matvec, dot
    use beamstops_state, only: state_type
    use beamstops_clock, only: thread_cpu_seconds
-   use beamstops_forcing, only: load_average, support_position, load_rotation, start_loads, next_load
+   use beamstops_forcing, only: load_average, load_rotation, start_loads, next_load
    use beamstops_contact_tip_contact, only: spring_term, tip_step, tip_step_massless, update, tip_outcome, tip_update, &
       & fix_tip, settle_tip
-   use beamstops_contact_span_stops, only: new_span_work, span_contact, span_correction, span_settle, span_energy, &
-      & span_energy_massless
+   use beamstops_contact_span_stops, only: new_span_work
    use beamstops_contact_box_qp, only: qp_solved, qp_message
    use beamstops_recorder, only: recorder_type, n_columns, col_energy
-   use beamstops_ledger, only: energy, move_on, shift_loads, damping_loss, fill_row, take_snapshot, first_events
-   use beamstops_contact_mass_redistribution, only: equilibrium_rows, massless_reaction
+   use beamstops_ledger, only: energy, shift_loads, damping_loss, fill_row, take_snapshot, first_events
+   use beamstops_contact_mass_redistribution, only: equilibrium_rows
    use beamstops_start, only: start_state
+   use beamstops_span_step, only: span_loop_type, start_span_block, next_span_step, span_step, end_span_block
    use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running, &
       & check_divergence
    implicit none
@@ -388,12 +388,9 @@ contains
       end if
    end subroutine advance_fused_general
 
-   !> The fused step with stops along the span (SPEC 7; contact/span_stops.f90): the full back
-   !> substitution gives x = A^{-1} rhs; the trial values u^n + d^{n-1} + x at the stops against
-   !> the bounds of t_{n+1}; only when some are out, the QP on C; then the loop's update, with
-   !> one active stop the tip's rank-one update along its column (so that a single stop at the
-   !> tip is the tip-only path to the bit), with more the correction folded into x. Records as
-   !> advance_fused, the stops' values handed just before each row. `done` is the last step
+   !> The fused step with stops along the span (SPEC 7; contact/span_stops.f90): the forward pass,
+   !> the full back substitution x = A^{-1} rhs, then the rest of the step, beamstops_span_step's
+   !> span_step (the routine the lockstep loop runs on each member). `done` is the last step
    !> done: `last`, unless the QP of a step fails (state%span%info), then the step before.
    subroutine advance_span(scene, model, state, recorder, last, done)
       type(scene_type), intent(in) :: scene
@@ -402,115 +399,23 @@ contains
       class(recorder_type), intent(inout) :: recorder
       integer(ik), intent(in) :: last
       integer(ik), intent(out) :: done
-      integer(ik) :: step, next_record, next_snapshot
-      integer :: tip, col, i
-      real(wp) :: sigma_next, weight, c, gd, d_tip_prev, u_tip_prev, r_tip
-      real(wp) :: usu, dsu, u_old_su, dmd, r_prev, phi_prev, phi_now, phi_next, row(n_columns)
-      logical :: contact, pending, enforce
-      type(load_rotation) :: loads
+      integer(ik) :: step
+      real(wp) :: usu, dsu, dmd
+      type(span_loop_type) :: lp
 
-      tip = model%tip
-      enforce = scene%law == law_signorini
       if (.not. allocated(state%span%trial)) call resume_span(model, state)
-      call first_events(scene, state%step, next_record, next_snapshot)
-      pending = .false.
-      u_old_su = 0
-      dmd = 0
-      done = state%step - 1
-      phi_prev = support_position(real(state%step - 1, wp)*model%dt, scene%amplitude, scene%omega)
-      phi_now = support_position(real(state%step, wp)*model%dt, scene%amplitude, scene%omega)
-      call start_loads(loads, state%step + 1, model%dt, scene%omega, scene%centered_load)
+      call start_span_block(scene, model, state, lp)
       do step = state%step, last
-         sigma_next = loads%sigma
-         call next_load(loads)
-         phi_next = support_position(real(step + 1, wp)*model%dt, scene%amplitude, scene%omega)
-         weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
+         call next_span_step(scene, model, state, lp, step)
          call forward_pass(model%stiffness_diagonals, model%mass_diagonals, model%solver, model%load, state%u, state%d, &
-            & model%dt2*weight, model%dt2, 0.0_wp, pending .or. step == next_record, &
-            & state%su, state%rhs, usu, dsu, dmd, model%massless, model%row_scale, sigma_next, state%cd, model%dt)
-         if (pending) then
-            row(col_energy) = scene%mass_per_length*energy(model, dmd, usu, dsu, u_old_su)
-            call recorder%record_stops(state%span%record_u, state%span%record_reaction)
-            call recorder%record(row)
-            pending = .false.
-         end if
-         u_old_su = usu
+            & model%dt2*lp%weight, model%dt2, 0.0_wp, lp%pending .or. step == lp%next_record, &
+            & state%su, state%rhs, usu, dsu, dmd, model%massless, model%row_scale, lp%sigma_next, state%cd, model%dt)
          call back_substitution(model%solver, state%rhs)
-         d_tip_prev = state%d(tip)
-         u_tip_prev = state%u(tip)
-         if (model%redistributed) then
-            do i = 1, model%stops%m
-               state%span%s_u(i) = diagonal_row(model%stiffness_diagonals, state%u, model%stops%unknown(i))
-               state%span%s_d_prev(i) = diagonal_row(model%stiffness_diagonals, state%d, model%stops%unknown(i))
-            end do
-         end if
-         call span_contact(model%stops, state%span, state%u, state%d, state%rhs, phi_next, enforce, state%span%info, &
-            & scene%restitution, phi_prev)
-         if (state%span%info /= qp_solved) exit
-         call span_correction(model%stops, state%span, model%solver, state%rhs, c, col)
-         if (col > 0) then
-            call update(state%rhs, c, model%stops%z(:, col), state%d, state%u)
-         else
-            call update(state%rhs, 0.0_wp, model%z, state%d, state%u)
-         end if
-         gd = dot(model%load, state%d)
-         contact = state%span%contact
-         ! The stops on their bounds, the energy they take and the work of the support through them.
-         if (enforce) call span_settle(model%stops, state%span, state%u, state%d, state%max_violation, &
-            & .not. model%redistributed)
-         r_prev = state%reaction
-         r_tip = 0
-         if (model%redistributed) then
-            do i = 1, model%stops%m
-               state%span%reaction(i) = massless_reaction(model%beta, weight, model%load(model%stops%unknown(i)), &
-                  & state%span%s_u(i), state%span%s_d_prev(i), &
-                  & diagonal_row(model%stiffness_diagonals, state%d, model%stops%unknown(i)))
-            end do
-            if (model%stops%tip > 0) r_tip = state%span%reaction(model%stops%tip)
-         else
-            if (model%stops%tip > 0) r_tip = state%span%lambda(model%stops%tip)/model%dt2
-         end if
-         call move_on(state, contact, gd, weight, r_tip, sigma_next)
-         if (model%redistributed) then
-            call span_energy_massless(model%stops, state%span, state%d, phi_next - phi_prev, state%dissipated, &
-               & state%work)
-         else
-            call span_energy(model%stops, state%span, state%d, model%dt2, phi_next - phi_prev, state%dissipated, &
-               & state%work)
-         end if
-         if (model%damped) call damping_loss(model, state)
-         if (step == next_record) then
-            next_record = next_record + scene%record_every
-            call fill_row(scene, model, state, step, u_tip_prev, d_tip_prev, r_prev, row)
-            state%span%record_u = state%span%u_prev + model%stops%lift*phi_now
-            state%span%record_reaction = scene%mass_per_length*state%stop_reaction
-            pending = .true.
-         end if
-         if (model%redistributed) then
-            state%stop_reaction = state%span%reaction
-         else
-            state%stop_reaction = state%span%lambda/model%dt2
-         end if
-         ! (with massless stops a free stop's row residual is not a contact: only the active ones count)
-         if (state%observer%active) call state%observer%span_indexed(real(step + 1, wp)*model%dt, state%u, &
-            & model%stops%unknown, model%stops%lift, phi_next, state%stop_reaction, state%span%lambda, &
-            & state%u(tip), state%dissipated)
-         if (step == next_snapshot) then
-            next_snapshot = next_snapshot + scene%snapshot_every
-            call take_snapshot(scene, model, state, step, recorder)
-         end if
-         done = step
-         phi_prev = phi_now
-         phi_now = phi_next
+         call span_step(scene, model, state, lp, recorder, step, usu, dsu, dmd)
+         if (.not. lp%live) exit
       end do
-      call diagonal_matvec(model%stiffness_diagonals, state%u, state%su)
-      if (pending) then
-         call diagonal_matvec(model%mass_diagonals, state%d, state%scratch)
-         row(col_energy) = scene%mass_per_length*energy(model, dot(state%d, state%scratch), dot(state%u, state%su), &
-            & dot(state%d, state%su), u_old_su)
-         call recorder%record_stops(state%span%record_u, state%span%record_reaction)
-         call recorder%record(row)
-      end if
+      call end_span_block(scene, model, state, lp, recorder)
+      done = lp%done
    end subroutine advance_span
 
    !> The damping terms of the state after a checkpoint: C d^{n-1} and d^{n-1}.C d^{n-1}, from d
