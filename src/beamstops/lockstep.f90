@@ -288,7 +288,7 @@ contains
             if (.not. ieee_is_finite(kinetic) .or. kinetic > cap) then
                summaries(k)%status = status_diverged
                summaries(k)%message = 'the solution blew up (kinetic energy beyond 1e8 times the energy supplied) '// &
-                  & 'before t = '//trim(real_text(real(ms%step - 1, wp)*model%dt))//' s'
+                  & 'before t = '//fmt_real(real(ms%step - 1, wp)*model%dt, 6)//' s'
                call finish_member(k, scenes(k), ms, model, summaries(k), t0)
                cycle
             end if
@@ -517,7 +517,6 @@ contains
          ms%cd = 0
       end if
    end subroutine start_general
-
 
    !> A member's load vector g = a (omega^2 (h, phi_i) + 8 k^2/L^4 (1, phi_i)), as build_model
    !> forms it.
@@ -773,12 +772,4 @@ contains
       row(col_dissipated) = scene%mass_per_length*lanes%dissipated(i)
       row(col_damped) = scene%mass_per_length*0.0_wp
    end subroutine fill_row_lanes
-
-
-   !> Text of a real for messages.
-   function real_text(x) result(s)
-      real(wp), intent(in) :: x
-      character(len=32) :: s
-      write (s, '(g0.6)') x
-   end function real_text
 end module beamstops_lockstep

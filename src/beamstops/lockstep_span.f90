@@ -24,7 +24,7 @@
 module beamstops_lockstep_span
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type
-   use beamstops_strings, only: fmt_int
+   use beamstops_strings, only: fmt_int, fmt_real
    use beamstops_scene, only: scene_type, steps_of
    use beamstops_model, only: model_type, build_model
    use beamstops_band, only: band_matvec
@@ -121,7 +121,7 @@ contains
             else if (states(k)%span%info /= qp_solved) then
                summaries(k)%status = status_failed
                summaries(k)%message = qp_message(states(k)%span%info)//' at t = '// &
-                  & trim(real_text(real(states(k)%step, wp)*model%dt))//' s'
+                  & fmt_real(real(states(k)%step, wp)*model%dt, 6)//' s'
             else
                call band_matvec(models(k)%mass, states(k)%d, states(k)%scratch)
                kinetic = 0.5_wp*dot_product(states(k)%d, states(k)%scratch)/model%dt2
@@ -273,7 +273,7 @@ contains
                lanes%dsu(k) = 0
                lanes%dmd(k) = 0
             end if
-            ! x back (S u^n is not read again before end_block computes S u^{last+1})
+            ! x back (S u^n is not read again before end_span_block computes S u^{last+1})
             states(k)%rhs = lanes%rhs(lane(k), :, chunk(k))
             call span_step(scenes(k), models(k), states(k), loop(k), recorders(k), step, lanes%usu(k), &
                & lanes%dsu(k), lanes%dmd(k))
@@ -284,12 +284,4 @@ contains
          if (loop(k)%live) call end_span_block(scenes(k), models(k), states(k), loop(k), recorders(k))
       end do
    end subroutine advance_span_members
-
-
-   !> Text of a real for messages.
-   function real_text(x) result(s)
-      real(wp), intent(in) :: x
-      character(len=32) :: s
-      write (s, '(g0.6)') x
-   end function real_text
 end module beamstops_lockstep_span

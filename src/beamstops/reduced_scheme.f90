@@ -15,6 +15,7 @@
 !> The loop allocates nothing and writes nothing itself.
 module beamstops_reduced_scheme
    use beamstops_kinds, only: wp, ik
+   use beamstops_strings, only: fmt_real
    use beamstops_error, only: error_type, fatal_error
    use beamstops_scene, only: scene_type, steps_of, law_none, law_signorini, law_compliance
    use beamstops_reduced, only: reduced_model_type, block_solver_type, block_solve, reduced_stiffness_product, &
@@ -292,7 +293,7 @@ contains
          if (state%span%info /= qp_solved) then
             summary%status = status_failed
             summary%message = qp_message(state%span%info)//' at t = '// &
-               & trim(real_text(real(state%step, wp)*reduced%dt))//' s'
+               & fmt_real(real(state%step, wp)*reduced%dt, 6)//' s'
             exit
          end if
          kinetic = 0.5_wp*reduced_mass_product(reduced, state%d)/reduced%dt2
@@ -1108,10 +1109,4 @@ contains
       end do
    end subroutine physical_shape
 
-   !> Text of a real for messages.
-   function real_text(x) result(s)
-      real(wp), intent(in) :: x
-      character(len=32) :: s
-      write (s, '(g0.6)') x
-   end function real_text
 end module beamstops_reduced_scheme

@@ -9,6 +9,7 @@
 !> contact/tip_contact.f90. The loop allocates nothing and writes nothing: records go to a recorder.
 module beamstops_scheme
    use beamstops_kinds, only: wp, ik
+   use beamstops_strings, only: fmt_real
    use beamstops_scene, only: scene_type, steps_of
    use beamstops_model, only: model_type
    use beamstops_error, only: error_type
@@ -73,7 +74,7 @@ contains
          if (state%span%info /= qp_solved) then
             summary%status = status_failed
             summary%message = qp_message(state%span%info)//' at t = '// &
-               & trim(real_text(real(state%step, wp)*model%dt))//' s'
+               & fmt_real(real(state%step, wp)*model%dt, 6)//' s'
             exit
          end if
          call band_matvec(model%mass, state%d, state%scratch)
@@ -125,13 +126,6 @@ contains
       summary%energy_residual = scene%mass_per_length*((e_end - state%energy0) &
          & - (state%work - state%dissipated - state%damped))
    end subroutine close_ledger
-
-   !> Text of a real for messages.
-   function real_text(x) result(s)
-      real(wp), intent(in) :: x
-      character(len=32) :: s
-      write (s, '(g0.6)') x
-   end function real_text
 
    !> Advance from state%step through step `last` (computing u^{last+1}), recording on the way.
    !> The fused path (default) or, with state%lapack_solve, the reference path; both compute
