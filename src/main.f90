@@ -15,6 +15,7 @@ program beamstops_main
    use beamstops_files, only: file_exists, remove_file, same_file
    use beamstops_recorder_hdf5, only: partial_path, check_output_path
    use beamstops_run, only: continue_run, continue_reduced
+   use beamstops_writer_thread, only: writer_thread, start_writer, stop_writer
    use beamstops_batch, only: lockstep_groups, simulate_group, min_group_members
    use beamstops_reduced, only: reduced_model_type, build_reduced, check_stability_reduced
    use beamstops_reduced_scheme, only: reduced_state_type, start_reduced
@@ -109,9 +110,12 @@ program beamstops_main
    type(scene_type) :: scene
    type(model_type) :: model
    type(error_type), allocatable :: error
+   !> The HDF5 writes of every run on a thread of their own (beamstops_writer_thread).
+   type(writer_thread) :: writer
 
    call ignore_file_size_signal()
    call parse_arguments(command, paths, out, restart)
+   if (command == 'run') call start_writer(writer)
    if (size(paths) > 1) call run_several(paths, restart)
    path = paths(1)%text
    call read_scene(path, scene, error)
@@ -305,6 +309,7 @@ contains
    !> was written correctly is closed by then).
    subroutine quit(status)
       integer, intent(in) :: status
+      call stop_writer(writer)
       flush (output_unit)
       flush (error_unit)
       call c_exit(int(status, c_int))
@@ -339,6 +344,7 @@ contains
       integer(ik) :: records, snapshots
       logical :: resume
       status = 0
+      recorder%writer = writer
       if (scene%modes > 0) then
          ! The reduced (Craig-Bampton) model, before anything is written.
          call build_reduced(scene, model, reduced, error)
@@ -553,6 +559,7 @@ contains
       allocate (recorders(size(members)), opened(size(members)))
       do k = 1, size(members)
          i = members(k)
+         recorders(k)%writer = writer
          call remove_file(checkpoint_path(scenes(i)%output_file))
          call recorders(k)%open(scenes(i)%output_file, scenes(i), models(i), error)
          opened(k) = .not. reported(error, exit_output, status(i))

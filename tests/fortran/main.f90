@@ -30,6 +30,7 @@ program tester
    use test_lockstep_span, only: collect_lockstep_span
    use test_reduced, only: collect_reduced
    use test_reduced_physics, only: collect_reduced_physics
+   use test_writer, only: collect_writer
    implicit none
 
    abstract interface
@@ -77,7 +78,8 @@ program tester
       & new_testsuite('lockstep', collect_lockstep), &
       & new_testsuite('lockstep_general', collect_lockstep_general), &
       & new_testsuite('lockstep_span', collect_lockstep_span), &
-      & new_testsuite('batch', collect_batch) &
+      & new_testsuite('batch', collect_batch), &
+      & new_testsuite('writer', collect_writer) &
       & ]
 
    if (command_argument_count() < 1) call usage()

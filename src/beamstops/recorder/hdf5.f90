@@ -26,13 +26,14 @@ module beamstops_recorder_hdf5
    use beamstops_attributes, only: attribute_list, kind_real, kind_int, kind_logical, kind_text
    use beamstops_output_attributes, only: run_attributes, summary_attributes
    use beamstops_recorder_hdf5_observations, only: write_observations
+   use beamstops_recorder_hdf5_writes, only: write_order, hand_over, n_series
+   use beamstops_writer_thread, only: writer_thread, wait_orders
    implicit none
    private
    public :: hdf5_recorder, partial_path, check_output_path
 
    !> Rows buffered before a write (and rows of a chunk).
    integer, parameter :: buffer_rows = 16384
-   integer, parameter :: n_series = 9
    character(len=*), parameter :: group_names(3) = [character(len=9) :: 'tip', 'energy', 'snapshots']
    character(len=*), parameter :: series_path(n_series) = [character(len=18) :: '/tip/t', '/tip/u', '/tip/v', &
       & '/tip/reaction', '/energy/t', '/energy/E', '/energy/work', '/energy/dissipated', '/energy/damped']
@@ -68,6 +69,11 @@ module beamstops_recorder_hdf5
       real(wp), allocatable :: stops_u_buffer(:, :), stops_r_buffer(:, :)
       integer :: stops_fill = 0, stops_rows = 0
       integer(hsize_t) :: stops_written = 0
+      !> The writer thread the program gives (none: each write_buffer writes at once).
+      type(writer_thread) :: writer
+      !> The order the writer carries out while the loop fills the buffers above (a pointer: its
+      !> address goes to the writer thread).
+      type(write_order), pointer :: order => null()
    contains
       procedure :: open => open_file
       procedure :: reopen
@@ -214,7 +220,7 @@ contains
       integer :: hdferr
       logical :: ok
       if (self%file < 0) return
-      call write_buffer(self)
+      call store(self)
       if (allocated(summary%shocks) .and. .not. self%failed) then
          call write_observations(self%file, summary%shocks, summary%statistics, self%scene%transient, &
             & self%scene%batches, self%scene%bins, self%scene%rest_time, ok, summary%ensemble, &
@@ -244,11 +250,13 @@ contains
       end if
    end subroutine finish
 
-   !> Close the datasets and the file (so that closing writes everything and says so).
+   !> Close the datasets and the file (so that closing writes everything and says so), once the
+   !> writer is done with them.
    subroutine close_file(self)
       class(hdf5_recorder), intent(inout) :: self
       integer :: hdferr, i
       logical :: ok
+      call wait_writes(self)
       ok = .true.
       do i = 1, n_series
          call close_dataset(self%series(i))
@@ -260,6 +268,7 @@ contains
       call h5fclose_f(self%file, hdferr)
       self%file = -1
       if (hdferr /= 0 .or. .not. ok) call fail(self, write_failure(self))
+      deallocate (self%order)
 
    contains
 
@@ -340,7 +349,7 @@ contains
       !> Snapshots in the file.
       integer(ik), intent(out) :: snapshots
       integer :: hdferr
-      call write_buffer(self)
+      call store(self)
       if (.not. self%failed) then
          call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, hdferr)
          if (hdferr /= 0) call fail(self, write_failure(self))
@@ -443,6 +452,7 @@ contains
       self%scene = scene
       self%nodes = size(model%x)
       allocate (self%buffer(buffer_rows, n_columns))
+      if (.not. associated(self%order)) allocate (self%order)
       if (scene%snapshot_every > 0) then
          self%snapshot_rows = max(1, min(buffer_rows, 2**20/self%nodes))
          allocate (self%snap_t_buffer(self%snapshot_rows), self%snap_u_buffer(self%nodes, self%snapshot_rows))
@@ -451,61 +461,80 @@ contains
       call h5eset_auto_f(0, hdferr)
    end subroutine prepare
 
-   !> Write the buffered records and snapshots.
+   !> Hand the buffered records, stops and snapshots to the writer thread as one order and start
+   !> filling the other buffers; the loop goes on while the writer stores them. The previous
+   !> order is waited for first: one order at a time, and HDF5 called by one thread at a time.
    subroutine write_buffer(self)
       class(hdf5_recorder), intent(inout) :: self
-      integer :: i
-      do i = 1, n_series
-         call append(self, self%series(i), 1, self%written, self%fill, self%buffer(:, series_column(i)))
-      end do
-      self%written = self%written + self%fill
-      self%fill = 0
-      if (self%stops_fill > 0) then
-         call append(self, self%stops_u, self%stops, self%stops_written, self%stops_fill, self%stops_u_buffer, &
-            & matrix=.true.)
-         call append(self, self%stops_reaction, self%stops, self%stops_written, self%stops_fill, self%stops_r_buffer, &
-            & matrix=.true.)
+      call wait_writes(self)
+      associate (o => self%order)
+         o%series = self%series
+         o%column = series_column
+         o%stops_u = self%stops_u
+         o%stops_reaction = self%stops_reaction
+         o%snap_t = self%snap_t
+         o%snap_u = self%snap_u
+         o%stops = self%stops
+         o%nodes = self%nodes
+         call swap(self%buffer, o%rows)
+         o%fill = self%fill
+         o%written = self%written
+         self%written = self%written + self%fill
+         self%fill = 0
+         if (self%stops > 0) then
+            call swap(self%stops_u_buffer, o%stops_u_rows)
+            call swap(self%stops_r_buffer, o%stops_r_rows)
+         end if
+         o%stops_fill = self%stops_fill
+         o%stops_written = self%stops_written
          self%stops_written = self%stops_written + self%stops_fill
          self%stops_fill = 0
-      end if
-      if (self%snap_fill > 0) then
-         call append(self, self%snap_t, 1, self%snaps_written, self%snap_fill, self%snap_t_buffer)
-         call append(self, self%snap_u, self%nodes, self%snaps_written, self%snap_fill, self%snap_u_buffer)
+         if (self%snapshot_rows > 0) then
+            call swap(self%snap_u_buffer, o%snap_u_rows)
+            call swap_vector(self%snap_t_buffer, o%snap_t_rows)
+         end if
+         o%snap_fill = self%snap_fill
+         o%snaps_written = self%snaps_written
          self%snaps_written = self%snaps_written + self%snap_fill
          self%snap_fill = 0
-      end if
+      end associate
+      call hand_over(self%writer, self%order)
    end subroutine write_buffer
 
-   !> Append `rows` rows of `width` values (stored row after row in `values`) at row `offset`;
-   !> a series of one value per row is 1-D unless `matrix`.
-   subroutine append(self, dset, width, offset, rows, values, matrix)
+   !> Everything buffered written, and the writer done with it.
+   subroutine store(self)
       class(hdf5_recorder), intent(inout) :: self
-      integer(hid_t), intent(in) :: dset
-      integer, intent(in) :: width, rows
-      integer(hsize_t), intent(in) :: offset
-      real(wp), intent(in) :: values(*)
-      logical, intent(in), optional :: matrix
-      integer(hid_t) :: filespace, memspace
-      integer(hsize_t) :: dims(2), start(2), count(2)
-      integer :: hdferr, rank
-      if (self%failed .or. rows == 0) return
-      rank = merge(1, 2, width == 1)
-      if (present(matrix)) rank = merge(2, rank, matrix)
-      if (rank == 1) then
-         dims(1) = offset + rows; start(1) = offset; count(1) = rows
-      else
-         dims = [int(width, hsize_t), offset + rows]; start = [0_hsize_t, offset]
-         count = [int(width, hsize_t), int(rows, hsize_t)]
-      end if
-      call h5dset_extent_f(dset, dims(:rank), hdferr)
-      call h5dget_space_f(dset, filespace, hdferr)
-      call h5sselect_hyperslab_f(filespace, H5S_SELECT_SET_F, start(:rank), count(:rank), hdferr)
-      call h5screate_simple_f(rank, count(:rank), memspace, hdferr)
-      call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, count(:rank), hdferr, memspace, filespace)
-      if (hdferr /= 0) call fail(self, write_failure(self))
-      call h5sclose_f(memspace, hdferr)
-      call h5sclose_f(filespace, hdferr)
-   end subroutine append
+      call write_buffer(self)
+      call wait_writes(self)
+   end subroutine store
+
+   !> Wait for the writer's order in progress; a write of it that failed fails the recorder.
+   subroutine wait_writes(self)
+      class(hdf5_recorder), intent(inout) :: self
+      call wait_orders(self%writer)
+      if (.not. associated(self%order)) return
+      if (self%order%failed) call fail(self, write_failure(self))
+   end subroutine wait_writes
+
+   !> Exchange a buffer with its twin in the order (allocated like it the first time).
+   subroutine swap(a, b)
+      real(wp), allocatable, intent(inout) :: a(:, :), b(:, :)
+      real(wp), allocatable :: t(:, :)
+      if (.not. allocated(b)) allocate (b, mold=a)
+      call move_alloc(a, t)
+      call move_alloc(b, a)
+      call move_alloc(t, b)
+   end subroutine swap
+
+   !> swap for the snapshot times.
+   subroutine swap_vector(a, b)
+      real(wp), allocatable, intent(inout) :: a(:), b(:)
+      real(wp), allocatable :: t(:)
+      if (.not. allocated(b)) allocate (b, mold=a)
+      call move_alloc(a, t)
+      call move_alloc(b, a)
+      call move_alloc(t, b)
+   end subroutine swap_vector
 
    !> An extendable, chunked dataset of rows of `width` doubles (1-D for width 1 unless `matrix`).
    subroutine create_series(self, path, units, width, dset, matrix)

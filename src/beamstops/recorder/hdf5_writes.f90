@@ -1,0 +1,111 @@
+!> The HDF5 recorder's writes of records, as orders the writer thread carries out
+!> (beamstops_writer_thread) while the time loop goes on: an order holds full buffers of
+!> records, of the stops' values and of snapshots, the datasets they go to and the rows they
+!> start at. The recorder fills one set of buffers while the writer stores the other; it hands
+!> an order over only when the previous one is done, and reads `failed` only then.
+module beamstops_recorder_hdf5_writes
+   use, intrinsic :: iso_c_binding, only: c_ptr, c_f_pointer, c_loc
+   use hdf5
+   use beamstops_kinds, only: wp
+   use beamstops_writer_thread, only: writer_thread, post_order
+   implicit none
+   private
+   public :: write_order, hand_over, n_series
+
+   !> The series of one value a record: /tip/t, u, v, reaction, /energy/t, E, work,
+   !> dissipated, damped.
+   integer, parameter :: n_series = 9
+
+   !> What the writer stores, and where.
+   type :: write_order
+      !> Datasets: the record series, the stops' u and reaction, the snapshots' t and u.
+      integer(hid_t) :: series(n_series) = -1, stops_u = -1, stops_reaction = -1, snap_t = -1, snap_u = -1
+      !> Columns of `rows` that go to each series.
+      integer :: column(n_series) = 0
+      !> Row of each dataset where the order's rows start.
+      integer(hsize_t) :: written = 0, stops_written = 0, snaps_written = 0
+      !> Stops along the span and nodes of a snapshot.
+      integer :: stops = 0, nodes = 0
+      !> Records (rows, columns), the stops' values (stops, rows), snapshot times and shapes (nodes, rows).
+      real(wp), allocatable :: rows(:, :), stops_u_rows(:, :), stops_r_rows(:, :), snap_t_rows(:), snap_u_rows(:, :)
+      !> How many of each the order holds.
+      integer :: fill = 0, stops_fill = 0, snap_fill = 0
+      !> Set when a write failed (HDF5 said so); the recorder then fails with its own message.
+      logical :: failed = .false.
+   end type write_order
+
+contains
+
+   !> Give the order to the writer (which carries it out at once when it has no thread).
+   subroutine hand_over(writer, order)
+      !> The writer.
+      type(writer_thread), intent(in) :: writer
+      !> The order; it must stay where it is until the writer is done with it (wait_orders).
+      type(write_order), intent(inout), target :: order
+      call post_order(writer, c_loc(order))
+   end subroutine hand_over
+
+   !> The writer thread's job (called by writer_thread.c): carry out the order at `arg` (c_loc
+   !> of a write_order).
+   subroutine write_order_job(arg) bind(c, name='beamstops_write_order')
+      !> The order.
+      type(c_ptr), value :: arg
+      type(write_order), pointer :: order
+      integer :: hdferr
+      ! HDF5 built thread-safe keeps an error stack per thread: its printing is off on this one
+      ! too (failures become the recorder's message)
+      call h5eset_auto_f(0, hdferr)
+      call c_f_pointer(arg, order)
+      call write_rows(order)
+   end subroutine write_order_job
+
+   !> Append the order's rows to their datasets.
+   subroutine write_rows(order)
+      type(write_order), intent(inout) :: order
+      integer :: i
+      do i = 1, n_series
+         call append(order, order%series(i), 1, order%written, order%fill, order%rows(:, order%column(i)))
+      end do
+      if (order%stops_fill > 0) then
+         call append(order, order%stops_u, order%stops, order%stops_written, order%stops_fill, order%stops_u_rows, &
+            & matrix=.true.)
+         call append(order, order%stops_reaction, order%stops, order%stops_written, order%stops_fill, &
+            & order%stops_r_rows, matrix=.true.)
+      end if
+      if (order%snap_fill > 0) then
+         call append(order, order%snap_t, 1, order%snaps_written, order%snap_fill, order%snap_t_rows)
+         call append(order, order%snap_u, order%nodes, order%snaps_written, order%snap_fill, order%snap_u_rows)
+      end if
+   end subroutine write_rows
+
+   !> Append `rows` rows of `width` values (stored row after row in `values`) at row `offset`;
+   !> a series of one value per row is 1-D unless `matrix`.
+   subroutine append(order, dset, width, offset, rows, values, matrix)
+      type(write_order), intent(inout) :: order
+      integer(hid_t), intent(in) :: dset
+      integer, intent(in) :: width, rows
+      integer(hsize_t), intent(in) :: offset
+      real(wp), intent(in) :: values(*)
+      logical, intent(in), optional :: matrix
+      integer(hid_t) :: filespace, memspace
+      integer(hsize_t) :: dims(2), start(2), count(2)
+      integer :: hdferr, rank
+      if (order%failed .or. rows == 0) return
+      rank = merge(1, 2, width == 1)
+      if (present(matrix)) rank = merge(2, rank, matrix)
+      if (rank == 1) then
+         dims(1) = offset + rows; start(1) = offset; count(1) = rows
+      else
+         dims = [int(width, hsize_t), offset + rows]; start = [0_hsize_t, offset]
+         count = [int(width, hsize_t), int(rows, hsize_t)]
+      end if
+      call h5dset_extent_f(dset, dims(:rank), hdferr)
+      call h5dget_space_f(dset, filespace, hdferr)
+      call h5sselect_hyperslab_f(filespace, H5S_SELECT_SET_F, start(:rank), count(:rank), hdferr)
+      call h5screate_simple_f(rank, count(:rank), memspace, hdferr)
+      call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, count(:rank), hdferr, memspace, filespace)
+      if (hdferr /= 0) order%failed = .true.
+      call h5sclose_f(memspace, hdferr)
+      call h5sclose_f(filespace, hdferr)
+   end subroutine append
+end module beamstops_recorder_hdf5_writes

@@ -1,0 +1,122 @@
+/* The writer thread (used by src/beamstops/writer_thread.f90): one thread that carries out one
+   write order at a time (beamstops_write_order, src/beamstops/recorder/hdf5_writes.f90), posted
+   by the thread of the time loop, which goes on meanwhile. Posting waits until the previous
+   order is done, so the orders run one after the other, and `wait` returns once none is
+   running (every write an order made is then visible to the caller: the mutex orders them).
+   The thread sleeps on a condition variable when it has nothing to do: it takes no CPU time
+   of its own. (The job is named here rather than passed as a function pointer: gfortran's
+   link-time optimizer loses a bind(c) procedure whose only use is c_funloc.) */
+#define _GNU_SOURCE
+#include <pthread.h>
+#include <sched.h>
+#include <stdlib.h>
+
+/* Carry out the write order at `order` (Fortran, bind(c)). */
+void beamstops_write_order(void *order);
+
+typedef struct {
+    pthread_t thread;
+    pthread_mutex_t lock;
+    pthread_cond_t changed;
+    void *arg;
+    int busy, quit;
+} writer_t;
+
+static void *writer_main(void *p)
+{
+    writer_t *w = p;
+    pthread_mutex_lock(&w->lock);
+    for (;;) {
+        while (!w->busy && !w->quit)
+            pthread_cond_wait(&w->changed, &w->lock);
+        if (!w->busy)
+            break;
+        pthread_mutex_unlock(&w->lock);
+        beamstops_write_order(w->arg);
+        pthread_mutex_lock(&w->lock);
+        w->busy = 0;
+        pthread_cond_broadcast(&w->changed);
+    }
+    pthread_mutex_unlock(&w->lock);
+    return NULL;
+}
+
+/* The number of CPUs this process may run on (its affinity mask: taskset, a batch system's
+   cpuset), at least 1. */
+int beamstops_usable_cpus(void)
+{
+    cpu_set_t set;
+    if (sched_getaffinity(0, sizeof set, &set) != 0)
+        return 1;
+    int n = CPU_COUNT(&set);
+    return n > 0 ? n : 1;
+}
+
+/* A new writer thread, or NULL when none can be started (the orders then run where posted). */
+void *beamstops_writer_start(void)
+{
+    writer_t *w = calloc(1, sizeof *w);
+    if (!w)
+        return NULL;
+    pthread_mutex_init(&w->lock, NULL);
+    pthread_cond_init(&w->changed, NULL);
+    if (pthread_create(&w->thread, NULL, writer_main, w) != 0) {
+        pthread_cond_destroy(&w->changed);
+        pthread_mutex_destroy(&w->lock);
+        free(w);
+        return NULL;
+    }
+    return w;
+}
+
+/* With the lock held: wait until no order runs. */
+static void wait_idle(writer_t *w)
+{
+    while (w->busy)
+        pthread_cond_wait(&w->changed, &w->lock);
+}
+
+/* Wait until no order runs. */
+void beamstops_writer_wait(void *p)
+{
+    writer_t *w = p;
+    if (!w)
+        return;
+    pthread_mutex_lock(&w->lock);
+    wait_idle(w);
+    pthread_mutex_unlock(&w->lock);
+}
+
+/* Carry out the order at `arg` on the writer thread once the previous one is done (at once,
+   here, without a thread). */
+void beamstops_writer_post(void *p, void *arg)
+{
+    writer_t *w = p;
+    if (!w) {
+        beamstops_write_order(arg);
+        return;
+    }
+    pthread_mutex_lock(&w->lock);
+    wait_idle(w);
+    w->arg = arg;
+    w->busy = 1;
+    pthread_cond_broadcast(&w->changed);
+    pthread_mutex_unlock(&w->lock);
+}
+
+/* Finish the last order, end the thread and free it. */
+void beamstops_writer_stop(void *p)
+{
+    writer_t *w = p;
+    if (!w)
+        return;
+    pthread_mutex_lock(&w->lock);
+    wait_idle(w);
+    w->quit = 1;
+    pthread_cond_broadcast(&w->changed);
+    pthread_mutex_unlock(&w->lock);
+    pthread_join(w->thread, NULL);
+    pthread_cond_destroy(&w->changed);
+    pthread_mutex_destroy(&w->lock);
+    free(w);
+}

@@ -1,0 +1,136 @@
+!> The HDF5 recorder's writer thread (beamstops_writer_thread): the records, energies and
+!> snapshots a run hands to the writer thread, several buffers of them and checkpoints (flushes)
+!> among them, reach the file exactly as the in-memory recorder keeps them; the same without a
+!> thread (the orders carried out where they are posted).
+module test_writer
+   use hdf5, only: hid_t, h5fopen_f, h5fclose_f, H5F_ACC_RDONLY_F
+   use testing
+   use beamstops, only: ik, scene_type, validate_scene, model_type, prepare_run, array_recorder, &
+      & hdf5_recorder, run_summary, record_count, snapshot_count, status_complete, state_type, start_state
+   use beamstops_recorder, only: col_t, col_u, col_energy, col_work
+   use beamstops_recorder_hdf5_vector, only: read_vector
+   use beamstops_run, only: continue_run
+   use beamstops_files, only: remove_file, file_exists
+   use beamstops_writer_thread, only: writer_thread, start_writer, stop_writer
+   implicit none
+   private
+   public :: collect_writer
+
+contains
+
+   !> Tests of the suite.
+   subroutine collect_writer(tests)
+      !> The suite's tests.
+      type(unittest_type), allocatable, intent(out) :: tests(:)
+      tests = [ &
+         & new_unittest('records written by the writer thread, with checkpoints among them, are the in-memory '// &
+         & 'recorder''s, bit for bit', test_thread), &
+         & new_unittest('without a thread, the orders carried out where posted: the same bits', test_inline) &
+         & ]
+   end subroutine collect_writer
+
+   !> 40,000 steps, each recorded (several buffers of the recorder), a snapshot every 97 steps,
+   !> a checkpoint every 15,000 steps.
+   subroutine prepare(scene, model, error)
+      type(scene_type), intent(out) :: scene
+      type(model_type), intent(out) :: model
+      type(error_type), allocatable, intent(out) :: error
+      scene%dt = 5.0e-5_wp
+      scene%t_end = 2.0_wp
+      scene%record_every = 1
+      scene%snapshot_every = 97
+      scene%checkpoint_every = 15000
+      call validate_scene(scene, 'test scene', error)
+      if (allocated(error)) return
+      call prepare_run(scene, 'test scene', model, error)
+   end subroutine prepare
+
+   subroutine test_thread(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(writer_thread) :: writer
+      call start_writer(writer)
+      call compare_with_memory(writer, 'test_writer_thread.h5', error)
+      call stop_writer(writer)
+   end subroutine test_thread
+
+   subroutine test_inline(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(writer_thread) :: none
+      call compare_with_memory(none, 'test_writer_inline.h5', error)
+   end subroutine test_inline
+
+   !> The scene run into `path` through `writer` (checkpoints into path.checkpoint), and into
+   !> memory: the file's series equal the memory's, bit for bit.
+   subroutine compare_with_memory(writer, path, error)
+      type(writer_thread), intent(in) :: writer
+      character(len=*), intent(in) :: path
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(model_type) :: model
+      type(hdf5_recorder) :: file_rec
+      type(array_recorder) :: memory
+      type(run_summary) :: summary, reference
+      type(state_type) :: state
+      type(error_type), allocatable :: failure
+      call prepare(scene, model, error)
+      if (allocated(error)) return
+      call remove_file(path)
+      file_rec%writer = writer
+      call file_rec%open(path, scene, model, error)
+      if (allocated(error)) return
+      call start_state(scene, model, state, file_rec, error)
+      if (allocated(error)) return
+      call continue_run(scene, model, state, file_rec, summary, failure, path//'.checkpoint')
+      call file_rec%finish(summary, error)
+      call remove_file(path//'.checkpoint')
+      if (allocated(error)) return
+      call check(error, .not. allocated(failure), 'the run writes its file and its checkpoints')
+      if (allocated(error)) return
+      call check(error, summary%status == status_complete .and. file_exists(path), 'complete, and the file in place')
+      if (allocated(error)) return
+      ! in memory, with the same checkpoints: the loop's blocks end at the same steps (a block's
+      ! last record takes its energy from dot products, not from the next forward pass)
+      call memory%reserve(record_count(scene), snapshot_count(scene), scene%elements + 1)
+      call start_state(scene, model, state, memory, error)
+      if (allocated(error)) return
+      call continue_run(scene, model, state, memory, reference, error, path//'.checkpoint')
+      call remove_file(path//'.checkpoint')
+      if (allocated(error)) return
+      call check(error, int(memory%filled) > 2*16384, 'more records than two buffers of the recorder')
+      if (allocated(error)) return
+      call compare_file(path, memory, error)
+      call remove_file(path)
+   end subroutine compare_with_memory
+
+   !> /tip/t, /tip/u, /energy/E, /energy/work and /snapshots/t of `path` against `memory`.
+   subroutine compare_file(path, memory, error)
+      character(len=*), intent(in) :: path
+      type(array_recorder), intent(in) :: memory
+      type(error_type), allocatable, intent(out) :: error
+      integer(hid_t) :: file
+      integer :: hdferr
+      call h5fopen_f(path, H5F_ACC_RDONLY_F, file, hdferr)
+      call check(error, hdferr == 0, 'the file opens')
+      if (allocated(error)) return
+      call same_series('/tip/t', memory%rows(col_t, :memory%filled))
+      if (.not. allocated(error)) call same_series('/tip/u', memory%rows(col_u, :memory%filled))
+      if (.not. allocated(error)) call same_series('/energy/E', memory%rows(col_energy, :memory%filled))
+      if (.not. allocated(error)) call same_series('/energy/work', memory%rows(col_work, :memory%filled))
+      if (.not. allocated(error)) call same_series('/snapshots/t', memory%snap_t(:memory%snaps))
+      call h5fclose_f(file, hdferr)
+
+   contains
+
+      subroutine same_series(name, expected)
+         character(len=*), intent(in) :: name
+         real(wp), intent(in) :: expected(:)
+         real(wp) :: values(size(expected))
+         logical :: ok
+         call read_vector(file, name, values, ok)
+         call check(error, ok, name//' holds '//int_text(size(expected))//' values')
+         if (allocated(error)) return
+         call check(error, all(transfer(values, 1_ik, size(values)) == transfer(expected, 1_ik, size(expected))), &
+            & name//' equals the in-memory series, bit for bit')
+      end subroutine same_series
+   end subroutine compare_file
+end module test_writer
