@@ -477,29 +477,33 @@ contains
          o%stops = self%stops
          o%nodes = self%nodes
          call swap(self%buffer, o%rows)
-         o%fill = self%fill
-         o%written = self%written
-         self%written = self%written + self%fill
-         self%fill = 0
+         call pass_rows(self%fill, self%written, o%fill, o%written)
          if (self%stops > 0) then
             call swap(self%stops_u_buffer, o%stops_u_rows)
             call swap(self%stops_r_buffer, o%stops_r_rows)
          end if
-         o%stops_fill = self%stops_fill
-         o%stops_written = self%stops_written
-         self%stops_written = self%stops_written + self%stops_fill
-         self%stops_fill = 0
+         call pass_rows(self%stops_fill, self%stops_written, o%stops_fill, o%stops_written)
          if (self%snapshot_rows > 0) then
             call swap(self%snap_u_buffer, o%snap_u_rows)
             call swap_vector(self%snap_t_buffer, o%snap_t_rows)
          end if
-         o%snap_fill = self%snap_fill
-         o%snaps_written = self%snaps_written
-         self%snaps_written = self%snaps_written + self%snap_fill
-         self%snap_fill = 0
+         call pass_rows(self%snap_fill, self%snaps_written, o%snap_fill, o%snaps_written)
       end associate
       call hand_over(self%writer, self%order)
    end subroutine write_buffer
+
+   !> The `fill` rows buffered go into the order at row `written` of their dataset; the buffer
+   !> starts empty and the dataset's next rows come after them.
+   pure subroutine pass_rows(fill, written, order_fill, order_written)
+      integer, intent(inout) :: fill
+      integer(hsize_t), intent(inout) :: written
+      integer, intent(out) :: order_fill
+      integer(hsize_t), intent(out) :: order_written
+      order_fill = fill
+      order_written = written
+      written = written + fill
+      fill = 0
+   end subroutine pass_rows
 
    !> Everything buffered written, and the writer done with it.
    subroutine store(self)
