@@ -21,8 +21,7 @@ module beamstops_recorder_hdf5
    use beamstops_summary, only: run_summary, status_running, status_complete, status_diverged, status_failed
    use beamstops_files, only: file_exists, is_directory, same_file, rename_file
    use beamstops_recorder_hdf5_vector, only: write_vector
-   use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
-      & col_work, col_dissipated, col_damped
+   use beamstops_recorder, only: recorder_type, n_columns
    use beamstops_attributes, only: attribute_list, kind_real, kind_int, kind_logical, kind_text
    use beamstops_output_attributes, only: run_attributes, summary_attributes
    use beamstops_recorder_hdf5_observations, only: write_observations
@@ -39,8 +38,6 @@ module beamstops_recorder_hdf5
       & '/tip/reaction', '/energy/t', '/energy/E', '/energy/work', '/energy/dissipated', '/energy/damped']
    character(len=*), parameter :: series_units(n_series) = [character(len=4) :: 's', 'm', 'm/s', 'N', 's', &
       & 'J', 'J', 'J', 'J']
-   integer, parameter :: series_column(n_series) = [col_t, col_u, col_v, col_reaction, col_t, col_energy, &
-      & col_work, col_dissipated, col_damped]
 
    !> Recorder writing an HDF5 file.
    type, extends(recorder_type) :: hdf5_recorder
@@ -49,8 +46,6 @@ module beamstops_recorder_hdf5
       !> The file written as the run goes (partial_path(path)).
       character(len=:), allocatable :: partial
       integer(hid_t) :: file = -1
-      integer(hid_t) :: series(n_series) = -1
-      integer(hid_t) :: snap_t = -1, snap_u = -1
       integer(hsize_t) :: written = 0, snaps_written = 0
       integer :: fill = 0
       integer :: nodes = 0
@@ -65,14 +60,13 @@ module beamstops_recorder_hdf5
       logical :: show_progress = .false.
       !> Stops along the span m, their two series (records x m) and buffers (m, stops_rows).
       integer :: stops = 0
-      integer(hid_t) :: stops_u = -1, stops_reaction = -1
       real(wp), allocatable :: stops_u_buffer(:, :), stops_r_buffer(:, :)
       integer :: stops_fill = 0, stops_rows = 0
       integer(hsize_t) :: stops_written = 0
       !> The writer thread the program gives (none: each write_buffer writes at once).
       type(writer_thread) :: writer
-      !> The order the writer carries out while the loop fills the buffers above (a pointer: its
-      !> address goes to the writer thread).
+      !> The order the writer carries out while the loop fills the buffers above, with the file's
+      !> datasets (a pointer: its address goes to the writer thread).
       type(write_order), pointer :: order => null()
    contains
       procedure :: open => open_file
@@ -115,11 +109,11 @@ contains
          call h5gclose_f(group, hdferr)
       end do
       do i = 1, n_series
-         call create_series(self, trim(series_path(i)), trim(series_units(i)), 1, self%series(i))
+         call create_series(self, trim(series_path(i)), trim(series_units(i)), 1, self%order%series(i))
       end do
       if (scene%snapshot_every > 0) then
-         call create_series(self, '/snapshots/t', 's', 1, self%snap_t)
-         call create_series(self, '/snapshots/u', 'm', self%nodes, self%snap_u)
+         call create_series(self, '/snapshots/t', 's', 1, self%order%snap_t)
+         call create_series(self, '/snapshots/u', 'm', self%nodes, self%order%snap_u)
       end if
       call allocate_stops_buffer(self)
       call write_vector(self%file, '/snapshots/x', model%x, ok)
@@ -170,14 +164,15 @@ contains
       call write_vector(self%file, '/stops/lower', scene%stop_lower, ok(3))
       call write_vector(self%file, '/stops/upper', scene%stop_upper, ok(4))
       if (.not. all(ok)) call fail(self, 'cannot write the datasets of /stops')
-      call create_series(self, '/stops/u', 'm', stop_count(scene), self%stops_u, matrix=.true.)
-      call create_series(self, '/stops/reaction', 'N', stop_count(scene), self%stops_reaction, matrix=.true.)
+      call create_series(self, '/stops/u', 'm', stop_count(scene), self%order%stops_u, matrix=.true.)
+      call create_series(self, '/stops/reaction', 'N', stop_count(scene), self%order%stops_reaction, matrix=.true.)
    end subroutine create_stops
 
    !> Buffers of the stops' series (when the scene has stops along the span).
    subroutine allocate_stops_buffer(self)
       class(hdf5_recorder), intent(inout) :: self
       self%stops = stop_count(self%scene)
+      self%order%stops = self%stops
       if (self%stops == 0) return
       self%stops_rows = max(1, min(buffer_rows, 2**19/self%stops))
       allocate (self%stops_u_buffer(self%stops, self%stops_rows), self%stops_r_buffer(self%stops, self%stops_rows))
@@ -259,12 +254,12 @@ contains
       call wait_writes(self)
       ok = .true.
       do i = 1, n_series
-         call close_dataset(self%series(i))
+         call close_dataset(self%order%series(i))
       end do
-      call close_dataset(self%snap_t)
-      call close_dataset(self%snap_u)
-      call close_dataset(self%stops_u)
-      call close_dataset(self%stops_reaction)
+      call close_dataset(self%order%snap_t)
+      call close_dataset(self%order%snap_u)
+      call close_dataset(self%order%stops_u)
+      call close_dataset(self%order%stops_reaction)
       call h5fclose_f(self%file, hdferr)
       self%file = -1
       if (hdferr /= 0 .or. .not. ok) call fail(self, write_failure(self))
@@ -306,16 +301,16 @@ contains
          return
       end if
       do i = 1, n_series
-         call reopen_series(trim(series_path(i)), self%series(i), [records])
+         call reopen_series(trim(series_path(i)), self%order%series(i), [records])
       end do
       if (scene%snapshot_every > 0) then
-         call reopen_series('/snapshots/t', self%snap_t, [snapshots])
-         call reopen_series('/snapshots/u', self%snap_u, [int(self%nodes, ik), snapshots])
+         call reopen_series('/snapshots/t', self%order%snap_t, [snapshots])
+         call reopen_series('/snapshots/u', self%order%snap_u, [int(self%nodes, ik), snapshots])
       end if
       call allocate_stops_buffer(self)
       if (self%stops > 0) then
-         call reopen_series('/stops/u', self%stops_u, [int(self%stops, ik), records])
-         call reopen_series('/stops/reaction', self%stops_reaction, [int(self%stops, ik), records])
+         call reopen_series('/stops/u', self%order%stops_u, [int(self%stops, ik), records])
+         call reopen_series('/stops/reaction', self%order%stops_reaction, [int(self%stops, ik), records])
       end if
       self%written = records
       self%snaps_written = snapshots
@@ -453,6 +448,7 @@ contains
       self%nodes = size(model%x)
       allocate (self%buffer(buffer_rows, n_columns))
       if (.not. associated(self%order)) allocate (self%order)
+      self%order%nodes = self%nodes
       if (scene%snapshot_every > 0) then
          self%snapshot_rows = max(1, min(buffer_rows, 2**20/self%nodes))
          allocate (self%snap_t_buffer(self%snapshot_rows), self%snap_u_buffer(self%nodes, self%snapshot_rows))
@@ -468,14 +464,6 @@ contains
       class(hdf5_recorder), intent(inout) :: self
       call wait_writes(self)
       associate (o => self%order)
-         o%series = self%series
-         o%column = series_column
-         o%stops_u = self%stops_u
-         o%stops_reaction = self%stops_reaction
-         o%snap_t = self%snap_t
-         o%snap_u = self%snap_u
-         o%stops = self%stops
-         o%nodes = self%nodes
          call swap(self%buffer, o%rows)
          call pass_rows(self%fill, self%written, o%fill, o%written)
          if (self%stops > 0) then

@@ -7,21 +7,24 @@ module beamstops_recorder_hdf5_writes
    use, intrinsic :: iso_c_binding, only: c_ptr, c_f_pointer, c_loc
    use hdf5
    use beamstops_kinds, only: wp
+   use beamstops_recorder, only: col_t, col_u, col_v, col_reaction, col_energy, col_work, col_dissipated, col_damped
    use beamstops_writer_thread, only: writer_thread, post_order
    implicit none
    private
-   public :: write_order, hand_over, n_series
+   public :: write_order, hand_over, n_series, series_column
 
    !> The series of one value a record: /tip/t, u, v, reaction, /energy/t, E, work,
    !> dissipated, damped.
    integer, parameter :: n_series = 9
+   !> The column of a record row that goes to each series.
+   integer, parameter :: series_column(n_series) = [col_t, col_u, col_v, col_reaction, col_t, col_energy, &
+      & col_work, col_dissipated, col_damped]
 
-   !> What the writer stores, and where.
+   !> What the writer stores, and where: the file's datasets (the recorder creates, reopens and
+   !> closes them here), the rows an order holds and where they start.
    type :: write_order
       !> Datasets: the record series, the stops' u and reaction, the snapshots' t and u.
       integer(hid_t) :: series(n_series) = -1, stops_u = -1, stops_reaction = -1, snap_t = -1, snap_u = -1
-      !> Columns of `rows` that go to each series.
-      integer :: column(n_series) = 0
       !> Row of each dataset where the order's rows start.
       integer(hsize_t) :: written = 0, stops_written = 0, snaps_written = 0
       !> Stops along the span and nodes of a snapshot.
@@ -64,7 +67,7 @@ contains
       type(write_order), intent(inout) :: order
       integer :: i
       do i = 1, n_series
-         call append(order, order%series(i), 1, order%written, order%fill, order%rows(:, order%column(i)))
+         call append(order, order%series(i), 1, order%written, order%fill, order%rows(:, series_column(i)))
       end do
       if (order%stops_fill > 0) then
          call append(order, order%stops_u, order%stops, order%stops_written, order%stops_fill, order%stops_u_rows, &
