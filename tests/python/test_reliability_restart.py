@@ -228,3 +228,32 @@ def test_a_resume_after_a_failed_attempt_keeps_no_stale_message(tmp_path: Path) 
     done = run("run", scene, "--restart", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert_identical(tmp_path / "killed.h5", tmp_path / "reference.h5")
+
+
+def test_a_resume_after_an_attempt_killed_in_its_end(tmp_path: Path) -> None:
+    # An attempt killed while it wrote its end (after its observations, before the rename)
+    # leaves /impacts and /statistics in OUT.h5.partial beside the checkpoint; the resumed run
+    # writes its own end and must be the uninterrupted run (found by the killed-runs test).
+    stats = "&statistics enabled=.true., transient=0.05 /\n"
+    reference = write_scene(tmp_path, "reference", t_end=0.2)
+    reference.write_text(reference.read_text() + stats)
+    assert run("run", reference, cwd=tmp_path).returncode == 0
+    scene = write_scene(tmp_path, "killed", t_end=0.2)
+    scene.write_text(scene.read_text() + stats)
+    process = subprocess.Popen([PROGRAM, "run", str(scene)], cwd=tmp_path, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+    checkpoint = tmp_path / "killed.h5.checkpoint"
+    while process.poll() is None and not checkpoint.exists():
+        time.sleep(0.001)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    if not checkpoint.exists():
+        pytest.skip("the run ended before its first checkpoint")
+    with h5py.File(tmp_path / "reference.h5") as done, h5py.File(tmp_path / "killed.h5.partial", "r+") as f:
+        assert "impacts" in done and "statistics" in done
+        for group in ("impacts", "statistics"):
+            done.copy(group, f)
+        f.attrs["status"] = "complete"
+    done = run("run", scene, "--restart", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert_identical(tmp_path / "killed.h5", tmp_path / "reference.h5")

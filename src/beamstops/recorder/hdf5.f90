@@ -291,6 +291,7 @@ contains
       integer(ik), intent(in) :: records, snapshots
       !> Set when the file cannot be opened or lacks a series.
       type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: end_groups(3) = [character(len=10) :: 'impacts', 'statistics', 'ensemble']
       integer :: hdferr, i
       logical :: stale
       call prepare(self, path, scene, model)
@@ -321,6 +322,14 @@ contains
       call h5aexists_f(self%file, 'message', stale, hdferr)
       if (hdferr == 0 .and. stale) call h5adelete_f(self%file, 'message', hdferr)
       if (hdferr /= 0) call fail(self, 'cannot clear the message of the failed attempt in '//self%partial)
+      ! An attempt killed in its end may have written its observations already: they are the
+      ! run's end, written again by this one.
+      do i = 1, size(end_groups)
+         call h5lexists_f(self%file, trim(end_groups(i)), stale, hdferr)
+         if (hdferr == 0 .and. stale) call h5ldelete_f(self%file, trim(end_groups(i)), hdferr)
+         if (hdferr /= 0) call fail(self, 'cannot clear /'//trim(end_groups(i))//' of the killed attempt in '// &
+            & self%partial)
+      end do
       if (self%failed) call fatal_error(error, self%message)
 
    contains
