@@ -20,7 +20,7 @@ module beamstops_band_solve
    implicit none
    private
    public :: band_solver, prepare_solver, fused_solve, forward_substitution, back_substitution
-   public :: forward_substitution_energy
+   public :: forward_substitution_energy, energy_sums
    public :: band_diagonals, prepare_diagonals, diagonal_matvec, diagonal_row, dot
 
    !> The factor of A = M + dt^2 beta S in the form the fused substitutions read.
@@ -164,6 +164,26 @@ contains
          end do
       end associate
    end subroutine forward_substitution_energy
+
+   !> The sums of forward_substitution_energy (u.su, d.su and d.M d) without a right-hand side
+   !> of interest: that routine on `scratch` set to zero, so that the sums are its bits (the
+   !> compiler rounds some of its terms apart, see beamstops_band_solve_lockstep; a loop of the
+   !> sums alone would not). For a record whose sums were not taken beside a substitution: the
+   !> end of a block, the writer thread's copy of a step.
+   pure subroutine energy_sums(solver, mass, u, d, su, scratch, usu, dsu, dmd)
+      !> Solver from prepare_solver.
+      type(band_solver), intent(in) :: solver
+      !> M by diagonals.
+      type(band_diagonals), intent(in) :: mass
+      !> u, d and su (n).
+      real(wp), intent(in), contiguous :: u(:), d(:), su(:)
+      !> Work vector (n).
+      real(wp), intent(out), contiguous :: scratch(:)
+      !> u.su, d.su and d.M d.
+      real(wp), intent(out) :: usu, dsu, dmd
+      scratch = 0
+      call forward_substitution_energy(solver, mass, u, d, su, scratch, usu, dsu, dmd)
+   end subroutine energy_sums
 
    !> The loop of forward_substitution_energy, three rows a turn from row j (= kd + 1) while
    !> a whole turn fits; on return j is the first row left. Explicit-shape arrays and local sums

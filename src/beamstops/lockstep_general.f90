@@ -24,7 +24,7 @@ module beamstops_lockstep_general
    use beamstops_kinds, only: wp, ik
    use beamstops_scene, only: scene_type, law_signorini, law_compliance
    use beamstops_model, only: model_type
-   use beamstops_band_solve, only: diagonal_matvec, dot
+   use beamstops_band_solve, only: diagonal_matvec, dot, energy_sums
    use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_matvec_rhs, lockstep_forward, &
       & lockstep_forward_energy, lockstep_back, lockstep_update, lockstep_dot, lockstep_matvec
    use beamstops_band_solve_lockstep_general, only: lockstep_matvec_rhs_damped, lockstep_row
@@ -57,6 +57,7 @@ contains
       integer(ik) :: step, next_record, next_snapshot
       integer :: k, c, lo, hi, n, tip, law
       logical :: energy_wanted, pending, observing, damped, massless
+      real(wp) :: sums(3)
 
       n = ms%n
       tip = model%tip
@@ -222,9 +223,8 @@ contains
          ms%vec_u = ms%u(lane(k), :, chunk(k))
          ms%vec_d = ms%d(lane(k), :, chunk(k))
          ms%vec_su = ms%su(lane(k), :, chunk(k))
-         call diagonal_matvec(ops%mass, ms%vec_d, ms%vec_s)
-         ms%rows(col_energy, k) = scenes(k)%mass_per_length*energy(model, dot(ms%vec_d, ms%vec_s), &
-            & dot(ms%vec_u, ms%vec_su), dot(ms%vec_d, ms%vec_su), ms%u_old_su(k))
+         call energy_sums(ops%solver, ops%mass, ms%vec_u, ms%vec_d, ms%vec_su, ms%vec_s, sums(1), sums(2), sums(3))
+         ms%rows(col_energy, k) = scenes(k)%mass_per_length*energy(model, sums(3), sums(1), sums(2), ms%u_old_su(k))
          call recorders(k)%record(ms%rows(:, k))
       end do
    end subroutine advance_members_general

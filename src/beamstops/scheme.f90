@@ -14,7 +14,7 @@ module beamstops_scheme
    use beamstops_model, only: model_type
    use beamstops_error, only: error_type
    use beamstops_band, only: band_matvec, cholesky_solve
-   use beamstops_band_solve, only: band_solver, forward_substitution, back_substitution, &
+   use beamstops_band_solve, only: band_solver, forward_substitution, back_substitution, energy_sums, &
       & forward_substitution_energy, band_diagonals, diagonal_matvec, dot
    use beamstops_state, only: state_type
    use beamstops_clock, only: thread_cpu_seconds
@@ -260,10 +260,8 @@ contains
       ! The state carries S u^{last+1}; the books of the last step, its record's energy from it.
       call diagonal_matvec(model%stiffness_diagonals, state%u, state%su)
       if (held) then
-         if (last == next_record) then
-            call diagonal_matvec(model%mass_diagonals, state%d, state%scratch)
-            sums(1:3) = [dot(state%u, state%su), dot(state%d, state%su), dot(state%d, state%scratch)]
-         end if
+         if (last == next_record) call energy_sums(model%solver, model%mass_diagonals, state%u, state%d, state%su, &
+            & state%scratch, sums(1), sums(2), sums(3))
          call settle_held(scene, model, state, recorder, last, outcome, d_tip_free, held_weight, sums, &
             & next_record, next_snapshot)
       end if
@@ -375,9 +373,8 @@ contains
       ! The state carries S u^{last+1}; it also completes a waiting record.
       call diagonal_matvec(model%stiffness_diagonals, state%u, state%su)
       if (pending) then
-         call diagonal_matvec(model%mass_diagonals, state%d, state%scratch)
-         row(col_energy) = scene%mass_per_length*energy(model, dot(state%d, state%scratch), dot(state%u, state%su), &
-            & dot(state%d, state%su), u_old_su)
+         call energy_sums(model%solver, model%mass_diagonals, state%u, state%d, state%su, state%scratch, usu, dsu, dmd)
+         row(col_energy) = scene%mass_per_length*energy(model, dmd, usu, dsu, u_old_su)
          call recorder%record(row)
       end if
    end subroutine advance_fused_general

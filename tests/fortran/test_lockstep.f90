@@ -19,7 +19,7 @@ module test_lockstep
    use beamstops_state, only: state_type
    use beamstops_model, only: build_model
    use beamstops_band_solve, only: band_solver, band_diagonals, prepare_solver, prepare_diagonals, diagonal_matvec, &
-      & forward_substitution, forward_substitution_energy, back_substitution, dot
+      & forward_substitution, forward_substitution_energy, energy_sums, back_substitution, dot
    use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_work_columns, lockstep_matvec, &
       & lockstep_forward, lockstep_forward_energy, lockstep_back, lockstep_dot, lockstep_update, lockstep_back_edge, &
       & lockstep_back_update
@@ -293,7 +293,7 @@ contains
       type(band_diagonals) :: s, m
       real(wp), allocatable :: x(:, :), y(:, :), b(:, :), u(:, :), d(:, :), ub(:, :), v(:), w(:), uk(:)
       real(wp) :: work(lanes, lockstep_work_columns), usu(lanes), dsu(lanes), dmd(lanes), dd(lanes), c(lanes)
-      real(wp) :: e(3)
+      real(wp) :: e(3), f(3)
       integer :: a, rep, k, n
       character(len=:), allocatable :: where
       do a = 1, size(meshes)
@@ -345,6 +345,8 @@ contains
                if (.not. same_bits(e(1), usu(k))) call test_failed(error, where//'u.S u, lane '//int_text(k))
                if (.not. same_bits(e(2), dsu(k))) call test_failed(error, where//'d.S u, lane '//int_text(k))
                if (.not. same_bits(e(3), dmd(k))) call test_failed(error, where//'d.M d, lane '//int_text(k))
+               call energy_sums(solver, m, u(k, :), d(k, :), y(k, :), w, f(1), f(2), f(3))
+               if (.not. all(same_bits(f, e))) call test_failed(error, where//'the energy sums alone, lane '//int_text(k))
             end do
             call lockstep_dot(n, u, d, work, dd, 1.0_wp)
             do k = 1, lanes

@@ -257,3 +257,18 @@ def test_a_resume_after_an_attempt_killed_in_its_end(tmp_path: Path) -> None:
     done = run("run", scene, "--restart", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert_identical(tmp_path / "killed.h5", tmp_path / "reference.h5")
+
+
+def test_checkpoints_leave_the_records_unchanged(tmp_path: Path) -> None:
+    # A block that ends at a checkpoint completes its last record with the sums of the forward
+    # pass (energy_sums), not with dot products: the run with checkpoints is the run without.
+    plain = tmp_path / "plain.nml"
+    plain.write_text(SCENE.format(t_end=0.2, file="plain.h5").replace(", checkpoint_every=40000", ""))
+    assert run("run", plain, cwd=tmp_path).returncode == 0
+    checked = write_scene(tmp_path, "checked", t_end=0.2)
+    assert run("run", checked, cwd=tmp_path).returncode == 0
+    x, y = datasets(tmp_path / "plain.h5"), datasets(tmp_path / "checked.h5")
+    names = sorted(name for name in x if not name.startswith("@"))
+    assert names == sorted(name for name in y if not name.startswith("@")) and "energy/E" in names
+    for name in names:
+        assert np.array_equal(x[name].view(np.uint64), y[name].view(np.uint64)), name
