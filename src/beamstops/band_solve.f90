@@ -169,7 +169,7 @@ contains
    !> of interest: that routine on `scratch` set to zero, so that the sums are its bits (the
    !> compiler rounds some of its terms apart, see beamstops_band_solve_lockstep; a loop of the
    !> sums alone would not). For a record whose sums were not taken beside a substitution: the
-   !> end of a block, the writer thread's copy of a step.
+   !> record of the last step of a block.
    pure subroutine energy_sums(solver, mass, u, d, su, scratch, usu, dsu, dmd)
       !> Solver from prepare_solver.
       type(band_solver), intent(in) :: solver

@@ -55,6 +55,18 @@ def assert_identical(a: Path, b: Path) -> None:
             assert np.array_equal(x[name].view(np.uint64), y[name].view(np.uint64)), name
 
 
+def kill_after_first_checkpoint(scene: Path, checkpoint: Path) -> None:
+    """Run `scene` and kill it (SIGKILL) as soon as its first checkpoint exists."""
+    process = subprocess.Popen([PROGRAM, "run", str(scene)], cwd=scene.parent, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+    while process.poll() is None and not checkpoint.exists():
+        time.sleep(0.001)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    if not checkpoint.exists():
+        pytest.skip("the run ended before its first checkpoint")
+
+
 def test_killed_runs_resume_bit_for_bit(tmp_path: Path) -> None:
     reference = write_scene(tmp_path, "reference")
     assert run("run", reference, cwd=tmp_path).returncode == 0
@@ -213,15 +225,7 @@ def test_a_resume_after_a_failed_attempt_keeps_no_stale_message(tmp_path: Path) 
     reference = write_scene(tmp_path, "reference", t_end=0.2)
     assert run("run", reference, cwd=tmp_path).returncode == 0
     scene = write_scene(tmp_path, "killed", t_end=0.2)
-    process = subprocess.Popen([PROGRAM, "run", str(scene)], cwd=tmp_path, stdout=subprocess.DEVNULL,
-                               stderr=subprocess.DEVNULL)
-    checkpoint = tmp_path / "killed.h5.checkpoint"
-    while process.poll() is None and not checkpoint.exists():
-        time.sleep(0.001)
-    process.send_signal(signal.SIGKILL)
-    process.wait()
-    if not checkpoint.exists():
-        pytest.skip("the run ended before its first checkpoint")
+    kill_after_first_checkpoint(scene, tmp_path / "killed.h5.checkpoint")
     with h5py.File(tmp_path / "killed.h5.partial", "r+") as f:
         f.attrs["status"] = "failed"
         f.attrs["message"] = "killed.h5: cannot write to killed.h5.partial"
@@ -240,15 +244,7 @@ def test_a_resume_after_an_attempt_killed_in_its_end(tmp_path: Path) -> None:
     assert run("run", reference, cwd=tmp_path).returncode == 0
     scene = write_scene(tmp_path, "killed", t_end=0.2)
     scene.write_text(scene.read_text() + stats)
-    process = subprocess.Popen([PROGRAM, "run", str(scene)], cwd=tmp_path, stdout=subprocess.DEVNULL,
-                               stderr=subprocess.DEVNULL)
-    checkpoint = tmp_path / "killed.h5.checkpoint"
-    while process.poll() is None and not checkpoint.exists():
-        time.sleep(0.001)
-    process.send_signal(signal.SIGKILL)
-    process.wait()
-    if not checkpoint.exists():
-        pytest.skip("the run ended before its first checkpoint")
+    kill_after_first_checkpoint(scene, tmp_path / "killed.h5.checkpoint")
     with h5py.File(tmp_path / "reference.h5") as done, h5py.File(tmp_path / "killed.h5.partial", "r+") as f:
         assert "impacts" in done and "statistics" in done
         for group in ("impacts", "statistics"):
