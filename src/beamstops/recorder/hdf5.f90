@@ -297,7 +297,8 @@ contains
       call prepare(self, path, scene, model)
       call h5fopen_f(self%partial, H5F_ACC_RDWR_F, self%file, hdferr)
       if (hdferr /= 0) then
-         call fail(self, 'cannot reopen '//self%partial//', the output of the interrupted run')
+         call fail(self, 'cannot reopen '//self%partial//', the output of the interrupted run (a run killed while '// &
+            & 'HDF5 wrote it may leave it unreadable); run without --restart to start over')
          call fatal_error(error, self%message)
          return
       end if
