@@ -13,6 +13,7 @@ import pytest
 
 import beamstops
 from beamstops import IncompleteRunError, Scene
+from beamstops.engine import canonical
 from beamstops.result import ARRAYS
 
 SHORT = Scene(t_end=0.3, dt=5e-5)
@@ -166,12 +167,48 @@ def test_load_refuses_an_incomplete_file_unless_asked(program: str, tmp_path: Pa
 
 
 def test_runs_in_threads_release_the_interpreter_and_agree() -> None:
+    # Engine calls from several threads are serialized (beamstops.engine_call: gfortran 12 keeps
+    # string lengths in static storage); each must still give the run alone, attributes and text
+    # included (before the lock, about one run in ten came back with garbled attributes), and the
+    # interpreter is free meanwhile: another Python thread counts while the runs go on.
     scene = SCENES["compliance"]
+    alone = beamstops.run(scene)
     results: list[beamstops.Result] = []
-    threads = [threading.Thread(target=lambda: results.append(beamstops.run(scene))) for _ in range(3)]
+    texts: list[str] = []
+    done = threading.Event()
+    ticks = [0]
+
+    def count() -> None:
+        while not done.wait(0.001):
+            ticks[0] += 1
+
+    def work() -> None:
+        for _ in range(4):
+            results.append(beamstops.run(scene))
+            texts.extend(canonical(scene.to_text()) for _ in range(25))
+
+    counter = threading.Thread(target=count)
+    counter.start()
+    threads = [threading.Thread(target=work) for _ in range(4)]
     for thread in threads:
         thread.start()
     for thread in threads:
         thread.join()
-    assert len(results) == 3
-    assert all(same_bits(r.tip_u, results[0].tip_u) for r in results)
+    done.set()
+    counter.join()
+    assert len(results) == 16 and ticks[0] > 0
+    attrs = {k: v for k, v in alone.attrs.items() if k != "cpu_seconds"}
+    for r in results:
+        assert same_bits(r.tip_u, alone.tip_u) and same_bits(r.energy, alone.energy)
+        assert {k: v for k, v in r.attrs.items() if k != "cpu_seconds"} == attrs
+    assert texts == [canonical(scene.to_text())] * 400
+    # one long run alone (about half a second): the counter goes on during it
+    done.clear()
+    ticks[0] = 0
+    counter = threading.Thread(target=count)
+    counter.start()
+    beamstops.run(scene.replace(t_end=3.0, record_every=1000, snapshot_every=0))
+    during = ticks[0]
+    done.set()
+    counter.join()
+    assert during >= 10, during

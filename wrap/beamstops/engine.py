@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, Callable, Optional
 import numpy as np
 
 from . import _engine
+from .engine_call import engine_call
 from .result import IncompleteRunError, Result
 
 if TYPE_CHECKING:
@@ -48,13 +49,13 @@ def _scene_text(scene: Scene) -> bytes:
 
 def version() -> str:
     """The engine's version."""
-    return _text(_engine.bs_version())
+    return _text(engine_call(_engine.bs_version))
 
 
 def keys() -> dict[str, tuple[str, ...]]:
     """The namelist groups and the keys the engine's reader accepts in each."""
     out: dict[str, tuple[str, ...]] = {}
-    for line in _text(_engine.bs_keys()).splitlines():
+    for line in _text(engine_call(_engine.bs_keys)).splitlines():
         group, _, names = line.partition(":")
         out[group.strip()] = tuple(name.strip() for name in names.split(",") if name.strip())
     return out
@@ -62,7 +63,7 @@ def keys() -> dict[str, tuple[str, ...]]:
 
 def canonical(text: str, source: str = "scene") -> str:
     """The engine's canonical text of namelist text (every key, defaults filled in)."""
-    result, status, message = _engine.bs_scene(text.encode("utf-8"), os.fsencode(source))
+    result, status, message = engine_call(_engine.bs_scene, text.encode("utf-8"), os.fsencode(source))
     _check(status, message)
     return _text(result)
 
@@ -78,7 +79,7 @@ def validate(scene: Scene, source: str = "scene") -> None:
 
 def read_file(path: PathLike) -> str:
     """The canonical text of the scene of a namelist file, read as the program reads it."""
-    result, status, message = _engine.bs_read_file(os.fsencode(os.fspath(path)))
+    result, status, message = engine_call(_engine.bs_read_file, os.fsencode(os.fspath(path)))
     if status != 0 and not os.path.exists(path):
         raise FileNotFoundError(_text(message))
     _check(status, message)
@@ -94,7 +95,7 @@ def read_namelist(path: PathLike) -> Scene:
 
 def sizes(scene: Scene) -> tuple[int, int, int, int]:
     """Records and snapshots of a complete run, nodes J+1 per snapshot, stops along the span."""
-    records, snapshots, nodes, stops, status, message = _engine.bs_sizes(_scene_text(scene), b"scene")
+    records, snapshots, nodes, stops, status, message = engine_call(_engine.bs_sizes, _scene_text(scene), b"scene")
     _check(status, message)
     return int(records), int(snapshots), int(nodes), int(stops)
 
@@ -131,7 +132,7 @@ class Stability:
 def stability(scene: Scene) -> Stability:
     """κ_h, the paper's κ̃ and the time-step limits of a scene (builds the model, does not run)."""
     (kappa_h, kappa_bound, kappa_contact, dt_newmark, dt_paper, dt_paper_bound, method, refused, refusal,
-     status, message) = _engine.bs_stability(_scene_text(scene), b"scene")
+     status, message) = engine_call(_engine.bs_stability, _scene_text(scene), b"scene")
     _check(status, message)
     return Stability(kappa_h=float(kappa_h), kappa_bound=float(kappa_bound), kappa_contact=float(kappa_contact),
                      kappa_method=_text(method), dt_limit_newmark=float(dt_newmark),
@@ -186,8 +187,8 @@ def run(scene: Scene, *, allow_incomplete: bool = False, shock_capacity: int = 4
     while True:
         (t, tip_u, tip_v, reaction, energy, work, dissipated, damped, snapshot_t, snapshot_x, snapshot_u, stops_x,
          stops_u, stops_reaction, filled, snaps, shocks, shock_count, shock_labels, stat_value, stat_half, stat_entries,
-         stat_labels, attribute_text, status, message) = _engine.bs_run(
-            text, b"scene", records, snapshots, nodes, stops, capacity, width)
+         stat_labels, attribute_text, status, message) = engine_call(
+            _engine.bs_run, text, b"scene", records, snapshots, nodes, stops, capacity, width)
         _check(status, message)
         if int(shock_count) <= capacity:
             break

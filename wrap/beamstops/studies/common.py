@@ -21,6 +21,7 @@ from typing import Any, Optional, TypeVar
 import numpy as np
 
 from .. import _engine
+from ..engine_call import engine_call
 from ..engine import _check, _scene_text, run, sizes
 from ..result import IncompleteRunError, Result
 from ..scene import Scene
@@ -72,7 +73,7 @@ def run_three_level(scene: Scene) -> tuple[np.ndarray, np.ndarray, float]:
     """The scene (law 'none') in the paper's three-level form (engine module beamstops_three_level):
     record times, tip displacement every ``record_every`` steps, and the loop's CPU time (s)."""
     records = sizes(scene)[0]
-    t, tip_u, cpu, status, message = _engine.bs_run_three_level(_scene_text(scene), b"scene", records)
+    t, tip_u, cpu, status, message = engine_call(_engine.bs_run_three_level, _scene_text(scene), b"scene", records)
     _check(status, message)
     return np.asarray(t), np.asarray(tip_u), float(cpu)
 
@@ -97,7 +98,7 @@ class States:
 def states(scene: Scene, times: Sequence[float]) -> States:
     """The engine's full state at the steps nearest ``times`` (wrapper ``bs_states``)."""
     steps = np.array([round(t / scene.dt) for t in times], dtype=np.int64)
-    u, v, mass, stiffness, cpu, status, message = _engine.bs_states(_scene_text(scene), b"scene", steps, 2 * scene.elements)
+    u, v, mass, stiffness, cpu, status, message = engine_call(_engine.bs_states, _scene_text(scene), b"scene", steps, 2 * scene.elements)
     _check(status, message)
     return States(steps=steps, u=np.asarray(u), v=np.asarray(v), mass=np.asarray(mass),
                   stiffness=np.asarray(stiffness), cpu_seconds=float(cpu))
