@@ -40,7 +40,7 @@ module beamstops_lockstep
    use beamstops_model, only: model_type, build_model, check_stability
    use beamstops_hermite, only: hermite_basis, gauss_points, gauss_weights
    use beamstops_band, only: band_matvec
-   use beamstops_band_solve, only: prepare_solver, prepare_diagonals, diagonal_matvec, dot, energy_sums
+   use beamstops_band_solve, only: prepare_solver, prepare_diagonals, energy_sums
    use beamstops_band_solve_lockstep, only: lockstep_forward, lockstep_forward_energy, lockstep_back_edge, &
       & lockstep_back_update, lockstep_matvec, lockstep_dot, lockstep_min_unknowns, lockstep_work_columns, &
       & lockstep_lanes, lockstep_matvec_rhs
@@ -671,7 +671,8 @@ contains
          ms%vec_d = ms%d(lane(k), :, chunk(k))
          ms%vec_su = ms%su(lane(k), :, chunk(k))
          call energy_sums(ops%solver, ops%mass, ms%vec_u, ms%vec_d, ms%vec_su, ms%vec_s, sums(1), sums(2), sums(3))
-         ms%rows(col_energy, k) = scenes(k)%mass_per_length*energy(model, sums(3), sums(1), sums(2), lanes(chunk(k))%u_old_su(lane(k)))
+         ms%rows(col_energy, k) = scenes(k)%mass_per_length*energy(model, sums(3), sums(1), sums(2), &
+            & lanes(chunk(k))%u_old_su(lane(k)))
          call recorders(k)%record(ms%rows(:, k))
       end do
    end subroutine advance_members

@@ -24,7 +24,7 @@ module beamstops_lockstep_general
    use beamstops_kinds, only: wp, ik
    use beamstops_scene, only: scene_type, law_signorini, law_compliance
    use beamstops_model, only: model_type
-   use beamstops_band_solve, only: diagonal_matvec, dot, energy_sums
+   use beamstops_band_solve, only: energy_sums
    use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_matvec_rhs, lockstep_forward, &
       & lockstep_forward_energy, lockstep_back, lockstep_update, lockstep_dot, lockstep_matvec
    use beamstops_band_solve_lockstep_general, only: lockstep_matvec_rhs_damped, lockstep_row
