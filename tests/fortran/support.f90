@@ -12,7 +12,7 @@ module test_support
    public :: band_eigenvalues, dense_eigenvalues, run_recorded, same_columns, int_text
    public :: basis_coefficients, product_integral, poly, exact_element, dense_assembly, lift, lift_prime
    public :: simpson_load, solve_spd
-   public :: base_scene, tube, balance_defect
+   public :: base_scene, tube, balance_defect, validated_model
 
 
 contains
@@ -229,6 +229,20 @@ contains
       if (info /= 0) call fatal_error(error, dsygv_message(info, n))
    end subroutine dense_eigenvalues
 
+   !> The model of a scene the engine's checks accept (validate_scene, then prepare_run, as
+   !> 'test scene').
+   subroutine validated_model(scene, model, error)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      !> Its model.
+      type(model_type), intent(out) :: model
+      !> Set when the scene is refused.
+      type(error_type), allocatable, intent(out) :: error
+      call validate_scene(scene, 'test scene', error)
+      if (allocated(error)) return
+      call prepare_run(scene, 'test scene', model, error)
+   end subroutine validated_model
+
    !> Validate, prepare and run a scene, every record kept in `rec`; the run must complete
    !> and fill exactly record_count(scene) rows.
    subroutine run_recorded(scene, rec, summary, error)
@@ -241,9 +255,7 @@ contains
       !> Set when the scene is refused or the run does not complete.
       type(error_type), allocatable, intent(out) :: error
       type(model_type) :: model
-      call validate_scene(scene, 'test scene', error)
-      if (allocated(error)) return
-      call prepare_run(scene, 'test scene', model, error)
+      call validated_model(scene, model, error)
       if (allocated(error)) return
       call rec%reserve(record_count(scene), 0_ik, scene%elements + 1, stop_count(scene))
       call simulate(scene, model, rec, summary, error)

@@ -4,9 +4,10 @@
 !> or a recorder that cannot write stops the run with status 'failed' and a message.
 module test_run
    use testing
-   use beamstops, only: ik, scene_type, validate_scene, model_type, prepare_run, simulate, array_recorder, &
+   use beamstops, only: ik, scene_type, model_type, simulate, array_recorder, &
       & run_summary, record_count, status_complete, status_failed, state_type, start_state
    use beamstops_run, only: continue_run
+   use test_support, only: validated_model
    use beamstops_checkpoint, only: read_checkpoint
    use beamstops_files, only: remove_file, file_exists
    implicit none
@@ -59,9 +60,7 @@ contains
       scene%t_end = 0.05_wp
       scene%record_every = 7
       scene%checkpoint_every = 300
-      call validate_scene(scene, 'test scene', error)
-      if (allocated(error)) return
-      call prepare_run(scene, 'test scene', model, error)
+      call validated_model(scene, model, error)
    end subroutine prepare
 
    !> Run from t = 0 with checkpoints into `rec`.

@@ -5,9 +5,10 @@
 module test_writer
    use hdf5, only: hid_t, h5fopen_f, h5fclose_f, H5F_ACC_RDONLY_F
    use testing
-   use beamstops, only: ik, scene_type, validate_scene, model_type, prepare_run, array_recorder, &
+   use beamstops, only: ik, scene_type, model_type, array_recorder, &
       & hdf5_recorder, run_summary, record_count, snapshot_count, status_complete, state_type, start_state
    use beamstops_recorder, only: col_t, col_u, col_energy, col_work
+   use test_support, only: validated_model
    use beamstops_recorder_hdf5_vector, only: read_vector
    use beamstops_run, only: continue_run
    use beamstops_files, only: remove_file, file_exists
@@ -40,9 +41,7 @@ contains
       scene%record_every = 1
       scene%snapshot_every = 97
       scene%checkpoint_every = 15000
-      call validate_scene(scene, 'test scene', error)
-      if (allocated(error)) return
-      call prepare_run(scene, 'test scene', model, error)
+      call validated_model(scene, model, error)
    end subroutine prepare
 
    subroutine test_thread(error)
