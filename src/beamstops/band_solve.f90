@@ -20,6 +20,7 @@ module beamstops_band_solve
    implicit none
    private
    public :: band_solver, prepare_solver, fused_solve, forward_substitution, back_substitution
+   public :: back_substitution_edge, back_substitution_update
    public :: forward_substitution_energy, energy_sums
    public :: band_diagonals, prepare_diagonals, diagonal_matvec, diagonal_row, dot
 
@@ -321,6 +322,92 @@ contains
       end if
       if (i - 1 >= 1) b(i - 1) = row(b(i - 1), off(1, i + 2), off(2, i + 1), off(3, i), xb, xc, xa)
    end subroutine back_rows
+
+   !> The first rows of back_substitution, x_n, x_{n-1} and x_{n-2} (all of it when n <= kd):
+   !> the tip value x_{n-1} that the contact law needs before the rest of the substitution,
+   !> back_substitution_update.
+   pure subroutine back_substitution_edge(solver, b)
+      !> Solver from prepare_solver.
+      type(band_solver), intent(in) :: solver
+      !> D^{-2} w (n); its last kd rows replaced by those of x.
+      real(wp), intent(inout), contiguous :: b(:)
+      integer :: n
+      n = solver%n
+      if (n <= kd) then
+         call back_substitution(solver, b)
+         return
+      end if
+      ! farthest value first (as back_rows)
+      b(n - 1) = b(n - 1) - solver%off(3, n)*b(n)
+      b(n - 2) = b(n - 2) - solver%off(2, n)*b(n) - solver%off(3, n - 1)*b(n - 1)
+   end subroutine back_substitution_edge
+
+   !> The rest of back_substitution after back_substitution_edge, each row of x followed at
+   !> once by its row of the update d^n = d^{n-1} + x + c z, u^{n+1} = u^n + d^n: the update
+   !> rides in the shadow of the substitution's chain instead of two passes of its own, and the
+   !> next forward pass, which starts from the first rows, finds them updated last. Per row the
+   !> same operations as back_substitution then beamstops_contact_tip_contact's update; x itself
+   !> is not stored (b keeps D^{-2} w below the edge rows).
+   pure subroutine back_substitution_update(solver, b, c, z, d, u)
+      !> Solver from prepare_solver.
+      type(band_solver), intent(in) :: solver
+      !> D^{-2} w (n) with its last kd rows from back_substitution_edge (all of x when n <= kd).
+      real(wp), intent(in), contiguous :: b(:)
+      !> Multiple of z.
+      real(wp), intent(in) :: c
+      !> z = A^{-1} e_tip (n).
+      real(wp), intent(in), contiguous :: z(:)
+      !> d^{n-1} and u^n on entry, d^n and u^{n+1} on return (n).
+      real(wp), intent(inout), contiguous :: d(:), u(:)
+      integer :: n
+      n = solver%n
+      if (n <= kd) then
+         d = d + b + c*z
+         u = u + d
+         return
+      end if
+      call back_update_rows(n, solver%off, b, c, z, d, u)
+   end subroutine back_substitution_update
+
+   !> The rows of back_substitution_update in one routine of explicit-shape arrays (as back_rows).
+   pure subroutine back_update_rows(n, off, b, c, z, d, u)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: off(kd, n), b(n), c, z(n)
+      real(wp), intent(inout) :: d(n), u(n)
+      real(wp) :: xa, xb, xc
+      integer :: i
+      xa = b(n)
+      xb = b(n - 1)
+      xc = b(n - 2)
+      d(n) = d(n) + xa + c*z(n)
+      u(n) = u(n) + d(n)
+      d(n - 1) = d(n - 1) + xb + c*z(n - 1)
+      u(n - 1) = u(n - 1) + d(n - 1)
+      d(n - 2) = d(n - 2) + xc + c*z(n - 2)
+      u(n - 2) = u(n - 2) + d(n - 2)
+      do i = n - kd, 3, -3
+         xa = row(b(i), off(1, i + 3), off(2, i + 2), off(3, i + 1), xa, xb, xc)
+         d(i) = d(i) + xa + c*z(i)
+         u(i) = u(i) + d(i)
+         xb = row(b(i - 1), off(1, i + 2), off(2, i + 1), off(3, i), xb, xc, xa)
+         d(i - 1) = d(i - 1) + xb + c*z(i - 1)
+         u(i - 1) = u(i - 1) + d(i - 1)
+         xc = row(b(i - 2), off(1, i + 1), off(2, i), off(3, i - 1), xc, xa, xb)
+         d(i - 2) = d(i - 2) + xc + c*z(i - 2)
+         u(i - 2) = u(i - 2) + d(i - 2)
+      end do
+      ! The first rows (fewer than three): xa, xb, xc hold x_{i+3}, x_{i+2}, x_{i+1}.
+      if (i >= 1) then
+         xa = row(b(i), off(1, i + 3), off(2, i + 2), off(3, i + 1), xa, xb, xc)
+         d(i) = d(i) + xa + c*z(i)
+         u(i) = u(i) + d(i)
+      end if
+      if (i - 1 >= 1) then
+         xb = row(b(i - 1), off(1, i + 2), off(2, i + 1), off(3, i), xb, xc, xa)
+         d(i - 1) = d(i - 1) + xb + c*z(i - 1)
+         u(i - 1) = u(i - 1) + d(i - 1)
+      end if
+   end subroutine back_update_rows
 
    !> One row of a substitution, b - o3 x3 - o2 x2 - o1 x1, with x1 the nearest value:
    !> subtracted last, it is the only input the row waits for.

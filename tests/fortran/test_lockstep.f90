@@ -19,7 +19,8 @@ module test_lockstep
    use beamstops_state, only: state_type
    use beamstops_model, only: build_model
    use beamstops_band_solve, only: band_solver, band_diagonals, prepare_solver, prepare_diagonals, diagonal_matvec, &
-      & forward_substitution, forward_substitution_energy, energy_sums, back_substitution, dot
+      & forward_substitution, forward_substitution_energy, energy_sums, back_substitution, dot, &
+      & back_substitution_edge, back_substitution_update
    use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_work_columns, lockstep_matvec, &
       & lockstep_forward, lockstep_forward_energy, lockstep_back, lockstep_dot, lockstep_update, lockstep_back_edge, &
       & lockstep_back_update
@@ -375,11 +376,50 @@ contains
                call update(v, c(k), model%z, w, uk)
                if (.not. (all(same_bits(w, y(k, :))) .and. all(same_bits(uk, ub(k, :))))) &
                   & call test_failed(error, where//'back substitution with the update, d and u, lane '//int_text(k))
+               ! and the one-member version of it (advance_fused's)
+               call same_back_update(solver, model%z, x(k, :), c(k), d(k, :), u(k, :), where, error)
             end do
             if (allocated(error)) return
          end do
       end do
+      ! the one-member back substitution with the update on meshes too small for lockstep
+      do a = 1, 3
+         scene%elements = a
+         call build_model(scene, model, error)
+         if (allocated(error)) return
+         call prepare_solver(model%factor, solver)
+         n = model%n
+         deallocate (v, w, uk)
+         allocate (v(n), w(n), uk(n))
+         call random_number(v)
+         call random_number(w)
+         call random_number(uk)
+         call same_back_update(solver, model%z, v - 0.5_wp, 0.3_wp, w, uk, 'J = '//int_text(a)//': ', error)
+         if (allocated(error)) return
+      end do
    end subroutine test_kernels
+
+   !> back_substitution_edge then back_substitution_update (x not stored, the update riding on
+   !> the substitution) against back_substitution then update: d and u to the bit.
+   subroutine same_back_update(solver, z, b, c, d, u, where, error)
+      type(band_solver), intent(in) :: solver
+      real(wp), intent(in) :: z(:), b(:), c, d(:), u(:)
+      character(len=*), intent(in) :: where
+      type(error_type), allocatable, intent(inout) :: error
+      real(wp) :: x(size(b)), d1(size(b)), u1(size(b)), d2(size(b)), u2(size(b))
+      x = b
+      call back_substitution(solver, x)
+      d1 = d
+      u1 = u
+      call update(x, c, z, d1, u1)
+      x = b
+      d2 = d
+      u2 = u
+      call back_substitution_edge(solver, x)
+      call back_substitution_update(solver, x, c, z, d2, u2)
+      if (.not. (all(same_bits(d1, d2)) .and. all(same_bits(u1, u2)))) &
+         & call test_failed(error, where//'one-member back substitution with the update, d and u')
+   end subroutine same_back_update
 
    subroutine test_one(error)
       type(error_type), allocatable, intent(out) :: error

@@ -18,7 +18,7 @@ module beamstops_contact_tip_contact
    implicit none
    private
    public :: spring_term, contact_law, tip_step, tip_step_massless, close_step, update, violation
-   public :: tip_outcome, tip_update, settle_tip, fix_tip
+   public :: tip_outcome, tip_law, settle_tip, fix_tip
 
    !> What the books of a step at the tip (settle_tip) need once the update is done.
    type :: tip_outcome
@@ -115,8 +115,9 @@ contains
       !> u^n_tip, d^{n-1}_tip and the reaction recorded with u^n.
       real(wp), intent(out) :: u_tip_prev, d_tip_prev, r_prev
       type(tip_outcome) :: outcome
-      real(wp) :: gd
-      call tip_update(scene, model, state, outcome)
+      real(wp) :: gd, c
+      call tip_law(scene, model, state, outcome, c)
+      call update(state%rhs, c, model%z, state%d, state%u)
       r_prev = state%reaction
       gd = dot(model%load, state%d)
       call fix_tip(scene, model, state, outcome%contact, outcome%tip_value, outcome%u_tip_prev, .true.)
@@ -126,24 +127,26 @@ contains
       d_tip_prev = outcome%d_tip_prev
    end subroutine tip_step
 
-   !> The contact law at the tip and the update of d and u (tip_step's first part; fix_tip then
-   !> sets the tip exactly on the stop, settle_tip books the step).
-   subroutine tip_update(scene, model, state, outcome)
+   !> The contact law at the tip (tip_step's first part; the update of d and u with c follows,
+   !> then fix_tip sets the tip exactly on the stop and settle_tip books the step). Needs only
+   !> the tip row of x = A^{-1} rhs in state%rhs.
+   subroutine tip_law(scene, model, state, outcome, c)
       !> Scene.
       type(scene_type), intent(in) :: scene
       !> Model.
       type(model_type), intent(in) :: model
-      !> State: rhs holds A^{-1} rhs on entry; u^{n+1} and d^n on return.
+      !> State at step n: state%rhs(tip) holds the tip row of A^{-1} rhs.
       type(state_type), intent(inout) :: state
       !> The step's contact, reaction and tip values (for fix_tip and settle_tip).
       type(tip_outcome), intent(out) :: outcome
-      real(wp) :: trial, c
+      !> Multiple of z in the update.
+      real(wp), intent(out) :: c
+      real(wp) :: trial
       outcome%d_tip_prev = state%d(model%tip)
       outcome%u_tip_prev = state%u(model%tip)
       trial = outcome%u_tip_prev + (outcome%d_tip_prev + state%rhs(model%tip))
       call contact_law(scene, model, state, trial, c, outcome%tip_value, outcome%r_step, outcome%contact)
-      call update(state%rhs, c, model%z, state%d, state%u)
-   end subroutine tip_update
+   end subroutine tip_law
 
    !> tip_step with a massless tip (mass redistribution, SPEC 10): the same law and update (the
    !> tip's row of rhs already holds its equilibrium), then the reaction of the step as the
