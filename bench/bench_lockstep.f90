@@ -83,6 +83,7 @@ program bench_lockstep
    call put('fma_per_ns', peak)
    call put('observe', real(observe, wp))
    call put('alone_ns_per_member_step', alone)
+   call put('alone_least_ns_per_member_step', minval(t_alone))
    print '(a)', ''
    write (line, '(a,i0,a,i0,a,i0,a)') '| J = ', elements, ' (n = ', n, '), ', steps, &
       & ' steps | ns per member-step | member-steps per s per core | × one at a time | floor ns | × floor |'
@@ -97,6 +98,8 @@ program bench_lockstep
       call table_row(trim(line), ns, max(floor_chain/groups(g), floor_ops))
       write (line, '(a,i0,a)') 'lockstep_', groups(g), '_ns_per_member_step'
       call put(trim(line), ns)
+      write (line, '(a,i0,a)') 'lockstep_', groups(g), '_least_ns_per_member_step'
+      call put(trim(line), minval(t_group(:, g)))
    end do
    print '(a)', ''
    write (line, '(a,f0.3,a,f0.1,a,f0.0,a)') 'multiply-add latency ', latency, ' ns, peak ', peak, &
