@@ -476,14 +476,7 @@ contains
       if (present(massless)) then
          if (size(massless) > 0) call equilibrium_rows(massless, row_scale, sigma_next, g, su, stiffness, d, rhs)
       end if
-      if (energy) then
-         call forward_substitution_energy(solver, mass, u, d, su, rhs, usu, dsu, dmd)
-      else
-         call forward_substitution(solver, rhs)
-         usu = 0
-         dsu = 0
-         dmd = 0
-      end if
+      call substitute_forward(solver, mass, n, u, d, su, energy, rhs, usu, dsu, dmd)
    end subroutine forward_pass
 
    !> forward_pass without its options (no massless rows, no damping), for advance_fused: arrays
@@ -512,6 +505,26 @@ contains
       call diagonal_matvec(stiffness, u, su)
       rhs = a*g - b*su
       rhs(n - 1) = rhs(n - 1) + spring
+      call substitute_forward(solver, mass, n, u, d, su, energy, rhs, usu, dsu, dmd)
+   end subroutine plain_forward_pass
+
+   !> The forward substitution of a pass, with the energy sums beside it when they are wanted
+   !> (0 otherwise).
+   subroutine substitute_forward(solver, mass, n, u, d, su, energy, rhs, usu, dsu, dmd)
+      !> Factor of A.
+      type(band_solver), intent(in) :: solver
+      !> M by diagonals.
+      type(band_diagonals), intent(in) :: mass
+      !> Unknowns.
+      integer, intent(in) :: n
+      !> u^n, d^{n-1} and S u^n.
+      real(wp), intent(in) :: u(n), d(n), su(n)
+      !> Whether the dot products are wanted.
+      logical, intent(in) :: energy
+      !> The right-hand side, replaced by D^{-2} w.
+      real(wp), intent(inout) :: rhs(n)
+      !> u.S u, d.S u and d.M d.
+      real(wp), intent(out) :: usu, dsu, dmd
       if (energy) then
          call forward_substitution_energy(solver, mass, u, d, su, rhs, usu, dsu, dmd)
       else
@@ -520,6 +533,6 @@ contains
          dsu = 0
          dmd = 0
       end if
-   end subroutine plain_forward_pass
+   end subroutine substitute_forward
 
 end module beamstops_scheme
