@@ -216,10 +216,11 @@ contains
    !> forward pass (plain_forward_pass). The contact law runs as soon as the back substitution's
    !> edge rows give the tip value; the update then rides on the rest of the substitution
    !> (back_substitution_update), so that the next forward pass finds its first rows updated
-   !> last and waits only for the tip set on the stop and the load averages moved on. The books of the step (g.d^n, the ledger, the observer, the record and the
-   !> snapshot: settle_held) wait until the next forward pass is under way, where they run in
-   !> the shadow of its chain; the record's energy comes from that pass's dot products. Same
-   !> operations on the same values as tip_step then close_step: the same bits.
+   !> last and waits only for the tip set on the stop and the load averages moved on. The books
+   !> of the step (g.d^n, the ledger, the observer, the record and the snapshot: settle_held)
+   !> wait until the next forward pass is under way, where they run in the shadow of its chain;
+   !> the record's energy comes from that pass's dot products. Same operations on the same values
+   !> as tip_step then close_step: the same bits.
    subroutine advance_fused(scene, model, state, recorder, last)
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
@@ -480,9 +481,9 @@ contains
    end subroutine forward_pass
 
    !> forward_pass without its options (no massless rows, no damping), for advance_fused: arrays
-   !> of explicit shape, so that a call passes addresses only (the descriptors and the optional
-   !> arguments of forward_pass cost about a hundred instructions a step, 5 % of the step).
-   !> The same operations: the same bits.
+   !> of explicit shape, so that a call passes addresses only (forward_pass builds and unpacks five
+   !> array descriptors and five optional arguments at every call; the README's "The Figure 4 run
+   !> against its targets" has the instruction counts). The same operations: the same bits.
    subroutine plain_forward_pass(stiffness, mass, solver, n, g, u, d, a, b, spring, energy, su, rhs, usu, dsu, dmd)
       !> S and M by diagonals.
       type(band_diagonals), intent(in) :: stiffness, mass
