@@ -441,11 +441,12 @@ contains
       type(statistics_table) :: table
       type(statistics_type) :: s
       real(wp), allocatable :: tb(:), nb(:), v(:), h(:)
-      real(wp) :: nn, tt, nan
+      real(wp) :: nn, tt, nan, t_all
       integer :: i, b, k, q
       s = self
       call keep(s)
       b = s%batches
+      t_all = all_finite_factor(b)
       nan = ieee_value(nan, ieee_quiet_nan)
       nb = real(s%bn, wp)
       tb = nb*s%dt
@@ -465,22 +466,22 @@ contains
       call put('contact_phases', '1', 'stop', v, spread(nan, 1, s%m))
       do i = 1, s%m
          v(i) = ratio(real(sum(s%bshocks(i, :)), wp), tt)
-         h(i) = batch_interval(ratios(real(s%bshocks(i, :), wp), tb))
+         h(i) = batch_interval(ratios(real(s%bshocks(i, :), wp), tb), t_all)
       end do
       call put('shocks_per_second', '1/s', 'stop', v, h)
       do i = 1, s%m
          v(i) = ratio(real(sum(s%brebounds(i, :)), wp), real(sum(s%bshocks(i, :)), wp))
-         h(i) = batch_interval(ratios(real(s%brebounds(i, :), wp), real(s%bshocks(i, :), wp)))
+         h(i) = batch_interval(ratios(real(s%brebounds(i, :), wp), real(s%bshocks(i, :), wp)), t_all)
       end do
       call put('rebounds_per_shock', '1', 'stop', v, h)
       do i = 1, s%m
          v(i) = ratio(sum(s%bsr(i, :)), nn)
-         h(i) = batch_interval(ratios(s%bsr(i, :), nb))
+         h(i) = batch_interval(ratios(s%bsr(i, :), nb), t_all)
       end do
       call put('force_mean', 'N', 'stop', v, h)
       do i = 1, s%m
          v(i) = sqrt(ratio(sum(s%bsrr(i, :)), nn))
-         h(i) = batch_interval(sqrt(ratios(s%bsrr(i, :), nb)))
+         h(i) = batch_interval(sqrt(ratios(s%bsrr(i, :), nb)), t_all)
       end do
       call put('force_rms', 'N', 'stop', v, h)
       do i = 1, s%m
@@ -490,17 +491,17 @@ contains
       call put('force_max', 'N', 'stop', v, spread(nan, 1, s%m))
       do i = 1, s%m
          v(i) = ratio(sum(s%bsr(i, :)), real(sum(s%bcontact(i, :)), wp))
-         h(i) = batch_interval(ratios(s%bsr(i, :), real(s%bcontact(i, :), wp)))
+         h(i) = batch_interval(ratios(s%bsr(i, :), real(s%bcontact(i, :), wp)), t_all)
       end do
       call put('force_mean_contact', 'N', 'stop', v, h)
       do i = 1, s%m
          v(i) = sqrt(ratio(sum(s%bsrr(i, :)), real(sum(s%bcontact(i, :)), wp)))
-         h(i) = batch_interval(sqrt(ratios(s%bsrr(i, :), real(s%bcontact(i, :), wp))))
+         h(i) = batch_interval(sqrt(ratios(s%bsrr(i, :), real(s%bcontact(i, :), wp))), t_all)
       end do
       call put('force_rms_contact', 'N', 'stop', v, h)
       do i = 1, s%m
          v(i) = ratio(sum(s%bdur(i, :)), real(sum(s%bshocks(i, :)), wp))
-         h(i) = batch_interval(ratios(s%bdur(i, :), real(s%bshocks(i, :), wp)))
+         h(i) = batch_interval(ratios(s%bdur(i, :), real(s%bshocks(i, :), wp)), t_all)
       end do
       call put('shock_duration_mean', 's', 'stop', v, h)
       do i = 1, s%m
@@ -515,21 +516,21 @@ contains
       call put('shock_duration_max', 's', 'stop', v, spread(nan, 1, s%m))
       do i = 1, s%m
          v(i) = ratio(real(sum(s%bcontact(i, :)), wp), nn)
-         h(i) = batch_interval(ratios(real(s%bcontact(i, :), wp), nb))
+         h(i) = batch_interval(ratios(real(s%bcontact(i, :), wp), nb), t_all)
       end do
       call put('contact_fraction', '1', 'stop', v, h)
       do i = 1, s%m
          v(i) = ratio(sum(s%bimp(i, :)), tt)
-         h(i) = batch_interval(ratios(s%bimp(i, :), tb))
+         h(i) = batch_interval(ratios(s%bimp(i, :), tb), t_all)
       end do
       call put('impulse_rate', 'N', 'stop', v, h)
       do i = 1, s%m
          v(i) = ratio(sum(s%bse(i, :)), tt)
-         h(i) = batch_interval(ratios(s%bse(i, :), tb))
+         h(i) = batch_interval(ratios(s%bse(i, :), tb), t_all)
       end do
       call put('power', 'W', 'stop', v, h)
-      call put('tip_mean', 'm', 'tip', [ratio(sum(s%bsu), nn)], [batch_interval(ratios(s%bsu, nb))])
-      call put('tip_rms', 'm', 'tip', [sqrt(ratio(sum(s%bsuu), nn))], [batch_interval(sqrt(ratios(s%bsuu, nb)))])
+      call put('tip_mean', 'm', 'tip', [ratio(sum(s%bsu), nn)], [batch_interval(ratios(s%bsu, nb), t_all)])
+      call put('tip_rms', 'm', 'tip', [sqrt(ratio(sum(s%bsuu), nn))], [batch_interval(sqrt(ratios(s%bsuu, nb)), t_all)])
       if (nn > 0) then
          call put('tip_min', 'm', 'tip', [minval(s%bumin)], [nan])
          call put('tip_max', 'm', 'tip', [maxval(s%bumax)], [nan])
@@ -541,7 +542,7 @@ contains
       allocate (v(s%bins), h(s%bins))
       do k = 1, s%bins
          v(k) = ratio(real(sum(s%bhist(k, :)), wp), nn)
-         h(k) = batch_interval(ratios(real(s%bhist(k, :), wp), nb))
+         h(k) = batch_interval(ratios(real(s%bhist(k, :), wp), nb), t_all)
       end do
       call put('tip_histogram', '1', 'bin', v, h)
       deallocate (v)
@@ -780,9 +781,13 @@ contains
 
    !> Half-width of the 95 % interval of the mean of the finite values x_j:
    !> t_{0.975, B'-1} s / sqrt(B'), s^2 = sum (x_j - mean)^2 / (B' - 1); NaN when B' < 2.
-   pure function batch_interval(x) result(h)
+   pure function batch_interval(x, t_all) result(h)
       !> Batch (or member) values; NaN entries are left out.
       real(wp), intent(in) :: x(:)
+      !> t_{0.975, B-1} for B = size(x), when the caller has it (all_finite_factor): the quantile
+      !> of the common case, all values finite, computed once for a whole table instead of by a
+      !> bisection at every call (a table of 40 histogram bins made its finish cost about 1 ms).
+      real(wp), intent(in), optional :: t_all
       real(wp) :: h
       real(wp) :: mean, s2
       integer :: nb
@@ -795,8 +800,21 @@ contains
       end if
       mean = sum(x, mask=use)/nb
       s2 = sum((x - mean)**2, mask=use)/(nb - 1)
-      h = student_t_quantile(0.975_wp, real(nb - 1, wp))*sqrt(s2/nb)
+      if (present(t_all) .and. nb == size(x)) then
+         h = t_all*sqrt(s2/nb)
+      else
+         h = student_t_quantile(0.975_wp, real(nb - 1, wp))*sqrt(s2/nb)
+      end if
    end function batch_interval
+
+   !> The factor t_{0.975, n-1} of batch_interval for n values, all finite (NaN when n < 2).
+   pure function all_finite_factor(n) result(t)
+      !> Number of values.
+      integer, intent(in) :: n
+      real(wp) :: t
+      t = student_t_quantile(0.975_wp, real(n - 1, wp))
+      if (n < 2) t = ieee_value(t, ieee_quiet_nan)
+   end function all_finite_factor
 
    !> Index of the quantity `name` in a table (0: none).
    pure integer function find(self, name)
@@ -829,6 +847,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: k, q, e, nk
       real(wp), allocatable :: x(:)
+      real(wp) :: t_all
       call validate_ensemble(size(members), 'ensemble', error)
       if (allocated(error)) return
       nk = size(members)
@@ -852,6 +871,7 @@ contains
       end do
       ensemble%quantity = members(1)%quantity
       allocate (x(nk))
+      t_all = all_finite_factor(nk)
       do q = 1, size(ensemble%quantity)
          if (ensemble%quantity(q)%axis == 'edge') cycle
          do e = 1, size(ensemble%quantity(q)%value)
@@ -863,7 +883,7 @@ contains
             else
                ensemble%quantity(q)%value(e) = ieee_value(x(1), ieee_quiet_nan)
             end if
-            ensemble%quantity(q)%half_width(e) = batch_interval(x)
+            ensemble%quantity(q)%half_width(e) = batch_interval(x, t_all)
          end do
       end do
    end subroutine ensemble_table
