@@ -84,6 +84,19 @@ def test_every_kind_is_known_to_the_command_line() -> None:
     assert {"impacts", "pdf", "psd", "poincare", "spacetime", "shape", "animation", "all"} <= set(plots.KINDS)
 
 
+def test_the_command_line_starts_without_matplotlib() -> None:
+    """``python -m beamstops`` builds its parser (every subcommand, plot's kinds included) without
+    importing matplotlib: it is imported when a plot is drawn, not at every start (it was about a
+    second of each ``python -m beamstops sweep ...``)."""
+    import subprocess
+    import sys
+
+    code = ("import sys; from beamstops.cli import build_parser; build_parser(); "
+            "print(sorted(m for m in sys.modules if m.split('.')[0] == 'matplotlib'))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == "[]"
+
+
 def test_spacetime_is_the_shape(result: beamstops.Result) -> None:
     assert plots.plot_spacetime is plots.plot_shape
     a, b = plots.figure(result, "shape"), plots.figure(result, "spacetime")

@@ -50,7 +50,7 @@ def _nonnegative(text: str) -> float:
 
 def register_plot(subparsers: argparse._SubParsersAction) -> None:
     """``plot OUT.h5 [-o PNG] [--kind KIND]``: draw a run written by ``beamstops run``."""
-    from .plots import KINDS
+    from .plot_kinds import KINDS
 
     parser = subparsers.add_parser("plot", help="plot the HDF5 output of `beamstops run`",
                                    description="Plot the HDF5 output of `beamstops run` (no display needed).")

@@ -35,6 +35,7 @@ from matplotlib import rc_context
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
+from .plot_kinds import FIGURE_KINDS, KINDS, TRANSIENT_KINDS
 from .plotbase import LINE as _LINE
 from .plotbase import STOP as _STOP
 from .plotbase import envelope as _envelope
@@ -50,14 +51,6 @@ from .transforms import after, stroboscopic
 __all__ = ["KINDS", "FIGURE_KINDS", "plot_tip", "plot_shape", "plot_spacetime", "plot_energy", "plot_phase",
            "plot_reaction", "plot_stop", "plot_impulses", "plot_impact_velocities", "plot_pdf", "plot_psd",
            "plot_poincare", "missing", "figure", "save"]
-
-#: Plot kinds understood by :func:`save` and ``python -m beamstops plot --kind``.
-KINDS = ("tip", "shape", "spacetime", "energy", "phase", "reaction", "stops", "impacts", "pdf", "psd", "poincare",
-         "animation", "all")
-#: The kinds that are still figures (:func:`figure`); 'animation' is written by :func:`save` only.
-FIGURE_KINDS = tuple(kind for kind in KINDS if kind != "animation")
-#: Kinds that take ``transient`` (s): only what comes after it is drawn.
-TRANSIENT_KINDS = ("pdf", "psd", "poincare")
 
 
 def plot_tip(result: Result, ax: Optional[Axes] = None, *, stops: bool = True,
