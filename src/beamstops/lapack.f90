@@ -2,6 +2,7 @@
 !> means, as a message (fortran-lang/stdlib's handle_<routine>_info, one per routine).
 !> Every other module calls LAPACK through these interfaces; none repeats them.
 module beamstops_lapack
+   use, intrinsic :: iso_c_binding, only: c_int
    use beamstops_kinds, only: wp
    use beamstops_strings, only: itoa
    implicit none
@@ -9,8 +10,14 @@ module beamstops_lapack
    public :: dpbtrf, dpbtrs, dsbgv, dsbgvx, dgbtrf, dgbtrs, dpotrf, dsygv
    public :: dpbtrf_message, dpbtrs_message, dsbgv_message, dsbgvx_message, dgbtrf_message, dgbtrs_message
    public :: dpotrf_message, dsygv_message
+   public :: openblas_loaded
 
    interface
+      !> 1 when the BLAS loaded is OpenBLAS, else 0 (blas_threads.c).
+      function openblas_loaded() bind(C, name='beamstops_openblas_loaded') result(loaded)
+         import :: c_int
+         integer(c_int) :: loaded
+      end function openblas_loaded
       !> Cholesky factorization of a symmetric positive definite band matrix.
       subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
          import :: wp

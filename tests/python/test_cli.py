@@ -424,3 +424,48 @@ def test_an_empty_partial_file_left_by_a_kill_is_replaced(tmp_path: Path) -> Non
     assert not (tmp_path / "out.h5.partial").exists()
     with h5py.File(tmp_path / "out.h5") as f:
         assert f.attrs["status"] == b"complete"
+
+
+def _environ_of(process: subprocess.Popen[bytes], wanted: str) -> str | None:
+    """The value of `wanted` in the running process's environment (/proc/PID/environ), polled
+    until it is there (the program may start itself again first) or the process ends."""
+    import time
+
+    path = Path(f"/proc/{process.pid}/environ")
+    while process.poll() is None:
+        try:
+            entries = path.read_bytes().split(b"\0")
+        except OSError:
+            entries = []
+        for entry in entries:
+            name, _, value = entry.decode(errors="replace").partition("=")
+            if name == wanted:
+                return value
+        time.sleep(0.005)
+    return None
+
+
+@pytest.mark.skipif(not Path("/proc/self/environ").exists(), reason="needs /proc")
+@pytest.mark.parametrize("chosen", [None, "2"])
+def test_run_keeps_a_threaded_openblas_to_one_thread_unless_told(chosen: str | None, tmp_path: Path) -> None:
+    """A threaded OpenBLAS spins its pool of threads for about 0.1 s of CPU at every start; `run`
+    starts itself again with OPENBLAS_NUM_THREADS=1 unless the user set it (or OMP_NUM_THREADS).
+    Checked on the running program's own environment; skipped when its BLAS is not OpenBLAS."""
+    ldd = shutil.which("ldd")
+    if ldd is None or "openblas" not in subprocess.run([ldd, PROGRAM], capture_output=True, text=True).stdout:
+        pytest.skip("the program's BLAS is not OpenBLAS")
+    scene = write(tmp_path, "&time dt=1e-6, t_end=2 /\n&output file='long.h5', record_every=1000 /\n")
+    env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")}
+    if chosen is not None:
+        env["OPENBLAS_NUM_THREADS"] = chosen
+    process = subprocess.Popen([PROGRAM, "run", str(scene)], cwd=tmp_path, env=env, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+    try:
+        seen = _environ_of(process, "OPENBLAS_NUM_THREADS")
+        assert process.wait(timeout=120) == 0
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert seen == (chosen or "1")
+    with h5py.File(tmp_path / "long.h5") as f:
+        assert f.attrs["status"] == b"complete"
