@@ -225,19 +225,12 @@ contains
       type(c_ptr), allocatable :: argv(:)
       character(len=:), allocatable :: folder, python
       integer(c_int) :: status
-      integer :: n, k, length
+      integer :: n, k
       n = command_argument_count()
       allocate (strings(n + 3), argv(n + 4))
       call set_string(strings(2), '-c')
       call set_string(strings(3), bootstrap)
-      do k = 1, n
-         call get_command_argument(k, length=length)
-         block
-            character(len=length) :: arg
-            if (length > 0) call get_command_argument(k, arg)
-            call set_string(strings(k + 3), arg)
-         end block
-      end do
+      call copy_arguments(1, strings(4:))
       folder = program_folder()
       if (len(folder) > 0) then
          do k = 1, 2
@@ -273,7 +266,7 @@ contains
       character(len=:), allocatable :: self
       integer(c_long) :: length
       integer(c_int) :: status
-      integer :: n, k, arg_length, env_length
+      integer :: n, k, env_length
       call get_environment_variable('OPENBLAS_NUM_THREADS', length=env_length, status=k)
       if (k /= 1) return
       call get_environment_variable('OMP_NUM_THREADS', length=env_length, status=k)
@@ -288,17 +281,26 @@ contains
       if (c_setenv('OPENBLAS_NUM_THREADS'//c_null_char, '1'//c_null_char, 1_c_int) /= 0) return
       n = command_argument_count()
       allocate (strings(n + 1), argv(n + 2))
-      do k = 0, n
-         call get_command_argument(k, length=arg_length)
-         block
-            character(len=arg_length) :: arg
-            if (arg_length > 0) call get_command_argument(k, arg)
-            call set_string(strings(k + 1), arg)
-         end block
-      end do
+      call copy_arguments(0, strings)
       call set_argv(strings, argv)
       status = c_execv(self//c_null_char, argv)
    end subroutine one_blas_thread
+
+   !> The command's arguments from `first` on (0: the command's own name) as C strings, in
+   !> strings(1), strings(2), ...
+   subroutine copy_arguments(first, strings)
+      integer, intent(in) :: first
+      type(c_string), intent(inout) :: strings(:)
+      integer :: k, length
+      do k = first, command_argument_count()
+         call get_command_argument(k, length=length)
+         block
+            character(len=length) :: arg
+            if (length > 0) call get_command_argument(k, arg)
+            call set_string(strings(k - first + 1), arg)
+         end block
+      end do
+   end subroutine copy_arguments
 
    !> execv's argument vector: the addresses of `strings`, then a null pointer.
    subroutine set_argv(strings, argv)
