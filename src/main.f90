@@ -20,7 +20,7 @@ program beamstops_main
    use beamstops_reduced, only: reduced_model_type, build_reduced, check_stability_reduced
    use beamstops_reduced_scheme, only: reduced_state_type, start_reduced
    use beamstops_reduced_checkpoint, only: read_reduced_checkpoint
-   use beamstops_lapack, only: openblas_loaded
+   use beamstops_lapack, only: openblas_one_thread
    implicit none
 
    interface
@@ -48,12 +48,6 @@ program beamstops_main
          type(c_ptr), intent(in) :: argv(*)
          integer(c_int) :: status
       end function c_execv
-      function c_setenv(name, value, overwrite) bind(c, name='setenv') result(status)
-         import :: c_char, c_int
-         character(kind=c_char), intent(in) :: name(*), value(*)
-         integer(c_int), value :: overwrite
-         integer(c_int) :: status
-      end function c_setenv
       function c_execvp(file, argv) bind(c, name='execvp') result(status)
          import :: c_char, c_ptr, c_int
          character(kind=c_char), intent(in) :: file(*)
@@ -256,34 +250,15 @@ contains
    !> sleep, whatever the program does (perf of a batch of eight 50,000-step sweep points: 0.22 s
    !> of CPU, 0.13 s with OPENBLAS_NUM_THREADS=1; the pool's spin the largest entry). The engine's
    !> LAPACK calls are small, and a sweep's processes share the cores, so unless the user chose
-   !> (OPENBLAS_NUM_THREADS or OMP_NUM_THREADS set) the program sets OPENBLAS_NUM_THREADS=1 and
-   !> starts itself again with the same arguments (execv of /proc/self/exe) before any work.
-   !> With another BLAS, or when any of this fails, it goes on as it is.
+   !> (OPENBLAS_NUM_THREADS or OMP_NUM_THREADS set) the program puts OpenBLAS on one thread and
+   !> stops its pool before any work (blas_threads.c; nothing with another BLAS).
    subroutine one_blas_thread()
-      type(c_string), allocatable, target :: strings(:)
-      type(c_ptr), allocatable :: argv(:)
-      character(kind=c_char) :: buffer(4096)
-      character(len=:), allocatable :: self
-      integer(c_long) :: length
-      integer(c_int) :: status
-      integer :: n, k, env_length
-      call get_environment_variable('OPENBLAS_NUM_THREADS', length=env_length, status=k)
-      if (k /= 1) return
-      call get_environment_variable('OMP_NUM_THREADS', length=env_length, status=k)
-      if (k /= 1) return
-      if (openblas_loaded() == 0) return
-      length = c_readlink('/proc/self/exe'//c_null_char, buffer, int(size(buffer), c_size_t))
-      if (length <= 0 .or. length >= size(buffer)) return
-      allocate (character(len=int(length)) :: self)
-      do k = 1, int(length)
-         self(k:k) = buffer(k)
-      end do
-      if (c_setenv('OPENBLAS_NUM_THREADS'//c_null_char, '1'//c_null_char, 1_c_int) /= 0) return
-      n = command_argument_count()
-      allocate (strings(n + 1), argv(n + 2))
-      call copy_arguments(0, strings)
-      call set_argv(strings, argv)
-      status = c_execv(self//c_null_char, argv)
+      integer :: status
+      call get_environment_variable('OPENBLAS_NUM_THREADS', status=status)
+      if (status /= 1) return
+      call get_environment_variable('OMP_NUM_THREADS', status=status)
+      if (status /= 1) return
+      status = openblas_one_thread()
    end subroutine one_blas_thread
 
    !> The command's arguments from `first` on (0: the command's own name) as C strings, in

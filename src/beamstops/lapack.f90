@@ -10,14 +10,15 @@ module beamstops_lapack
    public :: dpbtrf, dpbtrs, dsbgv, dsbgvx, dgbtrf, dgbtrs, dpotrf, dsygv
    public :: dpbtrf_message, dpbtrs_message, dsbgv_message, dsbgvx_message, dgbtrf_message, dgbtrs_message
    public :: dpotrf_message, dsygv_message
-   public :: openblas_loaded
+   public :: openblas_one_thread
 
    interface
-      !> 1 when the BLAS loaded is OpenBLAS, else 0 (blas_threads.c).
-      function openblas_loaded() bind(C, name='beamstops_openblas_loaded') result(loaded)
+      !> OpenBLAS on one thread, its pool of threads stopped (blas_threads.c): 1 when done, 0
+      !> when the BLAS is not OpenBLAS.
+      function openblas_one_thread() bind(C, name='beamstops_openblas_one_thread') result(done)
          import :: c_int
-         integer(c_int) :: loaded
-      end function openblas_loaded
+         integer(c_int) :: done
+      end function openblas_one_thread
       !> Cholesky factorization of a symmetric positive definite band matrix.
       subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
          import :: wp
