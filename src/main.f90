@@ -219,12 +219,19 @@ contains
       type(c_ptr), allocatable :: argv(:)
       character(len=:), allocatable :: folder, python
       integer(c_int) :: status
-      integer :: n, k
+      integer :: n, k, length
       n = command_argument_count()
       allocate (strings(n + 3), argv(n + 4))
       call set_string(strings(2), '-c')
       call set_string(strings(3), bootstrap)
-      call copy_arguments(1, strings(4:))
+      do k = 1, n
+         call get_command_argument(k, length=length)
+         block
+            character(len=length) :: arg
+            if (length > 0) call get_command_argument(k, arg)
+            call set_string(strings(k + 3), arg)
+         end block
+      end do
       folder = program_folder()
       if (len(folder) > 0) then
          do k = 1, 2
@@ -260,22 +267,6 @@ contains
       if (status /= 1) return
       status = openblas_one_thread()
    end subroutine one_blas_thread
-
-   !> The command's arguments from `first` on (0: the command's own name) as C strings, in
-   !> strings(1), strings(2), ...
-   subroutine copy_arguments(first, strings)
-      integer, intent(in) :: first
-      type(c_string), intent(inout) :: strings(:)
-      integer :: k, length
-      do k = first, command_argument_count()
-         call get_command_argument(k, length=length)
-         block
-            character(len=length) :: arg
-            if (length > 0) call get_command_argument(k, arg)
-            call set_string(strings(k - first + 1), arg)
-         end block
-      end do
-   end subroutine copy_arguments
 
    !> execv's argument vector: the addresses of `strings`, then a null pointer.
    subroutine set_argv(strings, argv)

@@ -446,7 +446,7 @@ contains
       s = self
       call keep(s)
       b = s%batches
-      t_all = all_finite_factor(b)
+      t_all = interval_factor(b)
       nan = ieee_value(nan, ieee_quiet_nan)
       nb = real(s%bn, wp)
       tb = nb*s%dt
@@ -784,10 +784,10 @@ contains
    pure function batch_interval(x, t_all) result(h)
       !> Batch (or member) values; NaN entries are left out.
       real(wp), intent(in) :: x(:)
-      !> t_{0.975, B-1} for B = size(x), when the caller has it (all_finite_factor): the quantile
-      !> of the common case, all values finite, computed once for a whole table instead of by a
-      !> bisection at every call (a table of 40 histogram bins made its finish cost about 1 ms).
-      real(wp), intent(in), optional :: t_all
+      !> interval_factor(size(x)), the factor of the common case, all values finite: computed once
+      !> for a whole table by the caller instead of by a bisection at every call (a table of 40
+      !> histogram bins made its finish cost about 1 ms).
+      real(wp), intent(in) :: t_all
       real(wp) :: h
       real(wp) :: mean, s2
       integer :: nb
@@ -800,21 +800,21 @@ contains
       end if
       mean = sum(x, mask=use)/nb
       s2 = sum((x - mean)**2, mask=use)/(nb - 1)
-      if (present(t_all) .and. nb == size(x)) then
+      if (nb == size(x)) then
          h = t_all*sqrt(s2/nb)
       else
-         h = student_t_quantile(0.975_wp, real(nb - 1, wp))*sqrt(s2/nb)
+         h = interval_factor(nb)*sqrt(s2/nb)
       end if
    end function batch_interval
 
-   !> The factor t_{0.975, n-1} of batch_interval for n values, all finite (NaN when n < 2).
-   pure function all_finite_factor(n) result(t)
-      !> Number of values.
+   !> The factor t_{0.975, n-1} of batch_interval for n finite values (NaN when n < 2:
+   !> student_t_quantile's for dof <= 0).
+   pure function interval_factor(n) result(t)
+      !> Number of finite values.
       integer, intent(in) :: n
       real(wp) :: t
       t = student_t_quantile(0.975_wp, real(n - 1, wp))
-      if (n < 2) t = ieee_value(t, ieee_quiet_nan)
-   end function all_finite_factor
+   end function interval_factor
 
    !> Index of the quantity `name` in a table (0: none).
    pure integer function find(self, name)
@@ -871,7 +871,7 @@ contains
       end do
       ensemble%quantity = members(1)%quantity
       allocate (x(nk))
-      t_all = all_finite_factor(nk)
+      t_all = interval_factor(nk)
       do q = 1, size(ensemble%quantity)
          if (ensemble%quantity(q)%axis == 'edge') cycle
          do e = 1, size(ensemble%quantity(q)%value)
