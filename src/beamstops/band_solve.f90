@@ -21,7 +21,7 @@ module beamstops_band_solve
    private
    public :: band_solver, prepare_solver, fused_solve, forward_substitution, back_substitution
    public :: back_substitution_edge, back_substitution_update
-   public :: forward_substitution_energy, energy_sums
+   public :: energy_dots
    public :: band_diagonals, prepare_diagonals, diagonal_matvec, diagonal_row, dot
 
    !> The factor of A = M + dt^2 beta S in the form the fused substitutions read.
@@ -33,6 +33,9 @@ module beamstops_band_solve
       !> 1/U(j,j)^2 (n).
       real(wp), allocatable :: inv_d2(:)
    end type band_solver
+
+   !> Partial sums of energy_dots (rows a vector operation).
+   integer, parameter :: energy_lanes = 4
 
    !> A symmetric kd = 3 band matrix stored by diagonals, the layout a vectorized product reads.
    type :: band_diagonals
@@ -117,129 +120,78 @@ contains
       call last_rows(n, off, inv_d2, j, b, xa, xb, xc)
    end subroutine forward_rows
 
-   !> forward_substitution with, in the shadow of its chain, the dot products of the discrete
-   !> energy: usu = u.su, dsu = d.su and dmd = d.M d = sum_j d_j (M_jj d_j + 2 sum_k M_j-k,j d_j-k)
-   !> (M by diagonals). Each sum is one multiply-add a row on its own chain, beside the
-   !> substitution's.
-   pure subroutine forward_substitution_energy(solver, mass, u, d, su, b, usu, dsu, dmd)
-      !> Solver from prepare_solver.
-      type(band_solver), intent(in) :: solver
+   !> The dot products of the discrete energy: usu = u.su, dsu = d.su and dmd = d.M d =
+   !> sum_j d_j (M_jj d_j + 2 sum_k M_j-k,j d_j-k) (M by diagonals), each in four partial sums
+   !> (row j in sum mod(j - 1, 4) + 1, so that four rows are one vector operation) added as
+   !> (s1 + s2) + (s3 + s4) at the end: a fixed order, with no running sum of products for the
+   !> compiler to round apart (beamstops_band_solve_lockstep's lockstep_energy_dots does the
+   !> same for each member).
+   pure subroutine energy_dots(mass, u, d, su, usu, dsu, dmd)
       !> M by diagonals.
       type(band_diagonals), intent(in) :: mass
       !> u, d and su (n).
       real(wp), intent(in), contiguous :: u(:), d(:), su(:)
-      !> Right-hand side b (n), replaced by D^{-2} w.
-      real(wp), intent(inout), contiguous :: b(:)
       !> u.su, d.su and d.M d.
       real(wp), intent(out) :: usu, dsu, dmd
-      real(wp) :: xa, xb, xc
       integer :: i, j, n
-      n = solver%n
-      associate (off => solver%off, inv_d2 => solver%inv_d2, m => mass%a)
-         if (n < 2*kd) then
-            call forward_substitution(solver, b)
-            usu = dot_product(u, su)
-            dsu = dot_product(d, su)
-            dmd = 0
-            do j = 1, n
-               xa = m(j, 0)*d(j)
-               do i = max(1, j - kd), j - 1
-                  xa = xa + 2*m(j, j - i)*d(i)
-               end do
-               dmd = dmd + d(j)*xa
+      real(wp) :: t
+      n = mass%n
+      if (n < energy_lanes) then
+         usu = 0
+         dsu = 0
+         dmd = 0
+         do j = 1, n
+            t = mass%a(j, 0)*d(j)
+            do i = max(1, j - kd), j - 1
+               t = t + 2*mass%a(j, j - i)*d(i)
             end do
-            return
-         end if
-         call first_rows(n, off, inv_d2, b, xa, xb, xc)
-         usu = u(1)*su(1) + u(2)*su(2) + u(3)*su(3)
-         dsu = d(1)*su(1) + d(2)*su(2) + d(3)*su(3)
-         dmd = d(1)*m(1, 0)*d(1) + d(2)*(m(2, 0)*d(2) + 2*m(2, 1)*d(1)) &
-            & + d(3)*(m(3, 0)*d(3) + 2*(m(3, 1)*d(2) + m(3, 2)*d(1)))
-         j = kd + 1
-         call energy_rows(n, off, inv_d2, m, u, d, su, b, j, xa, xb, xc, usu, dsu, dmd)
-         call last_rows(n, off, inv_d2, j, b, xa, xb, xc)
-         do i = j, n
-            usu = usu + u(i)*su(i)
-            dsu = dsu + d(i)*su(i)
-            dmd = dmd + d(i)*(m(i, 0)*d(i) + 2*(m(i, 1)*d(i - 1) + m(i, 2)*d(i - 2) + m(i, 3)*d(i - 3)))
+            usu = usu + u(j)*su(j)
+            dsu = dsu + d(j)*su(j)
+            dmd = dmd + d(j)*t
          end do
-      end associate
-   end subroutine forward_substitution_energy
+         return
+      end if
+      call energy_rows(n, mass%a, u, d, su, usu, dsu, dmd)
+   end subroutine energy_dots
 
-   !> The sums of forward_substitution_energy (u.su, d.su and d.M d) without a right-hand side
-   !> of interest: that routine on `scratch` set to zero, so that the sums are its bits (the
-   !> compiler rounds some of its terms apart, see beamstops_band_solve_lockstep; a loop of the
-   !> sums alone would not). For a record whose sums were not taken beside a substitution: the
-   !> record of the last step of a block.
-   pure subroutine energy_sums(solver, mass, u, d, su, scratch, usu, dsu, dmd)
-      !> Solver from prepare_solver.
-      type(band_solver), intent(in) :: solver
-      !> M by diagonals.
-      type(band_diagonals), intent(in) :: mass
-      !> u, d and su (n).
-      real(wp), intent(in), contiguous :: u(:), d(:), su(:)
-      !> Work vector (n).
-      real(wp), intent(out), contiguous :: scratch(:)
-      !> u.su, d.su and d.M d.
-      real(wp), intent(out) :: usu, dsu, dmd
-      scratch = 0
-      call forward_substitution_energy(solver, mass, u, d, su, scratch, usu, dsu, dmd)
-   end subroutine energy_sums
-
-   !> The loop of forward_substitution_energy, three rows a turn from row j (= kd + 1) while
-   !> a whole turn fits; on return j is the first row left. Explicit-shape arrays and local sums
-   !> and values, so that the compiler keeps every running value in a register and every array
-   !> at a fixed stride (inlined in the caller, with its dummies and descriptors, gfortran stored
-   !> the three sums and reloaded a dozen array addresses from the stack at every turn; this
-   !> loop is about 10 % of a recorded step faster, with the same operations: the same bits).
-   pure subroutine energy_rows(n, off, inv_d2, m, u, d, su, b, j, xa, xb, xc, usu, dsu, dmd)
+   !> The rows of energy_dots for n >= 4 in explicit-shape arrays: the first four rows written
+   !> out (fewer neighbours), then four rows a turn, then the last rows (fewer than four). The
+   !> turn is a loop over the four lanes kept as a loop (unroll 1) and vectorized: one vector
+   !> operation per term, as each member's in beamstops_band_solve_lockstep. Unrolled, gfortran
+   !> vectorized the turns' loop instead, each partial sum a reduction in order (products
+   !> rounded apart, 617 instructions a step where this takes about 250).
+   pure subroutine energy_rows(n, m, u, d, su, usu, dsu, dmd)
       integer, intent(in) :: n
-      real(wp), intent(in) :: off(kd, n), inv_d2(n), m(n, 0:kd), u(n), d(n), su(n)
-      real(wp), intent(inout) :: b(n)
-      integer, intent(inout) :: j
-      real(wp), intent(inout) :: xa, xb, xc, usu, dsu, dmd
-      real(wp) :: ra, rb, rc, s_usu, s_dsu, s_dmd, da, db, dc, d1, d2, d3
-      integer :: k
-      ra = xa
-      rb = xb
-      rc = xc
-      s_usu = usu
-      s_dsu = dsu
-      s_dmd = dmd
-      da = d(j - 3)
-      db = d(j - 2)
-      dc = d(j - 1)
-      do k = j, n - 2, 3
-         ra = row(b(k), off(1, k), off(2, k), off(3, k), ra, rb, rc)
-         b(k) = ra*inv_d2(k)
-         rb = row(b(k + 1), off(1, k + 1), off(2, k + 1), off(3, k + 1), rb, rc, ra)
-         b(k + 1) = rb*inv_d2(k + 1)
-         rc = row(b(k + 2), off(1, k + 2), off(2, k + 2), off(3, k + 2), rc, ra, rb)
-         b(k + 2) = rc*inv_d2(k + 2)
-         ! the sums, d_{k-3..k+2} loaded once (da, db, dc: the three before row k)
-         d1 = d(k)
-         d2 = d(k + 1)
-         d3 = d(k + 2)
-         s_usu = s_usu + u(k)*su(k)
-         s_dsu = s_dsu + d1*su(k)
-         s_dmd = s_dmd + d1*(m(k, 0)*d1 + 2*(m(k, 1)*dc + m(k, 2)*db + m(k, 3)*da))
-         s_usu = s_usu + u(k + 1)*su(k + 1)
-         s_dsu = s_dsu + d2*su(k + 1)
-         s_dmd = s_dmd + d2*(m(k + 1, 0)*d2 + 2*(m(k + 1, 1)*d1 + m(k + 1, 2)*dc + m(k + 1, 3)*db))
-         s_usu = s_usu + u(k + 2)*su(k + 2)
-         s_dsu = s_dsu + d3*su(k + 2)
-         s_dmd = s_dmd + d3*(m(k + 2, 0)*d3 + 2*(m(k + 2, 1)*d2 + m(k + 2, 2)*d1 + m(k + 2, 3)*dc))
-         da = d1
-         db = d2
-         dc = d3
+      real(wp), intent(in) :: m(n, 0:kd), u(n), d(n), su(n)
+      real(wp), intent(out) :: usu, dsu, dmd
+      real(wp) :: a(energy_lanes), b(energy_lanes), c(energy_lanes)
+      integer :: j, l
+      a = u(1:4)*su(1:4)
+      b = d(1:4)*su(1:4)
+      c(1) = d(1)*(m(1, 0)*d(1))
+      c(2) = d(2)*(m(2, 0)*d(2) + 2*(m(2, 1)*d(1)))
+      c(3) = d(3)*(m(3, 0)*d(3) + 2*(m(3, 1)*d(2) + m(3, 2)*d(1)))
+      c(4) = d(4)*(m(4, 0)*d(4) + 2*(m(4, 1)*d(3) + m(4, 2)*d(2) + m(4, 3)*d(1)))
+      do j = energy_lanes + 1, n - energy_lanes + 1, energy_lanes
+!GCC$ unroll 1
+!GCC$ ivdep
+!GCC$ vector
+         do l = 0, energy_lanes - 1
+            a(l + 1) = a(l + 1) + u(j + l)*su(j + l)
+            b(l + 1) = b(l + 1) + d(j + l)*su(j + l)
+            c(l + 1) = c(l + 1) + d(j + l)*(m(j + l, 0)*d(j + l) + 2*(m(j + l, 1)*d(j + l - 1) &
+               & + m(j + l, 2)*d(j + l - 2) + m(j + l, 3)*d(j + l - 3)))
+         end do
       end do
-      j = k
-      xa = ra
-      xb = rb
-      xc = rc
-      usu = s_usu
-      dsu = s_dsu
-      dmd = s_dmd
+      do l = 1, n - j + 1
+         a(l) = a(l) + u(j + l - 1)*su(j + l - 1)
+         b(l) = b(l) + d(j + l - 1)*su(j + l - 1)
+         c(l) = c(l) + d(j + l - 1)*(m(j + l - 1, 0)*d(j + l - 1) + 2*(m(j + l - 1, 1)*d(j + l - 2) &
+            & + m(j + l - 1, 2)*d(j + l - 3) + m(j + l - 1, 3)*d(j + l - 4)))
+      end do
+      usu = (a(1) + a(2)) + (a(3) + a(4))
+      dsu = (b(1) + b(2)) + (b(3) + b(4))
+      dmd = (c(1) + c(2)) + (c(3) + c(4))
    end subroutine energy_rows
 
    !> The first three rows of the forward substitution (n >= 3): b(1:3) replaced by

@@ -9,14 +9,11 @@
 !> Bit for bit: every routine performs, for each lane, the floating-point operations of its
 !> one-member counterpart in beamstops_band_solve, in the same order, with the same expressions
 !> and the same multiply-adds. The one-member routines are what the compiler made of them, and
-!> in two places it rounds a product before adding it (gfortran 12, -O3, znver3: where a
-!> running sum is a reduction it vectorizes in order, or a chain it keeps apart from multiply-adds):
-!> - forward_substitution_energy's three sums over the rows after its last triple of rows, when
-!>   there are two (n - 3 = 2 mod 3): each term rounded before it is added (one row: a
-!>   multiply-add); the sums start with u1 s1 + u2 s2 + u3 s3 as fma(u3, s3, fma(u1, s1, u2 s2));
-!> - dot's rows after the last eight, when four or more: the next four products rounded and
-!>   added in order, the rest by multiply-adds.
-!> Here those places round explicitly (add_rounded, subtract_rounded); everywhere else the
+!> in one place it rounds a product before adding it (gfortran 12, -O3, znver3: a running sum
+!> it vectorizes in order): dot's rows after the last eight, when four or more: the next four
+!> products rounded and added in order, the rest by multiply-adds. (The energy sums keep
+!> partial sums per row lane, energy_dots, so that no such place arises there.)
+!> Here that place rounds explicitly (add_rounded); everywhere else the
 !> multiply-adds are the compiler's, as in the one-member routines. tests/fortran/test_lockstep.f90
 !> checks every kernel lane by lane against its one-member counterpart (J = 4..13, 19, 20, 100,
 !> 101), and whole runs against the one-scene path: a change of compiler, flags or of
@@ -29,7 +26,7 @@ module beamstops_band_solve_lockstep
    use beamstops_band_solve, only: band_solver, band_diagonals
    implicit none
    private
-   public :: lockstep_forward, lockstep_forward_energy, lockstep_back, lockstep_matvec, lockstep_dot
+   public :: lockstep_forward, lockstep_energy_dots, lockstep_back, lockstep_matvec, lockstep_dot
    public :: lockstep_rhs, lockstep_update, lockstep_matvec_rhs
    public :: lockstep_back_edge, lockstep_back_update
    public :: lockstep_min_unknowns, lockstep_work_columns, lockstep_lanes
@@ -116,101 +113,69 @@ contains
       end if
    end subroutine forward_last_rows
 
-   !> lockstep_forward with the dot products of the discrete energy of every lane beside it
-   !> (beamstops_band_solve's forward_substitution_energy): usu = u.su, dsu = d.su, dmd = d.M d.
-   pure subroutine lockstep_forward_energy(solver, mass, u, d, su, b, usu, dsu, dmd, work)
-      !> Solver from prepare_solver.
-      type(band_solver), intent(in) :: solver
+   !> The dot products of the discrete energy of every lane (beamstops_band_solve's
+   !> energy_dots): usu = u.su, dsu = d.su, dmd = d.M d, each in four partial sums per lane (row j
+   !> in sum mod(j - 1, 4) + 1) added as (s1 + s2) + (s3 + s4).
+   pure subroutine lockstep_energy_dots(mass, u, d, su, usu, dsu, dmd)
       !> M by diagonals.
       type(band_diagonals), intent(in) :: mass
       !> u, d and su of every lane (lanes, n).
-      real(wp), intent(in) :: u(lockstep_lanes, solver%n), d(lockstep_lanes, solver%n), su(lockstep_lanes, solver%n)
-      !> Right-hand sides (lanes, n), replaced by D^{-2} w.
-      real(wp), intent(inout) :: b(lockstep_lanes, solver%n)
+      real(wp), intent(in) :: u(lockstep_lanes, mass%n), d(lockstep_lanes, mass%n), su(lockstep_lanes, mass%n)
       !> u.su, d.su and d.M d of every lane (lanes).
       real(wp), intent(out) :: usu(lockstep_lanes), dsu(lockstep_lanes), dmd(lockstep_lanes)
-      !> Work array (lanes, lockstep_work_columns).
-      real(wp), intent(out) :: work(lockstep_lanes, lockstep_work_columns)
-      real(wp) :: xa(lockstep_lanes), xb(lockstep_lanes), xc(lockstep_lanes)
-      integer :: i, j, k, n
-      n = solver%n
-      associate (off => solver%off, inv_d2 => solver%inv_d2, m => mass%a)
-         call forward_first_rows(off, inv_d2, n, b, xa, xb, xc)
-!GCC$ ivdep
-!GCC$ vector
-         do k = 1, lockstep_lanes
-            usu(k) = u(k, 1)*su(k, 1) + u(k, 2)*su(k, 2) + u(k, 3)*su(k, 3)
-            dsu(k) = d(k, 1)*su(k, 1) + d(k, 2)*su(k, 2) + d(k, 3)*su(k, 3)
-            dmd(k) = d(k, 1)*m(1, 0)*d(k, 1) + d(k, 2)*(m(2, 0)*d(k, 2) + 2*m(2, 1)*d(k, 1)) &
-               & + d(k, 3)*(m(3, 0)*d(k, 3) + 2*(m(3, 1)*d(k, 2) + m(3, 2)*d(k, 1)))
-         end do
-         do j = kd + 1, n - 2, 3
-!GCC$ ivdep
-!GCC$ vector
-            do k = 1, lockstep_lanes
-               xa(k) = b(k, j) - off(1, j)*xa(k) - off(2, j)*xb(k) - off(3, j)*xc(k)
-               b(k, j) = xa(k)*inv_d2(j)
-               xb(k) = b(k, j + 1) - off(1, j + 1)*xb(k) - off(2, j + 1)*xc(k) - off(3, j + 1)*xa(k)
-               b(k, j + 1) = xb(k)*inv_d2(j + 1)
-               xc(k) = b(k, j + 2) - off(1, j + 2)*xc(k) - off(2, j + 2)*xa(k) - off(3, j + 2)*xb(k)
-               b(k, j + 2) = xc(k)*inv_d2(j + 2)
-               usu(k) = usu(k) + u(k, j)*su(k, j)
-               dsu(k) = dsu(k) + d(k, j)*su(k, j)
-               dmd(k) = dmd(k) + d(k, j)*(m(j, 0)*d(k, j) + 2*(m(j, 1)*d(k, j - 1) + m(j, 2)*d(k, j - 2) &
-                  & + m(j, 3)*d(k, j - 3)))
-               usu(k) = usu(k) + u(k, j + 1)*su(k, j + 1)
-               dsu(k) = dsu(k) + d(k, j + 1)*su(k, j + 1)
-               dmd(k) = dmd(k) + d(k, j + 1)*(m(j + 1, 0)*d(k, j + 1) + 2*(m(j + 1, 1)*d(k, j) &
-                  & + m(j + 1, 2)*d(k, j - 1) + m(j + 1, 3)*d(k, j - 2)))
-               usu(k) = usu(k) + u(k, j + 2)*su(k, j + 2)
-               dsu(k) = dsu(k) + d(k, j + 2)*su(k, j + 2)
-               dmd(k) = dmd(k) + d(k, j + 2)*(m(j + 2, 0)*d(k, j + 2) + 2*(m(j + 2, 1)*d(k, j + 1) &
-                  & + m(j + 2, 2)*d(k, j) + m(j + 2, 3)*d(k, j - 1)))
-            end do
-         end do
-         call forward_last_rows(off, inv_d2, j, n, b, xa, xb, xc)
-         ! the rows after the last triple: one by a multiply-add; two, each term rounded
-         ! before it is added
-         if (j == n) then
-!GCC$ ivdep
-!GCC$ vector
-            do k = 1, lockstep_lanes
-               usu(k) = usu(k) + u(k, j)*su(k, j)
-               dsu(k) = dsu(k) + d(k, j)*su(k, j)
-               dmd(k) = dmd(k) + d(k, j)*(m(j, 0)*d(k, j) + 2*(m(j, 1)*d(k, j - 1) + m(j, 2)*d(k, j - 2) &
-                  & + m(j, 3)*d(k, j - 3)))
-            end do
-         else
-            do i = j, n
-               call rounded_terms(i, n, mass, u, d, su, usu, dsu, dmd, work, solver%inv_d2(1))
-            end do
-         end if
-      end associate
-   end subroutine lockstep_forward_energy
-
-   !> The terms of row j of the energy sums, rounded, then added (add_rounded).
-   pure subroutine rounded_terms(j, n, mass, u, d, su, usu, dsu, dmd, work, positive)
-      integer, intent(in) :: j, n
-      type(band_diagonals), intent(in) :: mass
-      real(wp), intent(in) :: u(lockstep_lanes, n), d(lockstep_lanes, n), su(lockstep_lanes, n)
-      real(wp), intent(inout) :: usu(lockstep_lanes), dsu(lockstep_lanes), dmd(lockstep_lanes)
-      real(wp), intent(inout) :: work(lockstep_lanes, lockstep_work_columns)
-      real(wp), intent(in) :: positive
-      integer :: k
+      real(wp) :: a(lockstep_lanes, 4), b(lockstep_lanes, 4), c(lockstep_lanes, 4)
+      integer :: i, j, k, l, n
+      n = mass%n
       associate (m => mass%a)
 !GCC$ ivdep
 !GCC$ vector
          do k = 1, lockstep_lanes
-            work(k, 1) = u(k, j)*su(k, j)
-            work(k, 2) = d(k, j)*su(k, j)
-            work(k, 3) = d(k, j)*(m(j, 0)*d(k, j) + 2*(m(j, 1)*d(k, j - 1) + m(j, 2)*d(k, j - 2) &
-               & + m(j, 3)*d(k, j - 3)))
+            a(k, 1) = u(k, 1)*su(k, 1)
+            a(k, 2) = u(k, 2)*su(k, 2)
+            a(k, 3) = u(k, 3)*su(k, 3)
+            a(k, 4) = u(k, 4)*su(k, 4)
+            b(k, 1) = d(k, 1)*su(k, 1)
+            b(k, 2) = d(k, 2)*su(k, 2)
+            b(k, 3) = d(k, 3)*su(k, 3)
+            b(k, 4) = d(k, 4)*su(k, 4)
+            c(k, 1) = d(k, 1)*(m(1, 0)*d(k, 1))
+            c(k, 2) = d(k, 2)*(m(2, 0)*d(k, 2) + 2*(m(2, 1)*d(k, 1)))
+            c(k, 3) = d(k, 3)*(m(3, 0)*d(k, 3) + 2*(m(3, 1)*d(k, 2) + m(3, 2)*d(k, 1)))
+            c(k, 4) = d(k, 4)*(m(4, 0)*d(k, 4) + 2*(m(4, 1)*d(k, 3) + m(4, 2)*d(k, 2) + m(4, 3)*d(k, 1)))
+         end do
+         do j = 5, n - 3, 4
+            do l = 1, 4
+               i = j + l - 1
+!GCC$ ivdep
+!GCC$ vector
+               do k = 1, lockstep_lanes
+                  a(k, l) = a(k, l) + u(k, i)*su(k, i)
+                  b(k, l) = b(k, l) + d(k, i)*su(k, i)
+                  c(k, l) = c(k, l) + d(k, i)*(m(i, 0)*d(k, i) + 2*(m(i, 1)*d(k, i - 1) + m(i, 2)*d(k, i - 2) &
+                     & + m(i, 3)*d(k, i - 3)))
+               end do
+            end do
+         end do
+         do l = 1, n - j + 1
+            i = j + l - 1
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               a(k, l) = a(k, l) + u(k, i)*su(k, i)
+               b(k, l) = b(k, l) + d(k, i)*su(k, i)
+               c(k, l) = c(k, l) + d(k, i)*(m(i, 0)*d(k, i) + 2*(m(i, 1)*d(k, i - 1) + m(i, 2)*d(k, i - 2) &
+                  & + m(i, 3)*d(k, i - 3)))
+            end do
          end do
       end associate
-      call add_rounded(usu, work(:, 1), positive)
-      call add_rounded(dsu, work(:, 2), positive)
-      call add_rounded(dmd, work(:, 3), positive)
-   end subroutine rounded_terms
+!GCC$ ivdep
+!GCC$ vector
+      do k = 1, lockstep_lanes
+         usu(k) = (a(k, 1) + a(k, 2)) + (a(k, 3) + a(k, 4))
+         dsu(k) = (b(k, 1) + b(k, 2)) + (b(k, 3) + b(k, 4))
+         dmd(k) = (c(k, 1) + c(k, 2)) + (c(k, 3) + c(k, 4))
+      end do
+   end subroutine lockstep_energy_dots
 
    !> Back substitution (I + N) x = b of every lane (beamstops_band_solve's back_substitution,
    !> its edge rows included).
@@ -603,16 +568,4 @@ contains
          s = p
       end if
    end subroutine add_rounded
-
-   !> s = s - p with p already rounded (add_rounded).
-   pure subroutine subtract_rounded(s, p, positive)
-      real(wp), intent(inout) :: s(lockstep_lanes)
-      real(wp), intent(in) :: p(lockstep_lanes)
-      real(wp), intent(in) :: positive
-      if (positive > 0) then
-         s = s - p
-      else
-         s = p
-      end if
-   end subroutine subtract_rounded
 end module beamstops_band_solve_lockstep

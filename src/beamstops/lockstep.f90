@@ -40,8 +40,8 @@ module beamstops_lockstep
    use beamstops_model, only: model_type, build_model, check_stability
    use beamstops_hermite, only: hermite_basis, gauss_points, gauss_weights
    use beamstops_band, only: band_matvec
-   use beamstops_band_solve, only: prepare_solver, prepare_diagonals, energy_sums
-   use beamstops_band_solve_lockstep, only: lockstep_forward, lockstep_forward_energy, lockstep_back_edge, &
+   use beamstops_band_solve, only: prepare_solver, prepare_diagonals, energy_dots
+   use beamstops_band_solve_lockstep, only: lockstep_forward, lockstep_energy_dots, lockstep_back_edge, &
       & lockstep_back_update, lockstep_matvec, lockstep_dot, lockstep_min_unknowns, lockstep_work_columns, &
       & lockstep_lanes, lockstep_matvec_rhs
    use beamstops_lockstep_lanes, only: lanes_type, lanes_restart_loads, lanes_next_loads, lanes_begin_step, &
@@ -594,11 +594,10 @@ contains
             call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), lanes(c)%coef, ms%g(:, :, c), model%dt2, &
                & lanes(c)%spring, ms%su(:, :, c), ms%rhs(:, :, c))
             if (energy_wanted) then
-               call lockstep_forward_energy(ops%solver, ops%mass, ms%u(:, :, c), ms%d(:, :, c), ms%su(:, :, c), &
-                  & ms%rhs(:, :, c), lanes(c)%usu, lanes(c)%dsu, lanes(c)%dmd, ms%partial)
-            else
-               call lockstep_forward(ops%solver, ms%rhs(:, :, c))
+               call lockstep_energy_dots(ops%mass, ms%u(:, :, c), ms%d(:, :, c), ms%su(:, :, c), lanes(c)%usu, &
+                  & lanes(c)%dsu, lanes(c)%dmd)
             end if
+            call lockstep_forward(ops%solver, ms%rhs(:, :, c))
          end do
          load_k = load_k + 1
          if (pending) then
@@ -670,7 +669,7 @@ contains
          ms%vec_u = ms%u(lane(k), :, chunk(k))
          ms%vec_d = ms%d(lane(k), :, chunk(k))
          ms%vec_su = ms%su(lane(k), :, chunk(k))
-         call energy_sums(ops%solver, ops%mass, ms%vec_u, ms%vec_d, ms%vec_su, ms%vec_s, sums(1), sums(2), sums(3))
+         call energy_dots(ops%mass, ms%vec_u, ms%vec_d, ms%vec_su, sums(1), sums(2), sums(3))
          ms%rows(col_energy, k) = scenes(k)%mass_per_length*energy(model, sums(3), sums(1), sums(2), &
             & lanes(chunk(k))%u_old_su(lane(k)))
          call recorders(k)%record(ms%rows(:, k))

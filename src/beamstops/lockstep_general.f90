@@ -24,9 +24,9 @@ module beamstops_lockstep_general
    use beamstops_kinds, only: wp, ik
    use beamstops_scene, only: scene_type, law_signorini, law_compliance
    use beamstops_model, only: model_type
-   use beamstops_band_solve, only: energy_sums
+   use beamstops_band_solve, only: energy_dots
    use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_matvec_rhs, lockstep_forward, &
-      & lockstep_forward_energy, lockstep_back, lockstep_update, lockstep_dot, lockstep_matvec
+      & lockstep_energy_dots, lockstep_back, lockstep_update, lockstep_dot, lockstep_matvec
    use beamstops_band_solve_lockstep_general, only: lockstep_matvec_rhs_damped, lockstep_row
    use beamstops_contact_mass_redistribution, only: massless_reaction, equilibrium_rows
    use beamstops_lockstep_members, only: operators_type, members_type, lane, chunk, contact_law, close_steps, &
@@ -100,11 +100,10 @@ contains
                end do
             end if
             if (energy_wanted) then
-               call lockstep_forward_energy(ops%solver, ops%mass, ms%u(:, :, c), ms%d(:, :, c), ms%su(:, :, c), &
-                  & ms%rhs(:, :, c), ms%usu(lo:hi), ms%dsu(lo:hi), ms%dmd(lo:hi), ms%partial)
-            else
-               call lockstep_forward(ops%solver, ms%rhs(:, :, c))
+               call lockstep_energy_dots(ops%mass, ms%u(:, :, c), ms%d(:, :, c), ms%su(:, :, c), ms%usu(lo:hi), &
+                  & ms%dsu(lo:hi), ms%dmd(lo:hi))
             end if
+            call lockstep_forward(ops%solver, ms%rhs(:, :, c))
          end do
          if (pending) then
             do k = 1, ms%k
@@ -223,7 +222,7 @@ contains
          ms%vec_u = ms%u(lane(k), :, chunk(k))
          ms%vec_d = ms%d(lane(k), :, chunk(k))
          ms%vec_su = ms%su(lane(k), :, chunk(k))
-         call energy_sums(ops%solver, ops%mass, ms%vec_u, ms%vec_d, ms%vec_su, ms%vec_s, sums(1), sums(2), sums(3))
+         call energy_dots(ops%mass, ms%vec_u, ms%vec_d, ms%vec_su, sums(1), sums(2), sums(3))
          ms%rows(col_energy, k) = scenes(k)%mass_per_length*energy(model, sums(3), sums(1), sums(2), ms%u_old_su(k))
          call recorders(k)%record(ms%rows(:, k))
       end do

@@ -29,7 +29,7 @@ module beamstops_lockstep_span
    use beamstops_model, only: model_type, build_model
    use beamstops_band, only: band_matvec
    use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_work_columns, lockstep_matvec_rhs, &
-      & lockstep_forward, lockstep_forward_energy, lockstep_back
+      & lockstep_forward, lockstep_energy_dots, lockstep_back
    use beamstops_band_solve_lockstep_general, only: lockstep_matvec_rhs_damped
    use beamstops_contact_mass_redistribution, only: equilibrium_rows
    use beamstops_contact_box_qp, only: qp_solved, qp_message
@@ -48,7 +48,6 @@ module beamstops_lockstep_span
    !> The lanes of a step (lanes, n, chunks) and the per-member values the substitutions give.
    type :: span_lanes_type
       real(wp), allocatable :: u(:, :, :), d(:, :, :), su(:, :, :), rhs(:, :, :), g(:, :, :), cd(:, :, :)
-      real(wp), allocatable :: partial(:, :)
       real(wp), allocatable :: coef(:), spring(:), usu(:), dsu(:), dmd(:)
    end type span_lanes_type
 
@@ -176,14 +175,13 @@ contains
       p = chunks*lockstep_lanes
       allocate (lanes%u(lockstep_lanes, n, chunks), lanes%d(lockstep_lanes, n, chunks), &
          & lanes%su(lockstep_lanes, n, chunks), lanes%rhs(lockstep_lanes, n, chunks), &
-         & lanes%g(lockstep_lanes, n, chunks), lanes%partial(lockstep_lanes, lockstep_work_columns))
+         & lanes%g(lockstep_lanes, n, chunks))
       allocate (lanes%coef(p), lanes%spring(p), lanes%usu(p), lanes%dsu(p), lanes%dmd(p))
       lanes%u = 0
       lanes%d = 0
       lanes%su = 0
       lanes%rhs = 0
       lanes%g = 0
-      lanes%partial = 0
       lanes%coef = 0
       lanes%spring = 0
       lanes%usu = 0
@@ -257,12 +255,10 @@ contains
                end do
             end if
             if (energy_wanted) then
-               call lockstep_forward_energy(ops%solver, ops%mass, lanes%u(:, :, c), lanes%d(:, :, c), &
-                  & lanes%su(:, :, c), lanes%rhs(:, :, c), lanes%usu(lo:hi), lanes%dsu(lo:hi), lanes%dmd(lo:hi), &
-                  & lanes%partial)
-            else
-               call lockstep_forward(ops%solver, lanes%rhs(:, :, c))
+               call lockstep_energy_dots(ops%mass, lanes%u(:, :, c), lanes%d(:, :, c), lanes%su(:, :, c), &
+                  & lanes%usu(lo:hi), lanes%dsu(lo:hi), lanes%dmd(lo:hi))
             end if
+            call lockstep_forward(ops%solver, lanes%rhs(:, :, c))
             call lockstep_back(ops%solver, lanes%rhs(:, :, c))
          end do
          ! each member's contact work, on its own state

@@ -14,9 +14,8 @@ module beamstops_scheme
    use beamstops_model, only: model_type
    use beamstops_error, only: error_type
    use beamstops_band, only: band_matvec, cholesky_solve
-   use beamstops_band_solve, only: band_solver, forward_substitution, back_substitution, energy_sums, &
-      & forward_substitution_energy, band_diagonals, diagonal_matvec, dot, back_substitution_edge, &
-      & back_substitution_update
+   use beamstops_band_solve, only: band_solver, forward_substitution, back_substitution, energy_dots, &
+      & band_diagonals, diagonal_matvec, dot, back_substitution_edge, back_substitution_update
    use beamstops_state, only: state_type
    use beamstops_clock, only: thread_cpu_seconds
    use beamstops_forcing, only: load_average, load_rotation, start_loads, next_load
@@ -264,8 +263,8 @@ contains
       ! The state carries S u^{last+1}; the books of the last step, its record's energy from it.
       call diagonal_matvec(model%stiffness_diagonals, state%u, state%su)
       if (held) then
-         if (last == next_record) call energy_sums(model%solver, model%mass_diagonals, state%u, state%d, state%su, &
-            & state%scratch, sums(1), sums(2), sums(3))
+         if (last == next_record) call energy_dots(model%mass_diagonals, state%u, state%d, state%su, sums(1), sums(2), &
+            & sums(3))
          call settle_held(scene, model, state, recorder, last, outcome, d_tip_free, held_weight, sums, &
             & next_record, next_snapshot)
       end if
@@ -377,7 +376,7 @@ contains
       ! The state carries S u^{last+1}; it also completes a waiting record.
       call diagonal_matvec(model%stiffness_diagonals, state%u, state%su)
       if (pending) then
-         call energy_sums(model%solver, model%mass_diagonals, state%u, state%d, state%su, state%scratch, usu, dsu, dmd)
+         call energy_dots(model%mass_diagonals, state%u, state%d, state%su, usu, dsu, dmd)
          row(col_energy) = scene%mass_per_length*energy(model, dmd, usu, dsu, u_old_su)
          call recorder%record(row)
       end if
@@ -438,7 +437,7 @@ contains
    !> Forward pass of a step: su = S u, rhs = a g - b su (- c_scale cd with damping) plus
    !> `spring` in the tip row (n-1), the rows of the massless unknowns replaced by their
    !> equilibrium (mass redistribution), then the forward substitution (rhs replaced by D^{-2} w);
-   !> with `energy`, usu = u.su, dsu = d.su and dmd = d.M d, accumulated beside the substitution.
+   !> with `energy`, usu = u.su, dsu = d.su and dmd = d.M d (energy_dots).
    subroutine forward_pass(stiffness, mass, solver, g, u, d, a, b, spring, energy, su, rhs, usu, dsu, dmd, &
       & massless, row_scale, sigma_next, cd, c_scale)
       !> S and M by diagonals.
@@ -509,8 +508,8 @@ contains
       call substitute_forward(solver, mass, n, u, d, su, energy, rhs, usu, dsu, dmd)
    end subroutine plain_forward_pass
 
-   !> The forward substitution of a pass, with the energy sums beside it when they are wanted
-   !> (0 otherwise).
+   !> The forward substitution of a pass, then the energy sums when they are wanted (0 otherwise):
+   !> independent of the substitution's chain, they run in its shadow.
    subroutine substitute_forward(solver, mass, n, u, d, su, energy, rhs, usu, dsu, dmd)
       !> Factor of A.
       type(band_solver), intent(in) :: solver
@@ -526,10 +525,10 @@ contains
       real(wp), intent(inout) :: rhs(n)
       !> u.S u, d.S u and d.M d.
       real(wp), intent(out) :: usu, dsu, dmd
+      call forward_substitution(solver, rhs)
       if (energy) then
-         call forward_substitution_energy(solver, mass, u, d, su, rhs, usu, dsu, dmd)
+         call energy_dots(mass, u, d, su, usu, dsu, dmd)
       else
-         call forward_substitution(solver, rhs)
          usu = 0
          dsu = 0
          dmd = 0

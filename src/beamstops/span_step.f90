@@ -8,7 +8,7 @@ module beamstops_span_step
    use beamstops_scene, only: scene_type, law_signorini
    use beamstops_model, only: model_type
    use beamstops_state, only: state_type
-   use beamstops_band_solve, only: diagonal_matvec, diagonal_row, dot, energy_sums
+   use beamstops_band_solve, only: diagonal_matvec, diagonal_row, dot, energy_dots
    use beamstops_contact_mass_redistribution, only: massless_reaction
    use beamstops_contact_tip_contact, only: update
    use beamstops_contact_span_stops, only: span_contact, span_correction, span_settle, span_energy, &
@@ -194,7 +194,7 @@ contains
       real(wp) :: usu, dsu, dmd
       call diagonal_matvec(model%stiffness_diagonals, state%u, state%su)
       if (lp%pending) then
-         call energy_sums(model%solver, model%mass_diagonals, state%u, state%d, state%su, state%scratch, usu, dsu, dmd)
+         call energy_dots(model%mass_diagonals, state%u, state%d, state%su, usu, dsu, dmd)
          lp%row(col_energy) = scene%mass_per_length*energy(model, dmd, usu, dsu, lp%u_old_su)
          call recorder%record_stops(state%span%record_u, state%span%record_reaction)
          call recorder%record(lp%row)

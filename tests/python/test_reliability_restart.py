@@ -257,7 +257,7 @@ def test_a_resume_after_an_attempt_killed_in_its_end(tmp_path: Path) -> None:
 
 def test_checkpoints_leave_the_records_unchanged(tmp_path: Path) -> None:
     # A block that ends at a checkpoint completes its last record with the sums of the forward
-    # pass (energy_sums), not with dot products: the run with checkpoints is the run without.
+    # pass's record (energy_dots), not with other dot products: the run with checkpoints is the run without.
     plain = tmp_path / "plain.nml"
     plain.write_text(SCENE.format(t_end=0.2, file="plain.h5").replace(", checkpoint_every=40000", ""))
     assert run("run", plain, cwd=tmp_path).returncode == 0
