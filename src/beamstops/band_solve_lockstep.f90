@@ -124,7 +124,7 @@ contains
       !> u.su, d.su and d.M d of every lane (lanes).
       real(wp), intent(out) :: usu(lockstep_lanes), dsu(lockstep_lanes), dmd(lockstep_lanes)
       real(wp) :: a(lockstep_lanes, 4), b(lockstep_lanes, 4), c(lockstep_lanes, 4)
-      integer :: i, j, k, l, n
+      integer :: i, k, l, n
       n = mass%n
       associate (m => mass%a)
 !GCC$ ivdep
@@ -143,21 +143,8 @@ contains
             c(k, 3) = d(k, 3)*(m(3, 0)*d(k, 3) + 2*(m(3, 1)*d(k, 2) + m(3, 2)*d(k, 1)))
             c(k, 4) = d(k, 4)*(m(4, 0)*d(k, 4) + 2*(m(4, 1)*d(k, 3) + m(4, 2)*d(k, 2) + m(4, 3)*d(k, 1)))
          end do
-         do j = 5, n - 3, 4
-            do l = 1, 4
-               i = j + l - 1
-!GCC$ ivdep
-!GCC$ vector
-               do k = 1, lockstep_lanes
-                  a(k, l) = a(k, l) + u(k, i)*su(k, i)
-                  b(k, l) = b(k, l) + d(k, i)*su(k, i)
-                  c(k, l) = c(k, l) + d(k, i)*(m(i, 0)*d(k, i) + 2*(m(i, 1)*d(k, i - 1) + m(i, 2)*d(k, i - 2) &
-                     & + m(i, 3)*d(k, i - 3)))
-               end do
-            end do
-         end do
-         do l = 1, n - j + 1
-            i = j + l - 1
+         do i = 5, n
+            l = mod(i - 1, 4) + 1
 !GCC$ ivdep
 !GCC$ vector
             do k = 1, lockstep_lanes
