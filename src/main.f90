@@ -116,8 +116,10 @@ program beamstops_main
 
    call ignore_file_size_signal()
    call parse_arguments(command, paths, out, restart)
-   if (command == 'run') call one_blas_thread()
-   if (command == 'run') call start_writer(writer)
+   if (command == 'run') then
+      call one_blas_thread()
+      call start_writer(writer)
+   end if
    if (size(paths) > 1) call run_several(paths, restart)
    path = paths(1)%text
    call read_scene(path, scene, error)

@@ -159,7 +159,9 @@ contains
    !> turn is a loop over the four lanes kept as a loop (unroll 1) and vectorized: one vector
    !> operation per term, as each member's in beamstops_band_solve_lockstep. Unrolled, gfortran
    !> vectorized the turns' loop instead, each partial sum a reduction in order (products
-   !> rounded apart, 617 instructions a step where this takes about 250).
+   !> rounded apart: d.M d no longer matched the lockstep lanes'). 283 instructions a call at
+   !> J = 19 (callgrind, bench_kernels step 19 signorini 1), where the sums beside the forward
+   !> substitution had added 617 to it.
    pure subroutine energy_rows(n, m, u, d, su, usu, dsu, dmd)
       integer, intent(in) :: n
       real(wp), intent(in) :: m(n, 0:kd), u(n), d(n), su(n)

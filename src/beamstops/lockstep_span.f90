@@ -28,7 +28,7 @@ module beamstops_lockstep_span
    use beamstops_scene, only: scene_type, steps_of
    use beamstops_model, only: model_type, build_model
    use beamstops_band, only: band_matvec
-   use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_work_columns, lockstep_matvec_rhs, &
+   use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_matvec_rhs, &
       & lockstep_forward, lockstep_energy_dots, lockstep_back
    use beamstops_band_solve_lockstep_general, only: lockstep_matvec_rhs_damped
    use beamstops_contact_mass_redistribution, only: equilibrium_rows
