@@ -22,7 +22,7 @@ module beamstops_band_solve
    public :: band_solver, prepare_solver, fused_solve, forward_substitution, back_substitution
    public :: back_substitution_edge, back_substitution_update
    public :: energy_dots
-   public :: band_diagonals, prepare_diagonals, diagonal_matvec, diagonal_row, dot
+   public :: band_diagonals, prepare_diagonals, diagonal_matvec, diagonal_matvec_rhs, diagonal_row, dot
 
    !> The factor of A = M + dt^2 beta S in the form the fused substitutions read.
    type :: band_solver
@@ -398,7 +398,7 @@ contains
       real(wp), intent(in), contiguous :: x(:)
       !> Product (n).
       real(wp), intent(out), contiguous :: y(:)
-      integer :: j, n
+      integer :: n
       n = diagonals%n
       associate (a => diagonals%a)
          if (n < 2*kd + 1) then
@@ -411,20 +411,79 @@ contains
             y(:n - 3) = y(:n - 3) + a(4:, 3)*x(4:)
             return
          end if
-         y(1) = a(1, 0)*x(1) + a(2, 1)*x(2) + a(3, 2)*x(3) + a(4, 3)*x(4)
-         y(2) = a(2, 1)*x(1) + a(2, 0)*x(2) + a(3, 1)*x(3) + a(4, 2)*x(4) + a(5, 3)*x(5)
-         y(3) = a(3, 2)*x(1) + a(3, 1)*x(2) + a(3, 0)*x(3) + a(4, 1)*x(4) + a(5, 2)*x(5) + a(6, 3)*x(6)
-         do j = kd + 1, n - kd
-            y(j) = a(j, 3)*x(j - 3) + a(j, 2)*x(j - 2) + a(j, 1)*x(j - 1) + a(j, 0)*x(j) &
-               & + a(j + 1, 1)*x(j + 1) + a(j + 2, 2)*x(j + 2) + a(j + 3, 3)*x(j + 3)
-         end do
-         y(n - 2) = a(n - 2, 3)*x(n - 5) + a(n - 2, 2)*x(n - 4) + a(n - 2, 1)*x(n - 3) + a(n - 2, 0)*x(n - 2) &
-            & + a(n - 1, 1)*x(n - 1) + a(n, 2)*x(n)
-         y(n - 1) = a(n - 1, 3)*x(n - 4) + a(n - 1, 2)*x(n - 3) + a(n - 1, 1)*x(n - 2) + a(n - 1, 0)*x(n - 1) &
-            & + a(n, 1)*x(n)
-         y(n) = a(n, 3)*x(n - 3) + a(n, 2)*x(n - 2) + a(n, 1)*x(n - 1) + a(n, 0)*x(n)
       end associate
+      call matvec_rows(n, diagonals%a, x, y)
    end subroutine diagonal_matvec
+
+   !> The rows of diagonal_matvec for n >= 2 kd + 1, in explicit-shape arrays (as energy_rows):
+   !> the edge rows written out, the interior rows vectorized.
+   pure subroutine matvec_rows(n, a, x, y)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: a(n, 0:kd), x(n)
+      real(wp), intent(out) :: y(n)
+      integer :: j
+      call edge_rows(n, a, x, y)
+      do j = kd + 1, n - kd
+         y(j) = a(j, 3)*x(j - 3) + a(j, 2)*x(j - 2) + a(j, 1)*x(j - 1) + a(j, 0)*x(j) &
+            & + a(j + 1, 1)*x(j + 1) + a(j + 2, 2)*x(j + 2) + a(j + 3, 3)*x(j + 3)
+      end do
+   end subroutine matvec_rows
+
+   !> The 2 kd edge rows of A x, 1..3 and n-2..n (n >= 2 kd + 1), written out.
+   pure subroutine edge_rows(n, a, x, y)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: a(n, 0:kd), x(n)
+      real(wp), intent(inout) :: y(n)
+      y(1) = a(1, 0)*x(1) + a(2, 1)*x(2) + a(3, 2)*x(3) + a(4, 3)*x(4)
+      y(2) = a(2, 1)*x(1) + a(2, 0)*x(2) + a(3, 1)*x(3) + a(4, 2)*x(4) + a(5, 3)*x(5)
+      y(3) = a(3, 2)*x(1) + a(3, 1)*x(2) + a(3, 0)*x(3) + a(4, 1)*x(4) + a(5, 2)*x(5) + a(6, 3)*x(6)
+      y(n - 2) = a(n - 2, 3)*x(n - 5) + a(n - 2, 2)*x(n - 4) + a(n - 2, 1)*x(n - 3) + a(n - 2, 0)*x(n - 2) &
+         & + a(n - 1, 1)*x(n - 1) + a(n, 2)*x(n)
+      y(n - 1) = a(n - 1, 3)*x(n - 4) + a(n - 1, 2)*x(n - 3) + a(n - 1, 1)*x(n - 2) + a(n - 1, 0)*x(n - 1) &
+         & + a(n, 1)*x(n)
+      y(n) = a(n, 3)*x(n - 3) + a(n, 2)*x(n - 2) + a(n, 1)*x(n - 1) + a(n, 0)*x(n)
+   end subroutine edge_rows
+
+   !> y = A x (diagonal_matvec) and rhs = a g - b y in one pass over the rows (the forward pass's
+   !> right-hand side without its tip term).
+   pure subroutine diagonal_matvec_rhs(diagonals, x, a, g, b, y, rhs)
+      !> Matrix by diagonals.
+      type(band_diagonals), intent(in) :: diagonals
+      !> Vector (n).
+      real(wp), intent(in), contiguous :: x(:)
+      !> Coefficients of rhs = a g - b y.
+      real(wp), intent(in) :: a, b
+      !> Load vector (n).
+      real(wp), intent(in), contiguous :: g(:)
+      !> Product (n).
+      real(wp), intent(out), contiguous :: y(:)
+      !> Right-hand side (n).
+      real(wp), intent(out), contiguous :: rhs(:)
+      integer :: n
+      n = diagonals%n
+      if (n < 2*kd + 1) then
+         call diagonal_matvec(diagonals, x, y)
+         rhs = a*g - b*y
+         return
+      end if
+      call matvec_rhs_rows(n, diagonals%a, x, a, g, b, y, rhs)
+   end subroutine diagonal_matvec_rhs
+
+   !> The rows of diagonal_matvec_rhs for n >= 2 kd + 1 (as matvec_rows, rhs row by row).
+   pure subroutine matvec_rhs_rows(n, s, x, a, g, b, y, rhs)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: s(n, 0:kd), x(n), a, g(n), b
+      real(wp), intent(out) :: y(n), rhs(n)
+      integer :: j
+      call edge_rows(n, s, x, y)
+      rhs(1:3) = a*g(1:3) - b*y(1:3)
+      do j = kd + 1, n - kd
+         y(j) = s(j, 3)*x(j - 3) + s(j, 2)*x(j - 2) + s(j, 1)*x(j - 1) + s(j, 0)*x(j) &
+            & + s(j + 1, 1)*x(j + 1) + s(j + 2, 2)*x(j + 2) + s(j + 3, 3)*x(j + 3)
+         rhs(j) = a*g(j) - b*y(j)
+      end do
+      rhs(n - 2:n) = a*g(n - 2:n) - b*y(n - 2:n)
+   end subroutine matvec_rhs_rows
 
    !> Row k of A x for a symmetric band matrix stored by diagonals (any row, the edges included).
    pure function diagonal_row(diagonals, x, k) result(y)

@@ -15,7 +15,7 @@ module beamstops_scheme
    use beamstops_error, only: error_type
    use beamstops_band, only: band_matvec, cholesky_solve
    use beamstops_band_solve, only: band_solver, forward_substitution, back_substitution, energy_dots, &
-      & band_diagonals, diagonal_matvec, dot, back_substitution_edge, back_substitution_update
+      & band_diagonals, diagonal_matvec, diagonal_matvec_rhs, dot, back_substitution_edge, back_substitution_update
    use beamstops_state, only: state_type
    use beamstops_clock, only: thread_cpu_seconds
    use beamstops_forcing, only: load_average, load_rotation, start_loads, next_load
@@ -502,8 +502,7 @@ contains
       real(wp), intent(out) :: rhs(n)
       !> u.S u, d.S u and d.M d (when energy; 0 otherwise).
       real(wp), intent(out) :: usu, dsu, dmd
-      call diagonal_matvec(stiffness, u, su)
-      rhs = a*g - b*su
+      call diagonal_matvec_rhs(stiffness, u, a, g, b, su, rhs)
       rhs(n - 1) = rhs(n - 1) + spring
       call substitute_forward(solver, mass, n, u, d, su, energy, rhs, usu, dsu, dmd)
    end subroutine plain_forward_pass
