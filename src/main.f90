@@ -165,7 +165,9 @@ contains
          select case (trim(arg))
          case ('-o', '--output')
             if (command /= 'run' .or. i == n) call usage("'-o' takes a file name, with 'run'")
+            if (allocated(out)) call usage("'-o' is given twice (one output: the last would have won)")
             call get_command_argument(i + 1, arg)
+            if (len_trim(arg) == 0) call usage("'-o' takes a file name; it was given an empty one")
             out = trim(arg)
             i = i + 1
          case ('--restart')
@@ -184,14 +186,14 @@ contains
          & 'namelist files each scene writes its own (&output file; default: the input''s name with .h5)')
    end subroutine parse_arguments
 
-   !> The help (on stdout), or a problem and the help on stderr with exit status 2.
+   !> The help (on stdout), or one line on stderr naming the problem, with exit status 2.
    subroutine usage(problem)
       character(len=*), intent(in), optional :: problem
       integer :: unit, k
       unit = output_unit
       if (present(problem)) then
-         unit = error_unit
-         write (unit, '(a)') 'beamstops: '//problem
+         write (error_unit, '(a)') 'beamstops: '//problem//' (beamstops --help: the commands)'
+         call quit(exit_usage)
       end if
       write (unit, '(a)') 'usage: beamstops COMMAND [ARGUMENTS]', '', &
          & 'commands of the engine:', &
@@ -209,7 +211,6 @@ contains
       write (unit, '(a)') '  --version       print the version', &
          & 'exit statuses: 0 success, 1 bad input, 2 bad command line (or no Python for its commands),', &
          & '  3 the run diverged or failed, 4 the output could not be written or would destroy a file'
-      if (present(problem)) call quit(exit_usage)
       stop
    end subroutine usage
 
@@ -614,11 +615,15 @@ contains
       type(run_summary), intent(in) :: summary
       character(len=:), allocatable :: line
       character(len=768) :: buf
-      write (buf, '(a,": ",i0," steps, ",f0.3," s CPU (",f0.3," us/step), ",i0," impacts (",i0,' // &
+      character(len=24) :: cpu, per_step
+      ! (f0.3 would drop the leading zero: ".003")
+      write (cpu, '(f24.3)') summary%cpu_seconds
+      write (per_step, '(f24.3)') 1.0e6_wp*summary%cpu_seconds/max(1_ik, summary%steps)
+      write (buf, '(a,": ",i0," steps, ",a," s CPU (",a," us/step), ",i0," impacts (",i0,' // &
          & '" contact phases), largest violation ",' // &
          & 'es9.3," m; energy (J): support work ",es10.3,", stops ",es10.3,", damping ",es10.3,' // &
-         & '", balance residual ",es9.2,"; status ",a)') scene%output_file, summary%steps, summary%cpu_seconds, &
-         & 1.0e6_wp*summary%cpu_seconds/max(1_ik, summary%steps), summary%impacts, summary%contact_phases, &
+         & '", balance residual ",es9.2,"; status ",a)') scene%output_file, summary%steps, trim(adjustl(cpu)), &
+         & trim(adjustl(per_step)), summary%impacts, summary%contact_phases, &
          & summary%max_violation, summary%work, summary%dissipated, summary%damped, summary%energy_residual, &
          & summary%status
       line = trim(buf)//headline(summary)

@@ -125,7 +125,7 @@ contains
                call band_matvec(models(k)%mass, states(k)%d, states(k)%scratch)
                kinetic = 0.5_wp*dot_product(states(k)%d, states(k)%scratch)/model%dt2
                call check_divergence(scenes(k), kinetic, states(k)%energy0, states(k)%work, states(k)%dissipated, &
-                  & real(states(k)%step - 1, wp)*model%dt, summaries(k))
+                  & real(states(k)%step - 1, wp)*model%dt, recorders(k)%blew_up, recorders(k)%blew_up_at, summaries(k))
             end if
             if (summaries(k)%status == status_running) then
                if (states(k)%observer%active) call states(k)%observer%drain()
@@ -161,6 +161,7 @@ contains
       if (state%observer%active .and. summary%status /= status_running) then
          call state%observer%finish(summary%shocks, summary%statistics)
          summary%impacts = state%observer%shocks%shock_count()
+         summary%contact_phases = state%observer%shocks%phase_count()
       end if
    end subroutine finish_member
 

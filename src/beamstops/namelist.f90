@@ -8,7 +8,8 @@ module beamstops_namelist
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
-   use beamstops_scene, only: scene_type, validate_scene, tube_beam, law_code, law_compliance, max_stops, stop_count
+   use beamstops_scene, only: scene_type, validate_scene, tube_beam, law_code, law_compliance, max_stops, stop_count, &
+      & steps_of
    use beamstops_strings, only: fmt_real, itoa, lower, squeeze
    use beamstops_physics_checks, only: validate_physics
    use beamstops_observe_statistics, only: validate_statistics, validate_ensemble
@@ -169,6 +170,11 @@ contains
 
       do g = 1, size(group_names)
          if (.not. has_group(g)) cycle
+         call repeated_key(g)
+         if (allocated(error)) return
+      end do
+      do g = 1, size(group_names)
+         if (.not. has_group(g)) cycle
          call read_group(g, cleaned, stat, msg)
          if (stat /= 0) then
             call malformed_key(g, stat, msg)
@@ -255,7 +261,7 @@ contains
       if (allocated(error)) return
       call validate_physics(scene, source, error)
       if (allocated(error)) return
-      call validate_statistics(scene%transient, scene%t_end, scene%batches, scene%bins, scene%rest_time, &
+      call validate_statistics(scene%transient, real(steps_of(scene), wp)*scene%dt, scene%batches, scene%bins, scene%rest_time, &
          & scene%histogram_lower, scene%histogram_upper, source, error)
       if (allocated(error)) return
       call validate_ensemble(scene%members, source, error)
@@ -346,6 +352,30 @@ contains
          case (9); read (text, nml=ensemble, iostat=stat, iomsg=msg)
          end select
       end subroutine read_group
+
+      !> A key given twice in group g (`key = ...` both times; the elements of an array, `key(i) =`,
+      !> may each be given once): refused, where gfortran would let the last one win unsaid.
+      subroutine repeated_key(g)
+         integer, intent(in) :: g
+         character(len=:), allocatable :: body, key, seen
+         integer, allocatable :: starts(:)
+         integer :: i, j
+         body = group_body(cleaned, trim(group_names(g)))
+         starts = assignment_starts(body)
+         seen = ' '
+         do i = 1, size(starts)
+            key = key_at(body, starts(i))
+            j = starts(i) + len(key)
+            j = j - 1 + verify(body(j:)//'=', ' ')
+            if (body(j:j) /= '=') cycle
+            if (index(seen, ' '//key//' ') > 0) then
+               call fatal_error(error, source//': &'//trim(group_names(g))//' '//key// &
+                  & ' is given twice; allowed: each key once in a group')
+               return
+            end if
+            seen = seen//key//' '
+         end do
+      end subroutine repeated_key
 
       !> The message of a group gfortran could not read: each `key = value` of the group is read
       !> alone to find the first one that fails, and the message names it with the kind of value

@@ -21,7 +21,14 @@ module beamstops_recorder
       logical :: failed = .false.
       !> What failed, naming the file (when the implementation says).
       character(len=:), allocatable :: message
+      !> Set by `screen` when values handed over were not finite (the solution blew up): from
+      !> then on nothing more is kept, and the loop's caller ends the run 'diverged'.
+      logical :: blew_up = .false.
+      !> The time of those values (s).
+      real(wp) :: blew_up_at = 0
    contains
+      !> Whether values handed over at time t may be kept: not once any value is not finite.
+      procedure :: screen
       !> Take one row (t, tip u, tip v, reaction, energy, work, dissipated, damped).
       procedure(record_interface), deferred :: record
       !> Take one snapshot of the physical displacement at the nodes x_0..x_J.
@@ -51,6 +58,28 @@ module beamstops_recorder
    end interface
 
 contains
+
+   !> keep = values (a row, or a snapshot) at time t are all finite and nothing before them blew
+   !> up; the first values that are not finite set blew_up and blew_up_at. One sum: a NaN or an
+   !> infinity among them makes it NaN or infinite (as does an overflow, itself a blow-up).
+   subroutine screen(self, t, values, keep)
+      !> Recorder.
+      class(recorder_type), intent(inout) :: self
+      !> Time of the values (s).
+      real(wp), intent(in) :: t
+      !> Values.
+      real(wp), intent(in) :: values(:)
+      !> Whether to keep them.
+      logical, intent(out) :: keep
+      real(wp) :: s
+      keep = .false.
+      if (self%blew_up) return
+      s = sum(values)
+      keep = abs(s) <= huge(s)
+      if (keep) return
+      self%blew_up = .true.
+      self%blew_up_at = t
+   end subroutine screen
 
    !> Default progress report: none.
    subroutine progress(self, step, steps)

@@ -298,7 +298,7 @@ contains
          end if
          kinetic = 0.5_wp*reduced_mass_product(reduced, state%d)/reduced%dt2
          call check_divergence(scene, kinetic, state%energy0, state%work, state%dissipated, &
-            & real(state%step - 1, wp)*reduced%dt, summary)
+            & real(state%step - 1, wp)*reduced%dt, recorder%blew_up, recorder%blew_up_at, summary)
          if (summary%status == status_diverged) exit
          if (state%observer%active) call state%observer%drain()
          call recorder%progress(state%step - 1, steps)
@@ -314,6 +314,7 @@ contains
       if (state%observer%active .and. summary%status /= status_running) then
          call state%observer%finish(summary%shocks, summary%statistics)
          summary%impacts = state%observer%shocks%shock_count()
+         summary%contact_phases = state%observer%shocks%phase_count()
       end if
    end subroutine run_reduced
 

@@ -80,7 +80,7 @@ contains
          call band_matvec(model%mass, state%d, state%scratch)
          kinetic = 0.5_wp*dot_product(state%d, state%scratch)/model%dt2
          call check_divergence(scene, kinetic, state%energy0, state%work, state%dissipated, &
-            & real(state%step - 1, wp)*model%dt, summary)
+            & real(state%step - 1, wp)*model%dt, recorder%blew_up, recorder%blew_up_at, summary)
          if (summary%status == status_diverged) exit
          if (state%observer%active) call state%observer%drain()
          call recorder%progress(state%step - 1, steps)
@@ -96,6 +96,7 @@ contains
       if (state%observer%active .and. summary%status /= status_running) then
          call state%observer%finish(summary%shocks, summary%statistics)
          summary%impacts = state%observer%shocks%shock_count()
+         summary%contact_phases = state%observer%shocks%phase_count()
       end if
    end subroutine run_scheme
 

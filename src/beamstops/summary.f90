@@ -4,6 +4,7 @@ module beamstops_summary
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_observe_statistics, only: statistics_table
    use beamstops_scene, only: scene_type
+   use beamstops_strings, only: fmt_real
    implicit none
    private
    public :: run_summary, status_complete, status_diverged, status_running, status_failed, check_divergence
@@ -48,25 +49,34 @@ module beamstops_summary
    end type run_summary
 contains
 
-   !> The divergence check of the time loops (full and reduced), between blocks: status
-   !> 'diverged' with its message when the kinetic energy is not finite or beyond 1e8 times the
-   !> energy the run has seen (the support's scale, E^{1/2}, the work, the stops' energy).
-   subroutine check_divergence(scene, kinetic, energy0, work, dissipated, t, summary)
+   !> The divergence check of the time loops (full, reduced and lockstep), between blocks: status
+   !> 'diverged' with its message when a recorder was handed values that are not finite
+   !> (`blew_up`, at `blew_up_at`: it kept nothing from then on), or when the kinetic energy is
+   !> not finite or beyond 1e8 times the energy the run has seen (the support's scale, E^{1/2},
+   !> the work, the stops' energy).
+   subroutine check_divergence(scene, kinetic, energy0, work, dissipated, t, blew_up, blew_up_at, summary)
       !> Scene (length, support amplitude and frequency).
       type(scene_type), intent(in) :: scene
       !> Kinetic energy 1/2 d.M d/dt^2, E^{1/2}, work and stops' energy so far, per unit mass.
       real(wp), intent(in) :: kinetic, energy0, work, dissipated
       !> Time reached (s), for the message.
       real(wp), intent(in) :: t
+      !> Whether the recorder was handed values that are not finite, and their time (s).
+      logical, intent(in) :: blew_up
+      real(wp), intent(in) :: blew_up_at
       !> Set to 'diverged' when the solution blew up.
       type(run_summary), intent(inout) :: summary
       real(wp) :: cap
-      character(len=32) :: text
+      if (blew_up) then
+         summary%status = status_diverged
+         summary%message = 'the solution blew up (values not finite at t = '//fmt_real(blew_up_at, 6)// &
+            & ' s; the records stop before them)'
+         return
+      end if
       cap = 1.0e8_wp*(0.5_wp*scene%length*(scene%amplitude*scene%omega)**2 + abs(energy0) + abs(work) + abs(dissipated))
       if (ieee_is_finite(kinetic) .and. kinetic <= cap) return
-      write (text, '(g0.6)') t
       summary%status = status_diverged
       summary%message = 'the solution blew up (kinetic energy beyond 1e8 times the energy supplied) before t = '// &
-         & trim(text)//' s'
+         & fmt_real(t, 6)//' s'
    end subroutine check_divergence
 end module beamstops_summary

@@ -92,12 +92,12 @@ contains
       call expect_message(error, 'in.nml: &statistics batches = 1 is out of range; allowed: batches >= 2')
       if (allocated(error)) return
       call validate_statistics(10.0_wp, 10.0_wp, 20, 10, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
-      call expect_message(error, 'in.nml: &statistics transient = 10 is out of range; allowed: 0 <= transient < t_end ='// &
-         & ' 10 s')
+      call expect_message(error, 'in.nml: &statistics transient = 10 is out of range; allowed: 0 <= transient < 10 s,'// &
+         & ' the time the run reaches (t_end in whole steps of dt)')
       if (allocated(error)) return
       call validate_statistics(-1.0_wp, 10.0_wp, 20, 10, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
-      call expect_message(error, 'in.nml: &statistics transient = -1 is out of range; allowed: 0 <= transient < t_end ='// &
-         & ' 10 s')
+      call expect_message(error, 'in.nml: &statistics transient = -1 is out of range; allowed: 0 <= transient < 10 s,'// &
+         & ' the time the run reaches (t_end in whole steps of dt)')
       if (allocated(error)) return
       call validate_statistics(1.0_wp, 10.0_wp, 20, 10, -2.0e-3_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
       call expect_message(error, 'in.nml: &statistics rest_time = -0.002 is out of range; allowed: rest_time >= 0 s')

@@ -121,14 +121,22 @@ def test_usage_errors_exit_2(tmp_path: Path) -> None:
 
 def test_unstable_run_is_marked_diverged_not_complete(tmp_path: Path) -> None:
     scene = write(tmp_path, "&time dt=2e-5, beta=0, t_end=0.5, allow_unstable=.true. /\n"
-                            "&output file='bad.h5', record_every=100 /\n")
+                            "&output file='bad.h5', record_every=1, snapshot_every=10 /\n")
     done = beamstops("run", scene, cwd=tmp_path)
     assert done.returncode == 3
-    assert "diverged" in done.stderr
+    assert "diverged" in done.stderr and "not finite" in done.stderr
     with h5py.File(tmp_path / "bad.h5") as f:
         assert f.attrs["status"] == b"diverged"
         assert f.attrs["steps"] < 25000
-        assert np.all(np.isfinite(f["tip/u"][:]))
+        # the records stop at the first values that are not finite: no series holds a NaN, the
+        # series have one length, and the last record comes before the time the message names
+        series = [f[name][:] for name in ("tip/t", "tip/u", "tip/v", "tip/reaction", "energy/E",
+                                          "energy/work", "energy/dissipated", "snapshots/u")]
+        assert all(np.all(np.isfinite(a)) for a in series)
+        assert len({a.shape[0] for a in series[:7]}) == 1
+        blew_up_at = float(f.attrs["message"].decode().split("at t = ")[1].split(" s")[0])
+        assert f["tip/t"][-1] < blew_up_at <= f.attrs["t_final"]
+        assert f["snapshots/t"][-1] < blew_up_at
 
 
 def test_unwritable_output_exits_4(tmp_path: Path) -> None:
@@ -471,3 +479,44 @@ def test_run_stops_a_threaded_openblas_pool_unless_told(chosen: str | None, tmp_
         assert threads == 2
     with h5py.File(tmp_path / "long.h5") as f:
         assert f.attrs["status"] == b"complete"
+
+
+def test_an_empty_or_repeated_output_name_is_refused_before_the_run(tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT)
+    for args in (["-o", ""], ["-o", "  "], ["-o", "a.h5", "-o", "b.h5"]):
+        done = beamstops("run", scene, *args, cwd=tmp_path)
+        lines = done.stderr.strip().splitlines()
+        assert done.returncode == 2 and len(lines) == 1 and "'-o'" in lines[0], (args, done.stderr)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.nml"]
+
+
+def test_the_transient_must_come_before_the_last_step_the_run_reaches(tmp_path: Path) -> None:
+    # t_end = 0.0104 s in steps of 1 ms: the run ends at 0.010 s, before a transient of 0.0102 s
+    scene = write(tmp_path, "&time dt=1e-3, t_end=0.0104 /\n&statistics transient=0.0102 /\n")
+    done = beamstops("run", scene, cwd=tmp_path)
+    line = one_error_line(done)
+    assert done.returncode == 1 and "&statistics transient" in line and "< 0.01 s" in line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.nml"]
+
+
+def test_contact_phases_count_every_phase_of_every_shock(tmp_path: Path) -> None:
+    # a gap of 2e-12 m: the tip goes from one stop straight to the other, phase after phase
+    for stops in ("&stops lower=-1e-12, upper=1e-12 /\n", "&stops nodes=5,10,19, lower=-0.01, upper=0.01 /\n"):
+        scene = write(tmp_path, "&time dt=5e-5, t_end=0.2 /\n" + stops + "&output file='p.h5' /\n")
+        done = beamstops("run", scene, cwd=tmp_path)
+        assert done.returncode == 0, done.stderr
+        with h5py.File(tmp_path / "p.h5") as f:
+            shocks = f["impacts/rebounds"].shape[0]
+            phases = int(np.sum(f["impacts/rebounds"][:])) + shocks  # rebounds = phases - 1 per shock
+            assert f.attrs["impacts"] == shocks > 0
+            assert f.attrs["contact_phases"] == phases >= shocks, stops
+        (tmp_path / "p.h5").unlink()
+
+
+def test_a_key_given_twice_in_a_group_is_refused(tmp_path: Path) -> None:
+    scene = write(tmp_path, "&time dt=1e-5, t_end=0.001, DT = 2e-5 /\n")
+    line = one_error_line(beamstops("run", scene, cwd=tmp_path))
+    assert "&time dt is given twice" in line
+    # the elements of an array, each once, are not a repetition
+    scene = write(tmp_path, "&damping ratio(1)=0.01, ratio(2)=0.02 /\n&time dt=5e-5, t_end=0.001 /\n")
+    assert beamstops("run", scene, cwd=tmp_path).returncode == 0

@@ -137,9 +137,10 @@ contains
    !> histogram_lower, histogram_upper; t_end is &time's); `source` (a file name) starts the
    !> message, in the form of validate_scene's: "SOURCE: &statistics KEY = VALUE is out of range;
    !> allowed: RANGE".
-   subroutine validate_statistics(transient, t_end, batches, bins, rest_time, lower, upper, source, error)
-      !> Start of the window (s) and end of the run (s).
-      real(wp), intent(in) :: transient, t_end
+   subroutine validate_statistics(transient, t_last, batches, bins, rest_time, lower, upper, source, error)
+      !> Start of the window (s), and the time the run reaches (s): its last step's, t_end
+      !> rounded to a whole number of steps.
+      real(wp), intent(in) :: transient, t_last
       !> Number of batches (>= 2) and of histogram bins (>= 1).
       integer, intent(in) :: batches, bins
       !> Rest time of the shock log (s, >= 0).
@@ -159,8 +160,9 @@ contains
       if (.not. (ieee_is_finite(rest_time) .and. rest_time >= 0)) then
          call say('rest_time', fmt_real(rest_time), 'rest_time >= 0 s'); return
       end if
-      if (.not. (ieee_is_finite(transient) .and. transient >= 0 .and. transient < t_end)) then
-         call say('transient', fmt_real(transient), '0 <= transient < t_end = '//fmt_real(t_end)//' s'); return
+      if (.not. (ieee_is_finite(transient) .and. transient >= 0 .and. transient < t_last)) then
+         call say('transient', fmt_real(transient), '0 <= transient < '//fmt_real(t_last)// &
+            & ' s, the time the run reaches (t_end in whole steps of dt)'); return
       end if
       if (.not. ieee_is_finite(lower)) then
          call say('histogram_lower', fmt_real(lower), 'a finite value (m)'); return

@@ -1,7 +1,7 @@
 !> The in-memory recorder: fills arrays sized before the run (the Python path).
 module beamstops_recorder_array
    use beamstops_kinds, only: wp, ik
-   use beamstops_recorder, only: recorder_type, n_columns
+   use beamstops_recorder, only: recorder_type, n_columns, col_t
    implicit none
    private
    public :: array_recorder
@@ -55,7 +55,7 @@ contains
       class(array_recorder), intent(inout) :: self
       real(wp), intent(in) :: u(:)
       real(wp), intent(in) :: reaction(:)
-      if (.not. allocated(self%stops_u)) return
+      if (.not. allocated(self%stops_u) .or. self%blew_up) return
       if (size(self%stops_u, 1) /= size(u)) return
       if (self%stops_filled >= size(self%stops_u, 2, ik)) then
          self%failed = .true.
@@ -69,6 +69,13 @@ contains
    subroutine record(self, row)
       class(array_recorder), intent(inout) :: self
       real(wp), intent(in) :: row(n_columns)
+      logical :: keep
+      call self%screen(row(col_t), row, keep)
+      if (.not. keep) then
+         ! the stops' values of this row came just before it
+         if (self%stops_filled > self%filled) self%stops_filled = self%filled
+         return
+      end if
       if (self%filled >= size(self%rows, 2, ik)) then
          self%failed = .true.
          return
@@ -81,6 +88,9 @@ contains
       class(array_recorder), intent(inout) :: self
       real(wp), intent(in) :: t
       real(wp), intent(in) :: u(:)
+      logical :: keep
+      call self%screen(t, u, keep)
+      if (.not. keep) return
       if (self%snaps >= size(self%snap_t, 1, ik)) then
          self%failed = .true.
          return

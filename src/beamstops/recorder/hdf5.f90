@@ -21,7 +21,7 @@ module beamstops_recorder_hdf5
    use beamstops_summary, only: run_summary, status_running, status_complete, status_diverged, status_failed
    use beamstops_files, only: file_exists, is_directory, same_file, rename_file
    use beamstops_recorder_hdf5_vector, only: write_vector
-   use beamstops_recorder, only: recorder_type, n_columns
+   use beamstops_recorder, only: recorder_type, n_columns, col_t
    use beamstops_attributes, only: attribute_list, kind_real, kind_int, kind_logical, kind_text
    use beamstops_output_attributes, only: run_attributes, summary_attributes
    use beamstops_recorder_hdf5_observations, only: write_observations
@@ -133,6 +133,13 @@ contains
    subroutine record(self, row)
       class(hdf5_recorder), intent(inout) :: self
       real(wp), intent(in) :: row(n_columns)
+      logical :: keep
+      call self%screen(row(col_t), row, keep)
+      if (.not. keep) then
+         ! the stops' values of this row came just before it
+         if (self%stops > 0 .and. self%stops_fill > 0) self%stops_fill = self%stops_fill - 1
+         return
+      end if
       self%fill = self%fill + 1
       self%buffer(self%fill, :) = row
       if (self%fill == buffer_rows) call write_buffer(self)
@@ -143,7 +150,7 @@ contains
       class(hdf5_recorder), intent(inout) :: self
       real(wp), intent(in) :: u(:)
       real(wp), intent(in) :: reaction(:)
-      if (self%stops == 0) return
+      if (self%stops == 0 .or. self%blew_up) return
       self%stops_fill = self%stops_fill + 1
       self%stops_u_buffer(:, self%stops_fill) = u
       self%stops_r_buffer(:, self%stops_fill) = reaction
@@ -184,6 +191,9 @@ contains
       class(hdf5_recorder), intent(inout) :: self
       real(wp), intent(in) :: t
       real(wp), intent(in) :: u(:)
+      logical :: keep
+      call self%screen(t, u, keep)
+      if (.not. keep) return
       self%snap_fill = self%snap_fill + 1
       self%snap_t_buffer(self%snap_fill) = t
       self%snap_u_buffer(:, self%snap_fill) = u
