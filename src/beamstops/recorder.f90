@@ -9,7 +9,7 @@ module beamstops_recorder
    implicit none
    private
    public :: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, col_work, col_dissipated
-   public :: col_damped
+   public :: col_damped, all_finite
 
    !> Columns of a record row; col_damped: the energy the Rayleigh damping took so far (J).
    integer, parameter :: col_t = 1, col_u = 2, col_v = 3, col_reaction = 4, col_energy = 5, &
@@ -21,14 +21,14 @@ module beamstops_recorder
       logical :: failed = .false.
       !> What failed, naming the file (when the implementation says).
       character(len=:), allocatable :: message
-      !> Set by `screen` when values handed over were not finite (the solution blew up): from
+      !> Set by `stop_keeping` when values handed over were not finite (the solution blew up): from
       !> then on nothing more is kept, and the loop's caller ends the run 'diverged'.
       logical :: blew_up = .false.
       !> The time of those values (s).
       real(wp) :: blew_up_at = 0
    contains
-      !> Whether values handed over at time t may be kept: not once any value is not finite.
-      procedure :: screen
+      !> Keep nothing more: values handed over were not finite.
+      procedure :: stop_keeping
       !> Take one row (t, tip u, tip v, reaction, energy, work, dissipated, damped).
       procedure(record_interface), deferred :: record
       !> Take one snapshot of the physical displacement at the nodes x_0..x_J.
@@ -59,27 +59,30 @@ module beamstops_recorder
 
 contains
 
-   !> keep = values (a row, or a snapshot) at time t are all finite and nothing before them blew
-   !> up; the first values that are not finite set blew_up and blew_up_at. One sum: a NaN or an
-   !> infinity among them makes it NaN or infinite (as does an overflow, itself a blow-up).
-   subroutine screen(self, t, values, keep)
+   !> Whether the n values are all finite: one sum, which a NaN or an infinity among them makes
+   !> NaN or infinite (as does an overflow, itself a blow-up).
+   pure function all_finite(n, values) result(ok)
+      !> Number of values.
+      integer, intent(in) :: n
+      !> Values.
+      real(wp), intent(in) :: values(n)
+      logical :: ok
+      real(wp) :: s
+      s = sum(values)
+      ok = abs(s) <= huge(s)
+   end function all_finite
+
+   !> Values handed over at time t were not finite (all_finite): keep nothing from now on, and
+   !> say when it happened first.
+   subroutine stop_keeping(self, t)
       !> Recorder.
       class(recorder_type), intent(inout) :: self
       !> Time of the values (s).
       real(wp), intent(in) :: t
-      !> Values.
-      real(wp), intent(in) :: values(:)
-      !> Whether to keep them.
-      logical, intent(out) :: keep
-      real(wp) :: s
-      keep = .false.
       if (self%blew_up) return
-      s = sum(values)
-      keep = abs(s) <= huge(s)
-      if (keep) return
       self%blew_up = .true.
       self%blew_up_at = t
-   end subroutine screen
+   end subroutine stop_keeping
 
    !> Default progress report: none.
    subroutine progress(self, step, steps)

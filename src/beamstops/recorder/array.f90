@@ -1,7 +1,7 @@
 !> The in-memory recorder: fills arrays sized before the run (the Python path).
 module beamstops_recorder_array
    use beamstops_kinds, only: wp, ik
-   use beamstops_recorder, only: recorder_type, n_columns, col_t
+   use beamstops_recorder, only: recorder_type, n_columns, col_t, all_finite
    implicit none
    private
    public :: array_recorder
@@ -69,9 +69,8 @@ contains
    subroutine record(self, row)
       class(array_recorder), intent(inout) :: self
       real(wp), intent(in) :: row(n_columns)
-      logical :: keep
-      call self%screen(row(col_t), row, keep)
-      if (.not. keep) then
+      if (self%blew_up .or. .not. all_finite(n_columns, row)) then
+         call self%stop_keeping(row(col_t))
          ! the stops' values of this row came just before it
          if (self%stops_filled > self%filled) self%stops_filled = self%filled
          return
@@ -88,9 +87,10 @@ contains
       class(array_recorder), intent(inout) :: self
       real(wp), intent(in) :: t
       real(wp), intent(in) :: u(:)
-      logical :: keep
-      call self%screen(t, u, keep)
-      if (.not. keep) return
+      if (self%blew_up .or. .not. all_finite(size(u), u)) then
+         call self%stop_keeping(t)
+         return
+      end if
       if (self%snaps >= size(self%snap_t, 1, ik)) then
          self%failed = .true.
          return

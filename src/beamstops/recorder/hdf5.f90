@@ -21,7 +21,7 @@ module beamstops_recorder_hdf5
    use beamstops_summary, only: run_summary, status_running, status_complete, status_diverged, status_failed
    use beamstops_files, only: file_exists, is_directory, same_file, rename_file
    use beamstops_recorder_hdf5_vector, only: write_vector
-   use beamstops_recorder, only: recorder_type, n_columns, col_t
+   use beamstops_recorder, only: recorder_type, n_columns, col_t, all_finite
    use beamstops_attributes, only: attribute_list, kind_real, kind_int, kind_logical, kind_text
    use beamstops_output_attributes, only: run_attributes, summary_attributes
    use beamstops_recorder_hdf5_observations, only: write_observations
@@ -133,9 +133,8 @@ contains
    subroutine record(self, row)
       class(hdf5_recorder), intent(inout) :: self
       real(wp), intent(in) :: row(n_columns)
-      logical :: keep
-      call self%screen(row(col_t), row, keep)
-      if (.not. keep) then
+      if (self%blew_up .or. .not. all_finite(n_columns, row)) then
+         call self%stop_keeping(row(col_t))
          ! the stops' values of this row came just before it
          if (self%stops > 0 .and. self%stops_fill > 0) self%stops_fill = self%stops_fill - 1
          return
@@ -191,9 +190,10 @@ contains
       class(hdf5_recorder), intent(inout) :: self
       real(wp), intent(in) :: t
       real(wp), intent(in) :: u(:)
-      logical :: keep
-      call self%screen(t, u, keep)
-      if (.not. keep) return
+      if (self%blew_up .or. .not. all_finite(size(u), u)) then
+         call self%stop_keeping(t)
+         return
+      end if
       self%snap_fill = self%snap_fill + 1
       self%snap_t_buffer(self%snap_fill) = t
       self%snap_u_buffer(:, self%snap_fill) = u
