@@ -693,13 +693,35 @@ contains
       write (output_unit, f) '      a (C = a M + b S)', model%damping_a, '1/s'
       write (output_unit, f) '      b', model%damping_b, 's'
       write (output_unit, fi) '&mesh elements', scene%elements, ''
+      write (output_unit, fi) '      modes', scene%modes, trim(merge('(a reduced model: r modes)', &
+         & '(0: the full model)       ', scene%modes > 0))
       write (output_unit, f) '&time dt', scene%dt, 's'
       write (output_unit, f) '      t_end', scene%t_end, 's'
       write (output_unit, f) '      beta', scene%beta, ''
       write (output_unit, fa) '      load_rule', trim(merge('centered', 'paper   ', scene%centered_load))
       write (output_unit, fa) '      start', trim(merge('taylor', 'euler ', scene%taylor_start))
+      write (output_unit, fa) '      allow_unstable', trim(merge('.true. ', '.false.', scene%allow_unstable))
       write (output_unit, fa) '&output file', scene%output_file
-      write (output_unit, fi) 'unknowns n', model%n, ''
+      write (output_unit, fi) '      record_every', scene%record_every, ''
+      write (output_unit, fi) '      snapshot_every', scene%snapshot_every, '(0: none)'
+      write (output_unit, fi) '      checkpoint_every', scene%checkpoint_every, '(0: none)'
+      write (output_unit, f) '      max_output_gb', scene%max_output_gb, 'GB'
+      write (output_unit, fa) '&statistics enabled', trim(merge('.true. ', '.false.', scene%statistics))
+      write (output_unit, f) '      transient', scene%transient, 's'
+      write (output_unit, fi) '      batches', scene%batches, ''
+      write (output_unit, fi) '      bins', scene%bins, ''
+      write (output_unit, f) '      rest_time', scene%rest_time, 's'
+      write (output_unit, f) '      histogram_lower', scene%histogram_lower, 'm'
+      write (output_unit, f) '      histogram_upper', scene%histogram_upper, 'm'
+      write (output_unit, fi) '&ensemble members', scene%members, ''
+      write (output_unit, f) '      perturbation', scene%perturbation, 'm'
+      write (output_unit, fi) '      seed', scene%seed, ''
+      if (scene%modes > 0) then
+         write (output_unit, '(a,t24,i0,a,i0,a)') 'unknowns n', model%n, ' of the full model (the run: a reduced '// &
+            & 'model of ', scene%modes, ' modes)'
+      else
+         write (output_unit, fi) 'unknowns n', model%n, ''
+      end if
       write (output_unit, f) 'kappa_h', model%kappa_h, '1/s^2 ('//model%kappa_method//')'
       write (output_unit, f) 'kappa_bound (5.2)', model%kappa_bound, '1/s^2'
       if (scene%law == law_compliance) write (output_unit, f) 'kappa with spring', model%kappa_contact, '1/s^2'
