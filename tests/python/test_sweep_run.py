@@ -379,3 +379,59 @@ def test_without_flock_the_pid_in_the_lock_file_decides(tmp_path: Path, write_sp
     with FolderLock(out) as lock:
         assert lock.unlocked and lock.stale == f"pid {dead.pid} host {socket.gethostname()}"
         assert (out / ".lock").read_text().split()[1] == str(os.getpid())
+
+
+UNSTABLE = """
+[scene]
+t_end = 0.01
+beta = 0
+dt = 1e-3
+[axes]
+omega = [5, 10]
+"""
+
+
+def sweep_command(*args: str | Path, cwd: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "beamstops", "sweep", *map(str, args)], cwd=cwd,
+                          capture_output=True, text=True, timeout=300)
+
+
+def test_a_sweep_with_failed_points_exits_3_and_says_so(tmp_path: Path, write_spec: Callable[..., Path]) -> None:
+    spec = write_spec(UNSTABLE)
+    done = sweep_command(spec, "-o", tmp_path / "out", "-j", "2", cwd=tmp_path)
+    assert done.returncode == 3, done.stderr
+    last = done.stderr.strip().splitlines()[-1]
+    assert last.startswith("beamstops: error: sweep: 2 of 2 points did not complete (2 failed, 0 diverged)")
+    assert [r["status"] for r in read_summary(tmp_path / "out")] == ["failed", "failed"]
+    # quiet: no progress, but the failure is still said, and the status is the same on a resume
+    again = sweep_command(spec, "-o", tmp_path / "out", "-q", cwd=tmp_path)
+    assert again.returncode == 3 and again.stderr.strip().startswith("beamstops: error: sweep: 2 of 2 points")
+    assert len(again.stderr.strip().splitlines()) == 1
+    # the status is documented
+    assert "3 some point failed" in sweep_command("--help", cwd=tmp_path).stdout
+
+
+def test_a_sweep_with_a_diverged_point_exits_3(tmp_path: Path, write_spec: Callable[..., Path]) -> None:
+    spec = write_spec("[scene]\nelements = 4\nt_end = 0.5\nbeta = 0.0\nallow_unstable = true\n"
+                      "[axes]\ndt = [1e-4, 1e-3]\n")  # the second diverges
+    done = sweep_command(spec, "-o", tmp_path / "out", "-j", "2", "-q", cwd=tmp_path)
+    assert done.returncode == 3, done.stderr
+    assert "1 of 2 points did not complete (0 failed, 1 diverged)" in done.stderr
+
+
+def test_a_sweep_whose_points_all_complete_exits_0(tmp_path: Path, write_spec: Callable[..., Path]) -> None:
+    done = sweep_command(write_spec(UNSTABLE.replace("beta = 0", "elements = 4").replace("1e-3", "1e-4")),
+                         "-o", tmp_path / "out", "-j", "2", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert "2 complete, 0 diverged, 0 failed" in done.stderr and "error" not in done.stderr
+
+
+@pytest.mark.parametrize("option, value", [("--timeout", "-1"), ("--timeout", "0"), ("--timeout", "nan"),
+                                           ("--interval", "-5"), ("--interval", "0")])
+def test_non_positive_timeout_and_interval_are_refused(option: str, value: str, tmp_path: Path,
+                                                       write_spec: Callable[..., Path]) -> None:
+    done = sweep_command(write_spec(UNSTABLE), "-o", tmp_path / "out", option, value, cwd=tmp_path)
+    assert done.returncode == 2
+    last = done.stderr.strip().splitlines()[-1]
+    assert f"argument {option}: '{value}': allowed: a number of seconds > 0" in last
+    assert not (tmp_path / "out").exists()

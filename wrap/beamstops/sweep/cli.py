@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
+from typing import Callable
 
 EPILOG = """\
 examples:
@@ -13,7 +15,14 @@ examples:
   mpiexec -n 9 python -m mpi4py.futures -m beamstops sweep SPEC -o DIR                # 8 MPI workers
 Running the same command again resumes: finished points are skipped. A folder holds one
 specification only. Summary: DIR/summary.csv (and summary.json); outputs: DIR/points/.
+exit status: 0 every point complete; 3 some point failed (refused, timed out, crashed) or
+diverged (the summary says which; running the same command again retries the failed ones);
+1 a bad specification, option or folder; 130 interrupted.
 """
+
+#: Exit status of a sweep in which some point failed (refused, timed out) or diverged, as for
+#: `beamstops run A.nml B.nml ...` with a scene that did not complete.
+INCOMPLETE = 3
 
 
 def _sweep(args: argparse.Namespace) -> int:
@@ -27,11 +36,31 @@ def _sweep(args: argparse.Namespace) -> int:
         raise ValueError("sweep: name the output folder with -o DIR")
     stream = None if args.quiet else sys.stderr
     try:
-        run_sweep(spec, args.output, executor=args.executor, jobs=args.jobs, program=args.program,
-                  timeout=args.timeout, stream=stream, interval=args.interval)
+        outcome = run_sweep(spec, args.output, executor=args.executor, jobs=args.jobs, program=args.program,
+                            timeout=args.timeout, stream=stream, interval=args.interval)
     except KeyboardInterrupt:
         return 130
-    return 0
+    if outcome.complete == outcome.total:
+        return 0
+    print(f"beamstops: error: sweep: {outcome.total - outcome.complete} of {outcome.total} points did not "
+          f"complete ({outcome.failed} failed, {outcome.diverged} diverged); their messages are in "
+          f"{outcome.summary}; running the same command again retries the failed ones", file=sys.stderr)
+    return INCOMPLETE
+
+
+def _positive(unit: str) -> Callable[[str], float]:
+    """An argparse type: a finite number > 0; argparse's message names the option, this one the range."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not (math.isfinite(value) and value > 0):
+            raise argparse.ArgumentTypeError(f"{text!r}: allowed: a number of {unit} > 0")
+        return value
+
+    return parse
 
 
 def _dry_run(spec, args: argparse.Namespace) -> int:  # type: ignore[no-untyped-def]
@@ -73,11 +102,12 @@ def register_sweep(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--set", action="append", metavar="TABLE.KEY=VALUE",
                         help="change the specification, e.g. --set axes.omega.num=20 (a TOML value; repeatable; "
                              "changes the hash, so use another folder)")
-    parser.add_argument("--timeout", type=float, help="wall-time limit of one point, s (default: [sweep] timeout)")
+    parser.add_argument("--timeout", type=_positive("seconds"),
+                        help="wall-time limit of one point, s > 0 (default: [sweep] timeout)")
     parser.add_argument("--program", help="the beamstops program to run (default: the one installed with "
                                           "this package)")
     parser.add_argument("--dry-run", action="store_true", help="check the specification, list points, run nothing")
-    parser.add_argument("--interval", type=float, default=10.0,
-                        help="seconds between progress lines when not on a terminal (default: 10)")
+    parser.add_argument("--interval", type=_positive("seconds"), default=10.0,
+                        help="seconds between progress lines when not on a terminal, > 0 (default: 10)")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress and no notes")
     parser.set_defaults(handler=_sweep)
