@@ -294,3 +294,16 @@ quantity = "damped"
 def test_damped_bifurcation_spec_is_valid() -> None:
     spec = load_spec(ROOT / "input" / "sweeps" / "bifurcation_damped.toml")
     assert spec.points[0].scene.ratio and "damped" in spec.reductions
+
+
+def test_the_allowed_scene_keys_are_listed_once_each(write_spec: Callable[..., Path]) -> None:
+    path = write_spec("[scene]\nomegaa = 3\n[axes]\nomega = [1]")
+    with pytest.raises(SpecError) as info:
+        load_spec(path)
+    allowed = str(info.value).split("allowed: ", 1)[1].split(", ")
+    assert "modes" in allowed and "omega" in allowed
+    assert len(allowed) == len(set(allowed)), sorted(k for k in allowed if allowed.count(k) > 1)
+    # a sweep's `modes` is the reduced model's (&mesh); the damping modes keep the base scene's
+    points = load_spec(write_spec("[axes]\nmodes = [0, 4]\n", "modes.toml")).points
+    assert [p.scene.modes for p in points] == [0, 4]
+    assert {p.scene.damping_modes for p in points} == {Scene().damping_modes}

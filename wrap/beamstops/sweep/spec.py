@@ -91,9 +91,11 @@ DEFAULT_MAX_POINTS = 10_000
 #: [sweep] max_points cannot go beyond this.
 HARD_MAX_POINTS = 10_000_000
 #: Keys a sweep may set: every namelist key but the output file, which the sweep names, and the
-#: positions of stops along the span (lists).
-SCENE_KEYS: tuple[str, ...] = tuple(key for keys in GROUPS.values() for key in keys
-                                    if key not in ("file", "nodes", "x"))
+#: positions of stops along the span (lists). ``modes`` is a key of &damping and of &mesh: a sweep's
+#: ``modes`` is the Scene field, &mesh's (the damping modes, a pair, go in the base namelist), so
+#: &damping's is left out and the list names each key once.
+SCENE_KEYS: tuple[str, ...] = tuple(key for group, keys in GROUPS.items() for key in keys
+                                    if key not in ("file", "nodes", "x") and (group, key) != ("damping", "modes"))
 _INT_KEYS = {f.name for f in dataclasses.fields(Scene) if f.type in ("int", int)}
 _KIND = {f.name: {"float": "real", "int": "integer", "bool": "boolean"}.get(str(f.type), "text")
          for f in dataclasses.fields(Scene)}
