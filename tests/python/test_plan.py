@@ -112,6 +112,8 @@ def test_cli_writes_the_chosen_scene(tmp_path: Path, capsys: pytest.CaptureFixtu
     (["--qoi", "tip", "--until", "0.08", "--tol", "-0.001"], "must be > 0"),
     (["--qoi", "energy", "--tol", "1e-3"], "unknown quantity 'energy'"),
     (["--qoi", "tip", "--tol", "1e-3"], "until"),
+    (["--qoi", "tip", "--until", "0.5", "--tol", "1e-3"],
+     "--until 0.5: beyond the scene's t_end = 0.1 s"),
 ])
 def test_cli_bad_input_is_one_line_and_exit_1(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                 arguments: list[str], message: str) -> None:
@@ -161,3 +163,54 @@ def test_a_shock_log_larger_than_its_room_runs_again_to_the_same_result() -> Non
     assert small.shocks == roomy.shocks > 1
     assert np.array_equal(small.impacts["impulse"], roomy.impacts["impulse"])
     assert np.array_equal(small.statistics["power"].value, roomy.statistics["power"].value)
+
+
+def test_until_beyond_the_scenes_t_end_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(ValueError, match=r"until 0\.5 s is beyond the scene's t_end = 0\.1 s; allowed: 0 < until ≤ 0\.1"):
+        plan(FREE, "tip", 1e-3, until=0.5, quiet=True)
+    scene_file = tmp_path / "free.nml"
+    FREE.to_namelist(scene_file)
+    assert cli.main(["plan", str(scene_file), "--qoi", "tip", "--until", "0.5", "--tol", "1e-3", "--quiet"]) == 1
+    assert "allowed: 0 < --until ≤ 0.1 s" in capsys.readouterr().err
+
+
+def test_a_plan_that_does_not_meet_the_tolerance_exits_3_and_writes_nothing(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    scene_file = tmp_path / "free.nml"
+    FREE.to_namelist(scene_file)
+    status = cli.main(["plan", str(scene_file), "--qoi", "tip", "--until", "0.05", "--tol", "1e-12", "--quiet"])
+    captured = capsys.readouterr()
+    assert status == 3
+    assert "does NOT qualify" in captured.out  # what it found is still printed
+    err = captured.err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("beamstops: error: plan: no model met the tolerance 1e-12 m"), err
+    assert err[0].endswith(f"{tmp_path / 'free_plan.nml'} not written")
+    assert not (tmp_path / "free_plan.nml").exists()
+    with pytest.raises(SystemExit):
+        cli.main(["plan", "--help"])
+    assert "3 the plan does not meet the tolerance" in capsys.readouterr().out
+
+
+def test_a_plan_whose_check_fails_exits_3(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    from beamstops import plan_cli
+    from beamstops.plan import Candidate, Check, Model
+
+    model, finer = Model("none", 19, 0, 1e-4), Model("none", 38, 0, 5e-5)
+    outcome = Plan(quantity=Quantity("tip", until=0.05), tolerance=1e-3, relative=None, unit="m",
+                   candidates=[Candidate(model, 0.03, float("nan"), 5e-4, {}, 0.01, "qualifies")])
+    outcome.choice, outcome.scene = outcome.candidates[0], FREE
+    outcome.check = Check(finer, 0.03, float("nan"), 0.032, float("nan"), 2e-3, 1e-3, None)
+    assert not outcome.met and "measured 0.002 m > tolerance 0.001 m" in (outcome.shortfall() or "")
+    monkeypatch.setattr(plan_cli, "plan", lambda *args, **kwargs: outcome)
+    scene_file = tmp_path / "free.nml"
+    FREE.to_namelist(scene_file)
+    assert cli.main(["plan", str(scene_file), "--qoi", "tip", "--until", "0.05", "--tol", "1e-3", "--quiet"]) == 3
+    captured = capsys.readouterr()
+    assert "FAIL" in captured.out and "qualified by its estimate, but its check" in captured.err
+    assert not (tmp_path / "free_plan.nml").exists()
+    # the same plan with a passing check is written, exit 0
+    outcome.check = Check(finer, 0.03, float("nan"), 0.0302, float("nan"), 2e-4, 1e-3, None)
+    assert outcome.met
+    assert cli.main(["plan", str(scene_file), "--qoi", "tip", "--until", "0.05", "--tol", "1e-3", "--quiet"]) == 0
+    assert (tmp_path / "free_plan.nml").exists()

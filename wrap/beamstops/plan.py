@@ -58,9 +58,14 @@ def plan(scene: Scene, qoi: Union[str, Quantity], tol: Union[str, float], *, unt
     noise). ``coarser``/``finer``: Δt ladder from dt·2^coarser down to dt/2^finer. ``exhaustive``:
     estimate every candidate (within the budget) instead of stopping at the first, in order of
     predicted cost, that qualifies. ``extend``: when nothing qualifies, add up to this many finer rungs
-    (Δt/2 and 2J each) and go on. Raises ValueError on bad input.
+    (Δt/2 and 2J each) and go on. Raises ValueError on bad input (``until`` beyond the scene's
+    ``t_end`` among them: the chosen scene keeps the scene's ``t_end``). :attr:`Plan.met` says whether
+    the outcome meets the tolerance, :meth:`Plan.shortfall` why not.
     """
     quantity = qoi if isinstance(qoi, Quantity) else Quantity(qoi, until=until)
+    if quantity.deterministic and quantity.until is not None and not quantity.until <= scene.t_end:
+        raise ValueError(f"until {quantity.until!r} s is beyond the scene's t_end = {scene.t_end!r} s; allowed: "
+                         f"0 < until ≤ {scene.t_end!r} s (the chosen scene runs to the scene's own t_end)")
     fraction, relative = parse_tolerance(tol)
     if budget is not None and not budget > 0:
         raise ValueError(f"budget {budget!r}: CPU seconds > 0")

@@ -143,6 +143,27 @@ class Plan:
     """Why the search stopped before finding a qualifying candidate (budget), or None."""
     notes: list[str] = field(default_factory=list)
 
+    @property
+    def met(self) -> bool:
+        """Whether the plan meets its tolerance: the choice's estimated error is within it and its
+        check against a finer run (when the engine could run one) measured a difference within it."""
+        return self.shortfall() is None
+
+    def shortfall(self) -> Optional[str]:
+        """Why the plan does not meet its tolerance, in one sentence, or None when it does."""
+        tol = f"{_g(self.tolerance)} {self.unit}".rstrip()
+        if self.choice is None:
+            return f"no candidate could be estimated{f' ({self.stopped})' if self.stopped else ''}"
+        c = self.choice
+        if not c.qualifies:
+            why = f"; {self.stopped}" if self.stopped else ""
+            return (f"no model met the tolerance {tol} (the best estimate found: {c.model.describe()}, estimated "
+                    f"error {_g(c.error)} {self.unit}{why})")
+        if self.check is not None and not self.check.passed:
+            return (f"the choice {c.model.describe()} qualified by its estimate, but its check against "
+                    f"{self.check.finer.describe()} measured {_g(self.check.difference)} {self.unit} > tolerance {tol}")
+        return None
+
     def table(self) -> str:
         """The candidates as a markdown table."""
         unit = f" ({self.unit})" if self.unit else ""
