@@ -361,3 +361,39 @@ def test_importing_the_package_does_not_import_pyplot() -> None:
     code = "import sys, beamstops, beamstops.plots; print('matplotlib.pyplot' in sys.modules)"
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, env=headless())
     assert done.stdout.strip() == "False", done.stderr
+
+
+def plot_command(*args: str | Path, cwd: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "beamstops", "plot", *map(str, args)], cwd=cwd,
+                          capture_output=True, text=True, timeout=120, env=headless())
+
+
+@pytest.mark.parametrize("spelling", ["existing", "existing/", "new/", "."])
+def test_command_line_refuses_a_folder_as_output(spelling: str, output: Path, tmp_path: Path) -> None:
+    (tmp_path / "existing").mkdir()
+    done = plot_command(output, "-o", spelling, cwd=tmp_path)
+    assert done.returncode == 1 and done.stdout == ""
+    assert done.stderr.strip() == (f"beamstops: error: -o {spelling}: is a folder; name the image file to write, "
+                                   f"e.g. -o {Path(spelling) / 'out_tip.png'}")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["existing"]  # nothing written beside it
+    assert list((tmp_path / "existing").iterdir()) == []
+
+
+def test_command_line_prints_the_file_it_wrote(output: Path, tmp_path: Path) -> None:
+    done = plot_command(output, "-o", "noext", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "noext.png" and (tmp_path / "noext.png").read_bytes()[:8] == PNG
+    assert not (tmp_path / "noext").exists()
+    done = plot_command(output, "-o", "figure.pdf", cwd=tmp_path)
+    assert done.returncode == 0 and done.stdout.strip() == "figure.pdf"
+    assert (tmp_path / "figure.pdf").read_bytes()[:4] == b"%PDF"
+
+
+def test_save_gives_the_file_written_and_refuses_a_folder(result: beamstops.Result, tmp_path: Path) -> None:
+    written = plots.save(result, tmp_path / "noext", kind="energy")
+    assert written == tmp_path / "noext.png" and written.read_bytes()[:8] == PNG
+    with pytest.raises(IsADirectoryError, match=r"is a folder; name the image file to write"):
+        plots.save(result, tmp_path)
+    with pytest.raises(IsADirectoryError, match=r"is a folder"):
+        plots.save(result, f"{tmp_path}/new/", kind="animation")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["noext.png"]

@@ -22,15 +22,18 @@ def _plot(args: argparse.Namespace) -> int:
     from . import plots
     from .result import load
 
-    result = load(args.file, allow_incomplete=args.allow_incomplete)
     suffix = ".gif" if args.kind == "animation" else ".png"
-    out = args.output or Path(args.file).with_name(f"{Path(args.file).stem}_{args.kind}{suffix}")
+    default = f"{Path(args.file).stem}_{args.kind}{suffix}"
+    if args.output is not None and plots.names_folder(args.output):
+        raise ValueError(f"-o {args.output}: is a folder; name the image file to write, e.g. "
+                         f"-o {Path(args.output) / default}")
+    result = load(args.file, allow_incomplete=args.allow_incomplete)
+    out = args.output or Path(args.file).with_name(default)
     if args.kind == "animation":
         options = {"frames": args.frames, "fps": args.fps}
     else:
         options = {"transient": args.transient} if args.transient is not None else {}
-    plots.save(result, out, kind=args.kind, dpi=args.dpi, **options)
-    print(out)
+    print(plots.save(result, out, kind=args.kind, dpi=args.dpi, **options))
     return 0
 
 
@@ -55,8 +58,10 @@ def register_plot(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser("plot", help="plot the HDF5 output of `beamstops run`",
                                    description="Plot the HDF5 output of `beamstops run` (no display needed).")
     parser.add_argument("file", type=Path, help="HDF5 file written by `beamstops run`")
-    parser.add_argument("-o", "--output", type=Path,
-                        help="image to write (default: FILE_KIND.png next to FILE; FILE_animation.gif for animation)")
+    parser.add_argument("-o", "--output",
+                        help="image file to write, not a folder; its extension gives the format (none: .png); "
+                             "the name written is printed (default: FILE_KIND.png next to FILE; "
+                             "FILE_animation.gif for animation)")
     parser.add_argument("--kind", choices=KINDS, default="tip",
                         help="tip: tip displacement; shape or spacetime: the beam's ũ(x, t) from snapshots; energy; "
                              "phase: tip phase portrait; reaction; stops: the stops along the span (one panel each); "

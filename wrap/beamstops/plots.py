@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any, Callable, Optional
 
 import numpy as np
-from matplotlib import rc_context
+from matplotlib import rc_context, rcParams
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
@@ -314,12 +314,23 @@ def figure(result: Result, kind: str = "tip", *, transient: Optional[float] = No
     return fig
 
 
-def save(result: Result, path: str | os.PathLike[str], kind: str = "tip", dpi: int = 120, **options: Any) -> Path:
-    """Draw a figure of one kind and write it (the format follows the file's extension).
+def names_folder(path: str | os.PathLike[str]) -> bool:
+    """Whether ``path`` names a folder: an existing one, or a name ending with a separator."""
+    raw = os.fspath(path)
+    return raw.endswith(("/", os.sep)) or os.path.isdir(raw)
 
-    ``kind='animation'`` writes the beam moving between its stops to a .gif (or .mp4 with
-    ffmpeg); its options are ``frames`` (at most this many, default 200) and ``fps``.
+
+def save(result: Result, path: str | os.PathLike[str], kind: str = "tip", dpi: int = 120, **options: Any) -> Path:
+    """Draw a figure of one kind and write it; gives the path of the file written.
+
+    The format follows the file's extension; a name without one gets matplotlib's default
+    format's (``savefig.format``, .png), and the path given back has it. A folder is refused
+    (IsADirectoryError). ``kind='animation'`` writes the beam moving between its stops to a .gif
+    (or .mp4 with ffmpeg); its options are ``frames`` (at most this many, default 200) and ``fps``.
     """
+    if names_folder(path):
+        raise IsADirectoryError(f"{os.fspath(path)}: is a folder; name the image file to write, e.g. "
+                                f"{Path(path) / ('animation.gif' if kind == 'animation' else kind + '.png')}")
     if kind == "animation":
         from .animation import animate
 
@@ -327,5 +338,7 @@ def save(result: Result, path: str | os.PathLike[str], kind: str = "tip", dpi: i
     fig = figure(result, kind, **options)
     path = Path(path)
     with rc_context({"agg.path.chunksize": 20000}):
+        if not path.suffix:  # what matplotlib would do, named here so that the caller knows the file
+            path = path.with_name(f"{path.name}.{rcParams['savefig.format']}")
         fig.savefig(path, dpi=dpi)
     return path
