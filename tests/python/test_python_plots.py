@@ -397,3 +397,19 @@ def test_save_gives_the_file_written_and_refuses_a_folder(result: beamstops.Resu
     with pytest.raises(IsADirectoryError, match=r"is a folder"):
         plots.save(result, f"{tmp_path}/new/", kind="animation")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["noext.png"]
+
+
+def test_command_line_names_its_option_for_an_incomplete_run(program: str, tmp_path: Path) -> None:
+    Scene(beta=0.0, dt=2e-5, t_end=0.5, allow_unstable=True, record_every=100, file="bad.h5").to_namelist(
+        tmp_path / "bad.nml")
+    assert subprocess.run([program, "run", "bad.nml"], cwd=tmp_path, capture_output=True, timeout=120).returncode == 3
+    done = plot_command("bad.h5", "-o", "bad.png", cwd=tmp_path)
+    assert done.returncode == 1 and not (tmp_path / "bad.png").exists()
+    err = done.stderr.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("beamstops: error: bad.h5: run diverged: "), err
+    assert err[0].endswith("; plot what it holds with --allow-incomplete") and "allow_incomplete" not in err[0]
+    done = plot_command("bad.h5", "-o", "bad.png", "--allow-incomplete", cwd=tmp_path)
+    assert done.returncode == 0 and done.stdout.strip() == "bad.png", done.stderr
+    # from Python, the message names the keyword
+    with pytest.raises(beamstops.IncompleteRunError, match=r"pass allow_incomplete=True to read what it holds$"):
+        beamstops.load(tmp_path / "bad.h5")

@@ -20,14 +20,17 @@ from typing import Callable, Optional, Sequence
 
 def _plot(args: argparse.Namespace) -> int:
     from . import plots
-    from .result import load
+    from .result import IncompleteRunError, load
 
     suffix = ".gif" if args.kind == "animation" else ".png"
     default = f"{Path(args.file).stem}_{args.kind}{suffix}"
     if args.output is not None and plots.names_folder(args.output):
         raise ValueError(f"-o {args.output}: is a folder; name the image file to write, e.g. "
                          f"-o {Path(args.output) / default}")
-    result = load(args.file, allow_incomplete=args.allow_incomplete)
+    try:
+        result = load(args.file, allow_incomplete=args.allow_incomplete)
+    except IncompleteRunError as exc:  # its message names the Python keyword; here it is the option
+        raise ValueError(f"{exc.reason}; plot what it holds with --allow-incomplete") from None
     out = args.output or Path(args.file).with_name(default)
     if args.kind == "animation":
         options = {"frames": args.frames, "fps": args.fps}

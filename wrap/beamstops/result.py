@@ -72,11 +72,15 @@ ARRAYS: dict[str, str] = {
 
 
 class IncompleteRunError(ValueError):
-    """A run that did not complete (diverged, failed or interrupted); ``result`` holds what was recorded."""
+    """A run that did not complete (diverged, failed or interrupted); ``result`` holds what was recorded.
 
-    def __init__(self, message: str, result: Optional[Result] = None) -> None:
+    ``reason`` is what is wrong (the message without its advice, which names the Python keyword
+    ``allow_incomplete``: a command line names its own option instead)."""
+
+    def __init__(self, message: str, result: Optional[Result] = None, reason: Optional[str] = None) -> None:
         super().__init__(message)
         self.result = result
+        self.reason = reason if reason is not None else message
 
 
 @dataclass(eq=False)
@@ -190,6 +194,6 @@ def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result
     result = Result(**arrays, impacts=impacts, statistics=statistics, statistics_attrs=statistics_attrs, ensemble=ensemble,
                     attrs=attrs, source=path)
     if result.status != "complete" and not allow_incomplete:
-        raise IncompleteRunError(f"{path}: run {result.status}: {attrs.get('message', 'not complete')}; "
-                                 "pass allow_incomplete=True to read what it holds", result)
+        reason = f"{path}: run {result.status}: {attrs.get('message', 'not complete')}"
+        raise IncompleteRunError(f"{reason}; pass allow_incomplete=True to read what it holds", result, reason)
     return result
