@@ -212,3 +212,26 @@ def test_runs_in_threads_release_the_interpreter_and_agree() -> None:
     done.set()
     counter.join()
     assert during >= 10, during
+
+
+def test_load_of_a_folder_says_it_is_a_folder(tmp_path: Path) -> None:
+    with pytest.raises(IsADirectoryError, match=r"is a folder, not the HDF5 output of `beamstops run`"):
+        beamstops.load(tmp_path)
+    with pytest.raises(FileNotFoundError, match="no such file"):
+        beamstops.load(tmp_path / "nowhere.h5")
+
+
+def test_submodules_are_reachable_from_the_package_after_a_plain_import() -> None:
+    code = "\n".join([
+        "import sys, beamstops",
+        "assert 'matplotlib' not in sys.modules and 'beamstops.plots' not in sys.modules",  # imported when used
+        "assert callable(beamstops.plots.save) and callable(beamstops.plan.plan)",  # as the README writes them
+        "assert callable(beamstops.sweep.run_sweep) and 'plots' in dir(beamstops)",
+        "try:",
+        "    beamstops.nothing",
+        "except AttributeError as exc:",
+        "    print(exc)",
+    ])
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "module 'beamstops' has no attribute 'nothing'"

@@ -212,3 +212,9 @@ def test_any_file_name_goes_through(tmp_path: Path) -> None:
     assert Scene.from_namelist(path) == engine.read_namelist(path) == Scene(dt=1e-5, file="scène.h5")
     with pytest.raises(ValueError, match="scène.nml: &time dt = -1"):
         Scene.from_text("&time dt=-1 /", str(path))
+
+
+@pytest.mark.parametrize("text, kind", [(123, "int"), (b"&time /", "bytes"), (None, "NoneType")])
+def test_from_text_of_something_not_text_is_a_type_error(text: object, kind: str) -> None:
+    with pytest.raises(TypeError, match=rf"^Scene.from_text: text must be a str of namelist text, not {kind}\b"):
+        Scene.from_text(text)  # type: ignore[arg-type]

@@ -165,6 +165,8 @@ def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result
     import h5py
 
     path = os.fspath(path)
+    if os.path.isdir(path):
+        raise IsADirectoryError(f"{path}: is a folder, not the HDF5 output of `beamstops run`; name the file")
     if not os.path.isfile(path):
         raise FileNotFoundError(f"{path}: no such file")
     try:

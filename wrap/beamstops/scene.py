@@ -163,7 +163,12 @@ class Scene:
 
     @classmethod
     def from_text(cls, text: str, source: str = "scene") -> Scene:
-        """The scene of namelist text, read by the engine; ValueError with its message otherwise."""
+        """The scene of namelist text, read by the engine; ValueError with its message otherwise
+        (TypeError when ``text`` is not a str: a file is read by :meth:`from_namelist`)."""
+        if not isinstance(text, str):
+            raise TypeError(f"Scene.from_text: text must be a str of namelist text, not {type(text).__name__}"
+                            f"{' (decode it first)' if isinstance(text, (bytes, bytearray)) else ''}; "
+                            "a file is read by Scene.from_namelist(path)")
         return cls._of_canonical(_canonical(text, source))
 
     @classmethod
