@@ -413,3 +413,19 @@ def test_command_line_names_its_option_for_an_incomplete_run(program: str, tmp_p
     # from Python, the message names the keyword
     with pytest.raises(beamstops.IncompleteRunError, match=r"pass allow_incomplete=True to read what it holds$"):
         beamstops.load(tmp_path / "bad.h5")
+
+
+def test_command_line_does_not_flood_stderr_with_font_lookups(output: Path, tmp_path: Path) -> None:
+    # a configuration asking for a font family that is nowhere: every text's lookup falls back to
+    # DejaVu Sans, which matplotlib logs as a warning each time (as a font cache without cmr10 does)
+    config = tmp_path / "mplconfig"
+    config.mkdir()
+    (config / "matplotlibrc").write_text("font.family: beamstops-absent-font\nmathtext.fontset: cm\n")
+    env = {**headless(), "MPLCONFIGDIR": str(config)}
+    probe = subprocess.run([sys.executable, "-c", "import matplotlib.font_manager as fm; fm.findfont(fm.FontProperties())"],
+                           capture_output=True, text=True, timeout=120, env=env)
+    assert "findfont" in probe.stderr  # the situation is there
+    done = subprocess.run([sys.executable, "-m", "beamstops", "plot", str(output), "-o", str(tmp_path / "p.png"),
+                           "--kind", "psd"], capture_output=True, text=True, timeout=120, env=env)
+    assert done.returncode == 0, done.stderr
+    assert done.stderr == "" and (tmp_path / "p.png").read_bytes()[:8] == PNG

@@ -121,10 +121,21 @@ def commands() -> dict[str, str]:
     return {choice.dest: choice.help or "" for choice in action._choices_actions}
 
 
+def quiet_font_lookup() -> None:
+    """Keep matplotlib's font lookup from flooding stderr: with a font cache that lacks a family
+    mathtext asks for (cmr10, STIXGeneral, DejaVu Sans Display on log axes), every lookup logs a
+    warning ``findfont: Font family [...] not found. Falling back to DejaVu Sans.``; the fallback
+    draws the same text, so the command line logs only the font manager's errors."""
+    import logging
+
+    logging.getLogger("matplotlib.font_manager").setLevel(logging.ERROR)
+
+
 def main(argv: Optional[Sequence[str]] = None, prog: str = "python -m beamstops") -> int:
     """Run a subcommand; ``prog`` names the command in messages (``beamstops`` when the
     program hands a subcommand on)."""
     args = build_parser(prog).parse_args(argv)
+    quiet_font_lookup()
     try:
         return int(args.handler(args))
     except (OSError, ValueError) as exc:
