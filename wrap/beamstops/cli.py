@@ -7,7 +7,9 @@ add its name and one-line help to the table of the program (``python_commands`` 
 src/main.f90), which hands these subcommands to this module: ``beamstops plot ...`` runs
 ``main(["plot", ...], prog="beamstops")`` in the Python beside the program
 (tests/python/test_cli.py checks that the two tables agree).
-Errors a user can fix end in one line ``beamstops: error: ...`` and exit status 1.
+Errors a user can fix end in one line ``beamstops: error: ...`` and exit status 1; a command that
+ran but did not reach its goal (a sweep with points that failed or diverged, a plan that does not
+meet its tolerance) says so in such a line and exits 3.
 """
 
 from __future__ import annotations
