@@ -148,7 +148,7 @@ contains
       character(len=*), parameter :: no_file = achar(1)
       integer :: stat, g
 
-      call scan_groups(text, source, has_group, groups_text, cleaned, error)
+      call scan_groups(without_bom(text), source, has_group, groups_text, cleaned, error)
       if (allocated(error)) return
 
       length = scene%length; k2 = unset; mass_per_length = unset
@@ -410,6 +410,17 @@ contains
             & ' in `'//trim(groups_text(g))//'`; keys of &'//trim(group_names(g))//': '//trim(group_keys(g)))
       end subroutine malformed_key
    end subroutine scene_from_text
+
+   !> The text without the UTF-8 byte order mark some editors put at its start.
+   pure function without_bom(text) result(rest)
+      character(len=*), intent(in) :: text
+      character(len=:), allocatable :: rest
+      character(len=*), parameter :: bom = char(239)//char(187)//char(191)
+      rest = text
+      if (len(text) >= len(bom)) then
+         if (text(:len(bom)) == bom) rest = text(len(bom) + 1:)
+      end if
+   end function without_bom
 
    !> The key (lower case) that starts at position `start` of a group's body.
    function key_at(body, start) result(key)

@@ -527,3 +527,12 @@ def test_a_key_given_twice_in_a_group_is_refused(tmp_path: Path) -> None:
     # the elements of an array, each once, are not a repetition
     scene = write(tmp_path, "&damping ratio(1)=0.01, ratio(2)=0.02 /\n&time dt=5e-5, t_end=0.001 /\n")
     assert beamstops("run", scene, cwd=tmp_path).returncode == 0
+
+
+def test_a_byte_order_mark_at_the_start_of_a_namelist_is_ignored(tmp_path: Path) -> None:
+    scene = tmp_path / "bom.nml"
+    scene.write_bytes(b"\xef\xbb\xbf&time dt=5e-5, t_end=0.001 /\n&output file='bom.h5' /\n")
+    done = beamstops("run", scene, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    with h5py.File(tmp_path / "bom.h5") as f:
+        assert f.attrs["status"] == b"complete" and f.attrs["steps"] == 20

@@ -144,10 +144,8 @@ def test_tip_only_output_has_no_stops(program: str, tmp_path: Path) -> None:
 def test_killed_run_resumes_bit_for_bit(program: str, tmp_path: Path) -> None:
     text = SUPPORTS.replace(dt=1e-6, t_end=1.0, record_every=7, snapshot_every=9973).groups()
     for name in ("reference", "killed"):
-        Scene(**{k: v for g in text.values() for k, v in g.items()}).replace(file=f"{name}.h5").to_namelist(
-            tmp_path / f"{name}.nml")
-        nml = tmp_path / f"{name}.nml"
-        nml.write_text(nml.read_text().replace("&output", "&output\n    checkpoint_every = 100000"))
+        Scene(**{k: v for g in text.values() for k, v in g.items()}).replace(
+            file=f"{name}.h5", checkpoint_every=100000).to_namelist(tmp_path / f"{name}.nml")
     assert subprocess.run([program, "run", "reference.nml"], cwd=tmp_path, timeout=300).returncode == 0
     process = subprocess.Popen([program, "run", "killed.nml"], cwd=tmp_path, stdout=subprocess.DEVNULL,
                                stderr=subprocess.DEVNULL)

@@ -15,6 +15,7 @@ the run's figures and the reductions) is written next to its HDF5 file as ``NAME
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -22,7 +23,7 @@ import re
 import subprocess
 import time
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, Callable, Optional
 
 __all__ = ["run_point", "run_batch", "read_status", "FINISHED"]
 
@@ -75,10 +76,30 @@ def _clean(value: Any) -> Any:
 
 
 _ARMED = False
+_BUSY = 0  # run_batch / run_point calls under way in this worker
 
 
 def _on_term(signum: int, frame: Any) -> None:
-    raise SystemExit(128 + signum)  # subprocess.run kills the running program on the way out
+    if _BUSY:
+        raise SystemExit(128 + signum)  # subprocess.run kills the running program on the way out
+    # idle (waiting for work, or shutting down): an exception raised here would surface as an
+    # "Exception ignored" traceback from the pool's machinery; nothing of ours needs cleaning
+    os._exit(128 + signum)
+
+
+def _busy(function: Callable[[Any], dict[str, Any]]) -> Callable[[Any], dict[str, Any]]:
+    """Count the call as work under way, for _on_term."""
+
+    @functools.wraps(function)
+    def counted(argument: Any) -> dict[str, Any]:
+        global _BUSY
+        _BUSY += 1
+        try:
+            return function(argument)
+        finally:
+            _BUSY -= 1
+
+    return counted
 
 
 def _arm() -> None:
@@ -96,6 +117,7 @@ def _arm() -> None:
     _ARMED = True
 
 
+@_busy
 def run_point(task: dict[str, Any]) -> dict[str, Any]:
     """Run (or, with ``task['reduce_only']``, only reduce) one point; never raises an Exception."""
     _arm()
@@ -167,6 +189,7 @@ def _base_record(task: dict[str, Any], folder: Path, h5: Path) -> dict[str, Any]
 _GROUPS = re.compile(r"^beamstops: (\d+) scenes: (\d+) in (\d+) lockstep group")
 
 
+@_busy
 def run_batch(tasks: list[dict[str, Any]]) -> dict[str, Any]:
     """Run points together as one ``beamstops run P1.nml P2.nml ...`` (the engine runs those
     that share A in lockstep), then reduce each; the points that did not end with a finished
