@@ -108,9 +108,17 @@ def test_bad_scenes_raise_value_error_with_the_engines_message(label: str, chang
     assert "allowed" in str(caught.value) or "keys of &" in str(caught.value)
 
 
+def python_child(lines: list[str]) -> str:
+    """Run the lines as a Python program in a child process (a crash shows as a failed test, not
+    a dead test run); its standard output."""
+    done = subprocess.run([sys.executable, "-c", "\n".join(lines)], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    return done.stdout
+
+
 def test_bad_scenes_never_crash_the_interpreter() -> None:
     # In a child process, so that a crash would show as a failed test, not a dead test run.
-    code = "\n".join([
+    out = python_child([
         "import beamstops, math",
         "from beamstops import Scene",
         "bad = [dict(dt=-1.0), dict(dt=math.nan), dict(dt=math.inf), dict(elements=0), dict(elements=-5),",
@@ -126,9 +134,7 @@ def test_bad_scenes_never_crash_the_interpreter() -> None:
         "            n += 1",
         "print(n)",
     ])
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
-    assert done.returncode == 0, done.stderr
-    assert int(done.stdout) == 16 * 3
+    assert int(out) == 16 * 3
 
 
 def test_a_diverged_run_is_an_incomplete_run_error_holding_the_partial_result() -> None:
@@ -220,9 +226,8 @@ def test_load_of_a_folder_says_it_is_a_folder(tmp_path: Path) -> None:
     with pytest.raises(FileNotFoundError, match="no such file"):
         beamstops.load(tmp_path / "nowhere.h5")
 
-
 def test_submodules_are_reachable_from_the_package_after_a_plain_import() -> None:
-    code = "\n".join([
+    out = python_child([
         "import sys, beamstops",
         "assert 'matplotlib' not in sys.modules and 'beamstops.plots' not in sys.modules",  # imported when used
         "assert callable(beamstops.plots.save) and callable(beamstops.plan.plan)",  # as the README writes them
@@ -232,6 +237,4 @@ def test_submodules_are_reachable_from_the_package_after_a_plain_import() -> Non
         "except AttributeError as exc:",
         "    print(exc)",
     ])
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
-    assert done.returncode == 0, done.stderr
-    assert done.stdout.strip() == "module 'beamstops' has no attribute 'nothing'"
+    assert out.strip() == "module 'beamstops' has no attribute 'nothing'"
