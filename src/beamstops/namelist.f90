@@ -465,12 +465,14 @@ contains
       select case (key)
       case ('elements', 'record_every', 'snapshot_every', 'checkpoint_every', 'batches', 'bins', 'members', 'seed')
          kind = 'a whole number'
-      case ('nodes', 'modes')
+      case ('nodes')
+         kind = 'whole numbers separated by commas (one per stop, at most '//itoa(max_stops)//' stops)'
+      case ('modes')
          kind = 'whole numbers separated by commas'
       case ('ratio')
          kind = 'one or two real numbers separated by commas'
       case ('lower', 'upper', 'x')
-         kind = 'real numbers separated by commas (one per stop)'
+         kind = 'real numbers separated by commas (one per stop, at most '//itoa(max_stops)//' stops)'
       case ('law', 'load_rule', 'start', 'file', 'mass')
          kind = "a quoted text, e.g. 'name'"
       case ('allow_unstable', 'enabled')

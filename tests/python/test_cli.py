@@ -536,3 +536,9 @@ def test_a_byte_order_mark_at_the_start_of_a_namelist_is_ignored(tmp_path: Path)
     assert done.returncode == 0, done.stderr
     with h5py.File(tmp_path / "bom.h5") as f:
         assert f.attrs["status"] == b"complete" and f.attrs["steps"] == 20
+
+
+def test_too_many_stops_along_the_span_are_refused_naming_the_limit(tmp_path: Path) -> None:
+    scene = write(tmp_path, "&stops nodes=" + ",".join(["19"] * 1001) + ", lower=-0.01, upper=0.01 /\n")
+    line = one_error_line(beamstops("run", scene, cwd=tmp_path))
+    assert "&stops nodes" in line and "at most 1000 stops" in line
