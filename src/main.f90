@@ -189,13 +189,12 @@ contains
    !> The help (on stdout), or one line on stderr naming the problem, with exit status 2.
    subroutine usage(problem)
       character(len=*), intent(in), optional :: problem
-      integer :: unit, k
-      unit = output_unit
+      integer :: k
       if (present(problem)) then
          write (error_unit, '(a)') 'beamstops: '//problem//' (beamstops --help: the commands)'
          call quit(exit_usage)
       end if
-      write (unit, '(a)') 'usage: beamstops COMMAND [ARGUMENTS]', '', &
+      write (output_unit, '(a)') 'usage: beamstops COMMAND [ARGUMENTS]', '', &
          & 'commands of the engine:', &
          & '  run FILE.nml [-o OUT.h5] [--restart]', &
          & '                  run a scene, write its HDF5 output (OUT.h5.partial until the run is done);', &
@@ -206,9 +205,9 @@ contains
          & '  info FILE.nml   print the scene, kappa_h, stability limits and cost, without running', &
          & 'commands of the Python package (python -m beamstops of this environment; COMMAND --help):'
       do k = 1, n_python_commands
-         write (unit, '(a)') '  '//python_commands(k)//'  '//trim(python_help(k))
+         write (output_unit, '(a)') '  '//python_commands(k)//'  '//trim(python_help(k))
       end do
-      write (unit, '(a)') '  --version       print the version', &
+      write (output_unit, '(a)') '  --version       print the version', &
          & 'exit statuses: 0 success, 1 bad input, 2 bad command line (or no Python for its commands),', &
          & '  3 the run diverged or failed, 4 the output could not be written or would destroy a file'
       stop

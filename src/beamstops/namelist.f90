@@ -261,8 +261,8 @@ contains
       if (allocated(error)) return
       call validate_physics(scene, source, error)
       if (allocated(error)) return
-      call validate_statistics(scene%transient, real(steps_of(scene), wp)*scene%dt, scene%batches, scene%bins, scene%rest_time, &
-         & scene%histogram_lower, scene%histogram_upper, source, error)
+      call validate_statistics(scene%transient, real(steps_of(scene), wp)*scene%dt, scene%batches, scene%bins, &
+         & scene%rest_time, scene%histogram_lower, scene%histogram_upper, source, error)
       if (allocated(error)) return
       call validate_ensemble(scene%members, source, error)
       if (allocated(error)) return
