@@ -274,7 +274,8 @@ contains
          if (ms%contact(k) .and. .not. ms%in_contact(k)) ms%impacts(k) = ms%impacts(k) + 1
          ms%in_contact(k) = ms%contact(k)
          ms%work(k) = ms%work(k) + 0.5_wp*ms%weight(k)*(ms%gd(k) + ms%gd_prev(k))
-         ms%reaction(k) = ms%r_step(k)
+         ! recorded only where the stop acts (tip_step_massless)
+         ms%reaction(k) = merge(ms%r_step(k), 0.0_wp, ms%contact(k))
          ms%gd_prev(k) = ms%gd(k)
          ms%sigma_prev(k) = ms%sigma_now(k)
          ms%sigma_now(k) = ms%sigma_next(k)

@@ -168,7 +168,7 @@ contains
    end subroutine build_model
 
    !> Rayleigh damping (SPEC 8): a and b, given or solved from the ratios at two modes,
-   !> zeta(omega) = a/(2 omega) + b omega/2 (one ratio given, the second left 0: both equal), the
+   !> zeta(omega) = a/(2 omega) + b omega/2 (the reader gives both modes one ratio when one is given), the
    !> frequencies those of the model's own pencil (S, M) (M^rho with mass redistribution);
    !> then C = a M + b S.
    subroutine build_damping(scene, model, error)
@@ -181,17 +181,16 @@ contains
       model%damping_b = scene%damping_stiffness
       if (scene%damping_by_ratio) then
          zeta = scene%damping_ratio
-         if (zeta(2) == 0) zeta(2) = zeta(1)
          if (model%n > exact_eigen_limit) then
-            call fatal_error(error, '&damping damping_ratio: the ratio form needs the frequencies of the mesh, '// &
+            call fatal_error(error, '&damping ratio: the ratio form needs the frequencies of the mesh, '// &
                & 'computed for 2 elements <= '//fmt_real(real(exact_eigen_limit, wp))//' only; give '// &
-               & 'damping_mass and damping_stiffness instead')
+               & 'mass_coefficient and stiffness_coefficient instead')
             return
          end if
          call generalized_eigenvalues(model%stiffness, model%mass, size(model%massless), kappa, error)
          if (allocated(error)) return
          if (any(scene%damping_modes > size(kappa))) then
-            call fatal_error(error, '&damping damping_modes: the model has '//fmt_real(real(size(kappa), wp))// &
+            call fatal_error(error, '&damping modes: the model has '//fmt_real(real(size(kappa), wp))// &
                & ' modes only')
             return
          end if
@@ -203,7 +202,7 @@ contains
          model%damping_a = (zeta(1)*w2/2 - zeta(2)*w1/2)/det
          model%damping_b = (zeta(2)/(2*w1) - zeta(1)/(2*w2))/det
          if (model%damping_a < 0 .or. model%damping_b < 0) then
-            call fatal_error(error, '&damping damping_ratio = '//fmt_real(zeta(1))//', '//fmt_real(zeta(2))// &
+            call fatal_error(error, '&damping ratio = '//fmt_real(zeta(1))//', '//fmt_real(zeta(2))// &
                & ' at modes of '//fmt_real(w1, 6)//' and '//fmt_real(w2, 6)//' rad/s gives a = '// &
                & fmt_real(model%damping_a, 6)//' 1/s, b = '//fmt_real(model%damping_b, 6)// &
                & ' s; allowed: ratios giving a >= 0 and b >= 0')
@@ -211,8 +210,8 @@ contains
          end if
       end if
       if (model%redistributed .and. model%damping_b /= 0) then
-         call fatal_error(error, '&stops redistributed_mass = .true. with stiffness-proportional damping (b = '// &
-            & fmt_real(model%damping_b, 6)//' s) is not supported; allowed: &damping damping_mass alone')
+         call fatal_error(error, '&stops mass = ''redistributed'' with stiffness-proportional damping (b = '// &
+            & fmt_real(model%damping_b, 6)//' s) is not supported; allowed: &damping mass_coefficient alone')
          return
       end if
       model%damped = model%damping_a /= 0 .or. model%damping_b /= 0
@@ -273,7 +272,7 @@ contains
       if (model%redistributed) then
          ! M^rho is singular: the finite spectrum from the pencil taken the other way round.
          if (model%n > exact_eigen_limit) then
-            call fatal_error(error, '&stops redistributed_mass = .true.: the spectrum of M^rho is computed for '// &
+            call fatal_error(error, '&stops mass = ''redistributed'': the spectrum of M^rho is computed for '// &
                & '2 elements <= '//fmt_real(real(exact_eigen_limit, wp))//' only')
             return
          end if

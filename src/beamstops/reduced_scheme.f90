@@ -441,7 +441,7 @@ contains
             state%stop_reaction = state%span%lambda/dt2
             if (state%observer%active) call state%observer%span(real(step + 1, wp)*reduced%dt, &
                & state%q(reduced%r + 1:) + reduced%stops%lift*phi_next, state%stop_reaction, &
-               & dot_product(reduced%tip_row, state%q), state%dissipated)
+               & dot_product(reduced%tip_row, state%q), state%span%taken)
             phi_prev = phi_now
             phi_now = phi_next
          else
@@ -564,9 +564,10 @@ contains
          state%work = state%work + 0.5_wp*weight*(gd + state%gd_prev)
          state%dissipated = state%dissipated - 0.5_wp*r_step*(state%d(pt) + old_dtip)
          if (reduced%damped) call damping_loss(reduced, state)
-         state%reaction = r_step
+         ! recorded only where the stop acts (tip_step_massless)
+         state%reaction = merge(r_step, 0.0_wp, contact)
          if (state%observer%active) call state%observer%tip(real(step + 1, wp)*reduced%dt, state%q(pt), &
-            & merge(r_step, 0.0_wp, contact), state%dissipated)
+            & state%reaction, state%dissipated)
          state%gd_prev = gd
          state%sigma_prev = state%sigma_now
          state%sigma_now = sigma_next
@@ -656,7 +657,10 @@ contains
                & reduced%stiffness_pp(j, j)*state%d(r + j))
          end do
          r_step = 0
-         if (reduced%stops%tip > 0) r_step = state%span%reaction(reduced%stops%tip)
+         ! recorded only where the stop acts (tip_step_massless)
+         if (reduced%stops%tip > 0) then
+            if (state%span%lambda(reduced%stops%tip) /= 0) r_step = state%span%reaction(reduced%stops%tip)
+         end if
          if (contact .and. .not. state%in_contact) state%impacts = state%impacts + 1
          state%in_contact = contact
          state%work = state%work + 0.5_wp*weight*(gd + state%gd_prev)
@@ -669,11 +673,11 @@ contains
             state%span%record_reaction = scene%mass_per_length*state%stop_reaction
             call recorder%record_stops(state%span%record_u, state%span%record_reaction)
          end if
-         state%stop_reaction = state%span%reaction
          ! (with massless stops a free stop's row residual is not a contact: only the active ones count)
+         state%stop_reaction = merge(state%span%reaction, 0.0_wp, state%span%lambda /= 0)
          if (state%observer%active) call state%observer%span(real(step + 1, wp)*reduced%dt, &
-            & state%q(r + 1:) + reduced%stops%lift*phi_next, merge(state%stop_reaction, 0.0_wp, state%span%lambda /= 0), &
-            & tip_value_of(reduced, state%q), state%dissipated)
+            & state%q(r + 1:) + reduced%stops%lift*phi_next, state%stop_reaction, &
+            & tip_value_of(reduced, state%q), state%span%taken)
          state%gd_prev = gd
          state%sigma_prev = state%sigma_now
          state%sigma_now = sigma_next

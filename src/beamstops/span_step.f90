@@ -142,7 +142,10 @@ contains
                & state%span%s_u(i), state%span%s_d_prev(i), &
                & diagonal_row(model%stiffness_diagonals, state%d, model%stops%unknown(i)))
          end do
-         if (model%stops%tip > 0) r_tip = state%span%reaction(model%stops%tip)
+         ! recorded only where the stop acts (tip_step_massless)
+         if (model%stops%tip > 0) then
+            if (state%span%lambda(model%stops%tip) /= 0) r_tip = state%span%reaction(model%stops%tip)
+         end if
       else
          if (model%stops%tip > 0) r_tip = state%span%lambda(model%stops%tip)/model%dt2
       end if
@@ -163,13 +166,13 @@ contains
          lp%pending = .true.
       end if
       if (model%redistributed) then
-         state%stop_reaction = state%span%reaction
+         state%stop_reaction = merge(state%span%reaction, 0.0_wp, state%span%lambda /= 0)
       else
          state%stop_reaction = state%span%lambda/model%dt2
       end if
       if (state%observer%active) call state%observer%span_indexed(real(step + 1, wp)*model%dt, state%u, &
          & model%stops%unknown, model%stops%lift, lp%phi_next, state%stop_reaction, state%span%lambda, &
-         & state%u(tip), state%dissipated)
+         & state%u(tip), state%span%taken)
       if (step == lp%next_snapshot) then
          lp%next_snapshot = lp%next_snapshot + scene%snapshot_every
          call take_snapshot(scene, model, state, step, recorder)

@@ -9,6 +9,7 @@ module test_damping
    use beamstops_scheme, only: advance
    use beamstops_checkpoint, only: write_checkpoint, read_checkpoint
    use beamstops_files, only: remove_file
+   use beamstops_namelist, only: scene_from_text
    use beamstops_recorder, only: col_t, col_u, col_energy, col_work, col_dissipated, col_damped
    implicit none
    private
@@ -87,6 +88,7 @@ contains
 
    subroutine test_ratio_form(error)
       type(error_type), allocatable, intent(out) :: error
+      type(error_type), allocatable :: failure
       type(scene_type) :: scene
       type(model_type) :: model
       real(wp), allocatable :: w(:)
@@ -109,9 +111,10 @@ contains
       end do
       call check(error, model%damped, 'the model is damped')
       if (allocated(error)) return
-      ! one ratio: both modes get it
-      scene%damping_ratio = [0.05_wp, 0.0_wp]
-      scene%damping_modes = [1, 2]
+      ! one ratio read: both modes get it
+      call scene_from_text('&mesh elements = 19 / &time dt = 1e-5, t_end = 0.01 / &damping ratio = 0.05 /', &
+         & 'one.nml', scene, error)
+      if (allocated(error)) return
       call build_model(scene, model, error)
       if (allocated(error)) return
       do i = 1, 2
@@ -119,6 +122,15 @@ contains
             & 0.05_wp, 'one ratio, zeta at mode '//int_text(i), thr=1.0e-13_wp, rel=.true.)
          if (allocated(error)) return
       end do
+      ! two ratios read, the second 0: that pair (b < 0 here), not one ratio for both
+      call scene_from_text('&mesh elements = 19 / &time dt = 1e-5, t_end = 0.01 / &damping ratio = 0.05, 0 /', &
+         & 'two.nml', scene, error)
+      if (allocated(error)) return
+      call build_model(scene, model, failure)
+      call check(error, allocated(failure), 'ratio = 0.05, 0 is refused (b < 0)')
+      if (allocated(error)) return
+      call check(error, index(failure%message, 'ratio = 0.05, 0 ') > 0, 'the message gives the ratios: '// &
+         & failure%message)
    end subroutine test_ratio_form
 
    subroutine test_balance(error)
@@ -191,7 +203,7 @@ contains
       type(run_summary) :: summary
       scene = tube_scene(2.0e-5_wp, 1.0_wp)
       scene%damping_by_ratio = .true.
-      scene%damping_ratio = [0.02_wp, 0.0_wp]
+      scene%damping_ratio = [0.02_wp, 0.02_wp]
       call run_recorded(scene, rec, summary, error)
       if (allocated(error)) return
       call note('tube, zeta = 0.02: defect '//real_text(balance_defect(rec))//', damped '// &

@@ -140,3 +140,54 @@ def test_bad_statistics_inputs(text: str, needle: str, tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="allowed") as caught:
         Scene.from_namelist(path)
     assert needle in str(caught.value)
+
+
+def test_samples_are_the_records_times() -> None:
+    """The shock log and the statistics take the samples t_1 .. t_N of the records: the loop's
+    last step computes u^{N+1} only to complete the record of t_N = t_end."""
+    dt, transient = 1e-4, 0.1
+    run = beamstops.run(Scene(elements=4, dt=dt, t_end=0.3, transient=transient, batches=4))
+    assert run.t[-1] == pytest.approx(0.3, abs=1e-12)
+    kept = (run.t >= transient) & (run.t > 0)
+    assert float(run.statistics["window"]) == pytest.approx(kept.sum() * dt, rel=1e-12)
+    assert float(run.statistics["tip_mean"]) == pytest.approx(run.tip_u[kept].mean(), rel=1e-10)
+    assert float(run.statistics["tip_max"]) == run.tip_u[kept].max()
+    assert float(run.statistics["tip_min"]) == run.tip_u[kept].min()
+
+
+def energy_per_sample(u: np.ndarray, reaction: np.ndarray) -> np.ndarray:
+    """The energy a stop took in the step that brought row k, -1/2 R_k (u_k - u_{k-2}) (J), from
+    the records (record_every = 1; rows 0 and 1: 0, no contact at the start here)."""
+    e = np.zeros_like(u)
+    e[2:] = -0.5 * reaction[2:] * (u[2:] - u[:-2])
+    return e
+
+
+def test_each_stop_keeps_its_own_energy() -> None:
+    """Two stops along the span in contact at once: each shock's energy and each stop's power are
+    that stop's own -1/2 R (u~^{n+1} - u~^{n-1}), not a share of the step's total."""
+    scene = Scene(dt=DT, t_end=1.0, nodes=(10, 19), lower=(-0.03, -0.1), upper=(0.03, 0.1), rest_time=0.005)
+    run = beamstops.run(scene)
+    both = (run.stops_reaction != 0).all(axis=1)
+    assert both.sum() > 100
+    window = float(run.statistics["window"])
+    for i in range(2):
+        e = energy_per_sample(run.stops_u[:, i], run.stops_reaction[:, i])
+        mine = run.impacts["stop"] == i + 1
+        assert run.impacts["energy_taken"][mine].sum() == pytest.approx(e.sum(), rel=1e-9)
+        assert run.statistics["power"].value[i] == pytest.approx(e[run.t > 0].sum() / window, rel=1e-9)
+    assert run.impacts["energy_taken"].sum() == pytest.approx(run.dissipated[-2], rel=1e-9)
+
+
+def test_massless_tip_reaction_only_on_the_stops() -> None:
+    """Mass redistribution: the recorded reaction is zero off the stops (SPEC 4), equals the shock
+    log's contact samples, and the shocks' energies (with the two steps after each contact phase,
+    where the Newmark row still holds the contact) add up to the stops' energy."""
+    run = beamstops.run(Scene(mass="redistributed", beta=0.25, dt=DT, t_end=1.0))
+    acting = run.reaction != 0
+    assert acting.sum() > 100
+    on_stop = np.minimum(np.abs(run.tip_u - 0.1), np.abs(run.tip_u + 0.1))
+    assert on_stop[acting].max() < 1e-9
+    assert acting.sum() == run.impacts["contact_steps"].sum()
+    assert run.impacts["energy_taken"].sum() == pytest.approx(run.dissipated[-2], rel=1e-9)
+    assert run.impacts["impulse"].sum() == pytest.approx(run.reaction.sum() * DT, rel=1e-12)

@@ -72,6 +72,8 @@ module beamstops_contact_span_stops
       !> Mass redistribution: (S u^n)_k and (S d^{n-1})_k at the stops before the step, and the
       !> reaction of each stop during the step, per unit mass (m).
       real(wp), allocatable :: s_u(:), s_d_prev(:), reaction(:)
+      !> The energy each stop took during the step, per unit mass (span_energy) (m).
+      real(wp), allocatable :: taken(:)
       !> u^n and d^{n-1} at the stops, before the step (m).
       real(wp), allocatable :: u_prev(:), d_prev(:)
       !> A record of the stops waiting for the recorder: u~ at each stop and reactions (N) (m).
@@ -154,7 +156,8 @@ contains
       end if
       allocate (work%trial(m), work%lo(m), work%hi(m), work%lambda(m), work%y(m), work%u_prev(m), work%d_prev(m), &
          & work%record_u(m), work%record_reaction(m), work%vlo(m), work%vhi(m), work%s_u(m), work%s_d_prev(m), &
-         & work%reaction(m))
+         & work%reaction(m), work%taken(m))
+      work%taken = 0
       work%s_u = 0
       work%s_d_prev = 0
       work%reaction = 0
@@ -305,12 +308,13 @@ contains
    !> The energy the stops take during the step (>= 0) and the work the moving support does
    !> through them, per unit mass, added to the loop's sums, from d^n (after the update and
    !> span_settle) and the values kept by span_contact; dphi = phi(t_{n+1}) - phi(t_{n-1}).
-   !> At the tip (h = 0) the expression is the tip path's, so that the sums are its bits.
+   !> At the tip (h = 0) the expression is the tip path's, so that the sums are its bits. Each
+   !> stop's share goes to work%taken (the sum's increment by it: the shares add up to the sum).
    pure subroutine span_energy(stops, work, d, dt2, dphi, dissipated, support_work)
       !> The stops.
       type(span_stops_type), intent(in) :: stops
-      !> Work after span_contact.
-      type(span_work_type), intent(in) :: work
+      !> Work after span_contact; its `taken` set.
+      type(span_work_type), intent(inout) :: work
       !> d^n (n).
       real(wp), intent(in) :: d(:)
       !> dt^2.
@@ -322,29 +326,32 @@ contains
       !> Work of the load and the support so far; plus -1/2 sum r_i h_i dphi.
       real(wp), intent(inout) :: support_work
       integer :: j, a, k
-      real(wp) :: r
+      real(wp) :: r, before
+      work%taken = 0
       if (.not. work%contact) return
       do j = 1, work%qp%n_active
          a = work%qp%active(j)
          k = stops%unknown(a)
          r = work%lambda(a)/dt2
+         before = dissipated
          if (stops%lift(a) == 0) then
             dissipated = dissipated - 0.5_wp*r*(d(k) + work%d_prev(a))
          else
             dissipated = dissipated - 0.5_wp*r*((d(k) + work%d_prev(a)) + stops%lift(a)*dphi)
             support_work = support_work - 0.5_wp*r*stops%lift(a)*dphi
          end if
+         work%taken(a) = dissipated - before
       end do
    end subroutine span_energy
 
    !> span_energy for massless stop unknowns (mass redistribution, SPEC 10): the reaction of
    !> every stop is given (work%reaction, the residual of its row, nonzero a few steps after a
-   !> contact), so the sums run over all stops.
+   !> contact), so the sums run over all stops; each stop's share goes to work%taken.
    pure subroutine span_energy_massless(stops, work, d, dphi, dissipated, support_work)
       !> The stops.
       type(span_stops_type), intent(in) :: stops
-      !> Work after span_contact, with the reactions of the step.
-      type(span_work_type), intent(in) :: work
+      !> Work after span_contact, with the reactions of the step; its `taken` set.
+      type(span_work_type), intent(inout) :: work
       !> d^n (n).
       real(wp), intent(in) :: d(:)
       !> phi(t_{n+1}) - phi(t_{n-1}).
@@ -354,11 +361,13 @@ contains
       !> Work of the load and the support so far.
       real(wp), intent(inout) :: support_work
       integer :: a, k
-      real(wp) :: r
+      real(wp) :: r, before
       do a = 1, stops%m
          k = stops%unknown(a)
          r = work%reaction(a)
+         work%taken(a) = 0
          if (r == 0) cycle
+         before = dissipated
          if (stops%lift(a) == 0) then
             ! the tip path's expression, so that a stop at the tip gives its bits
             dissipated = dissipated - 0.5_wp*r*(d(k) + work%d_prev(a))
@@ -366,6 +375,7 @@ contains
             dissipated = dissipated - 0.5_wp*r*((d(k) + work%d_prev(a)) + stops%lift(a)*dphi)
             support_work = support_work - 0.5_wp*r*stops%lift(a)*dphi
          end if
+         work%taken(a) = dissipated - before
       end do
    end subroutine span_energy_massless
 end module beamstops_contact_span_stops

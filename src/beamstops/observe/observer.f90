@@ -8,7 +8,7 @@ module beamstops_observe_observer
    use beamstops_error, only: error_type, fatal_error
    use beamstops_observe_shocks, only: shock_log, shock_row, new_shock_log, shock_row_values, n_shock_columns
    use beamstops_observe_statistics, only: statistics_type, statistics_table, new_statistics
-   use beamstops_scene, only: scene_type
+   use beamstops_scene, only: scene_type, steps_of
    implicit none
    private
    public :: observer_type, new_observer, observe_scene
@@ -25,6 +25,10 @@ module beamstops_observe_observer
       real(wp) :: dt = 0
       !> Energy taken by the stops, per unit mass, up to the last sample.
       real(wp) :: dissipated_seen = 0
+      !> Samples after this time are not taken: (N + 1/2) dt, N the steps of the run, so that the
+      !> samples are t_1 .. t_N, the times of the records (the loop's last step computes
+      !> u^{N+1} only to complete the record of t_N).
+      real(wp) :: t_stop = huge(1.0_wp)
       !> The shock log.
       type(shock_log) :: shocks
       !> The running statistics.
@@ -57,7 +61,7 @@ contains
    !> An observer of m stops whose values are u0 at t = 0, over [transient, t_end] in `batches`
    !> batches, the tip histogram with `bins` bins over [lower, upper].
    subroutine new_observer(self, m, u0, rho, dt, rest_time, transient, t_end, batches, bins, lower, upper, &
-      & dissipated0, error)
+      & dissipated0, samples, error)
       !> The observer, active on return.
       type(observer_type), intent(out) :: self
       !> Number of stops.
@@ -72,9 +76,12 @@ contains
       real(wp), intent(in) :: lower, upper
       !> Energy the stops took before the first sample, per unit mass (the start).
       real(wp), intent(in) :: dissipated0
+      !> N: the samples taken are those of t_1 .. t_N = N dt.
+      integer(ik), intent(in) :: samples
       !> Set on a value out of range.
       type(error_type), allocatable, intent(out) :: error
       self%m = m
+      self%t_stop = (real(samples, wp) + 0.5_wp)*dt
       self%rho = rho
       self%dt = dt
       self%dissipated_seen = dissipated0
@@ -107,11 +114,20 @@ contains
       real(wp), intent(in) :: tip1, dissipated
       !> Set on a value out of range.
       type(error_type), allocatable, intent(out) :: error
+      real(wp) :: weight
       call new_observer(self, size(u0), u0, scene%mass_per_length, dt, scene%rest_time, scene%transient, &
-         & scene%t_end, scene%batches, scene%bins, scene%histogram_lower, scene%histogram_upper, 0.0_wp, error)
+         & scene%t_end, scene%batches, scene%bins, scene%histogram_lower, scene%histogram_upper, 0.0_wp, &
+         & steps_of(scene), error)
       if (allocated(error)) return
       if (span) then
-         call self%span(dt, u1, reaction, tip1, dissipated)
+         ! the start's energy (a projection of u^1, if any) shared in proportion to |r|
+         weight = sum(abs(reaction))
+         if (weight > 0) then
+            call self%span(dt, u1, reaction, tip1, dissipated*abs(reaction)/weight)
+         else
+            call self%span(dt, u1, reaction, tip1, 0*reaction)
+         end if
+         self%dissipated_seen = dissipated
       else
          call self%tip(dt, u1(1), reaction(1), dissipated)
       end if
@@ -125,6 +141,7 @@ contains
       !> t_{n+1} (s), u^{n+1}_tip (m), reaction per unit mass, energy taken so far per unit mass.
       real(wp), intent(in) :: t, u_tip, reaction, dissipated
       real(wp) :: r, e
+      if (t > self%t_stop) return
       r = self%rho*reaction
       e = self%rho*(dissipated - self%dissipated_seen)
       self%dissipated_seen = dissipated
@@ -133,27 +150,29 @@ contains
    end subroutine tip
 
    !> The sample of step n with stops along the span: t_{n+1}, the stops' physical displacement,
-   !> their reactions per unit mass, and the tip displacement. The energy the stops took in the
-   !> step is one total; it is shared among the stops acting in the step in proportion to |r|
-   !> (exact whenever one stop acts at a time).
-   subroutine span(self, t, u, reaction, u_tip, dissipated)
+   !> their reactions per unit mass, the tip displacement and the energy each stop took in the
+   !> step per unit mass (span_energy's `taken`: -1/2 r_i (u~^{n+1}_i - u~^{n-1}_i)).
+   subroutine span(self, t, u, reaction, u_tip, taken)
       !> Observer.
       class(observer_type), intent(inout) :: self
       !> t_{n+1} (s).
       real(wp), intent(in) :: t
       !> Stops' physical displacement (m) and reactions per unit mass (m each).
       real(wp), intent(in) :: u(:), reaction(:)
-      !> Tip displacement (m), energy taken so far per unit mass.
-      real(wp), intent(in) :: u_tip, dissipated
+      !> Tip displacement (m).
+      real(wp), intent(in) :: u_tip
+      !> Energy each stop took in the step, per unit mass (m each).
+      real(wp), intent(in) :: taken(:)
+      if (t > self%t_stop) return
       self%u = u
       self%r = self%rho*reaction
-      call span_sample(self, t, u_tip, dissipated)
+      call span_sample(self, t, u_tip, taken)
    end subroutine span
 
    !> span from the loop's own arrays, so that the hot loop passes no array expression (each
    !> would be a temporary a step): stop i's displacement is u(unknown(i)) + lift(i) phi and its
    !> reaction reaction(i) where lambda(i) /= 0 (an active stop), else 0.
-   subroutine span_indexed(self, t, u, unknown, lift, phi, reaction, lambda, u_tip, dissipated)
+   subroutine span_indexed(self, t, u, unknown, lift, phi, reaction, lambda, u_tip, taken)
       !> Observer.
       class(observer_type), intent(inout) :: self
       !> t_{n+1} (s).
@@ -166,9 +185,12 @@ contains
       real(wp), intent(in) :: lift(:), phi
       !> The stops' reactions per unit mass (m) and their multipliers (m; 0: the stop is free).
       real(wp), intent(in) :: reaction(:), lambda(:)
-      !> Tip displacement (m), energy taken so far per unit mass.
-      real(wp), intent(in) :: u_tip, dissipated
+      !> Tip displacement (m).
+      real(wp), intent(in) :: u_tip
+      !> Energy each stop took in the step, per unit mass (m).
+      real(wp), intent(in) :: taken(:)
       integer :: i
+      if (t > self%t_stop) return
       do i = 1, self%m
          self%u(i) = u(unknown(i)) + lift(i)*phi
          if (lambda(i) /= 0) then
@@ -177,23 +199,15 @@ contains
             self%r(i) = 0
          end if
       end do
-      call span_sample(self, t, u_tip, dissipated)
+      call span_sample(self, t, u_tip, taken)
    end subroutine span_indexed
 
-   !> The rest of span: self%u and self%r set, the step's energy shared among the active stops,
-   !> the log and the statistics fed.
-   subroutine span_sample(self, t, u_tip, dissipated)
+   !> The rest of span: self%u and self%r set; each stop's energy in physical units, the log and
+   !> the statistics fed.
+   subroutine span_sample(self, t, u_tip, taken)
       class(observer_type), intent(inout) :: self
-      real(wp), intent(in) :: t, u_tip, dissipated
-      real(wp) :: total, weight
-      total = self%rho*(dissipated - self%dissipated_seen)
-      self%dissipated_seen = dissipated
-      weight = sum(abs(self%r))
-      if (weight > 0) then
-         self%e = total*abs(self%r)/weight
-      else
-         self%e = 0
-      end if
+      real(wp), intent(in) :: t, u_tip, taken(:)
+      self%e = self%rho*taken
       call self%shocks%step(t, self%dt, self%u, self%r, self%e)
       call self%stats%step(t, self%dt, u_tip, self%r, self%e)
    end subroutine span_sample
@@ -233,7 +247,7 @@ contains
       table = self%stats%results()
       shocks = self%rows(:, :self%shocks_kept)
    end subroutine finish
-   !> The whole observer as reals: [m, rho, dt, dissipated_seen, kept, size of the log's vector,
+   !> The whole observer as reals: [m, rho, dt, dissipated_seen, t_stop, kept, size of the log's vector,
    !> the log's vector (shock_log%pack), size of the statistics' vector, its vector
    !> (statistics_type%pack), the kept rows (13 per shock)].
    subroutine pack_observer(self, values)
@@ -244,8 +258,8 @@ contains
       real(wp), allocatable :: log(:), stats(:)
       call self%shocks%pack(log)
       call self%stats%pack(stats)
-      values = [real(self%m, wp), self%rho, self%dt, self%dissipated_seen, real(self%shocks_kept, wp), &
-         & real(size(log), wp), log, real(size(stats), wp), stats]
+      values = [real(self%m, wp), self%rho, self%dt, self%dissipated_seen, self%t_stop, &
+         & real(self%shocks_kept, wp), real(size(log), wp), log, real(size(stats), wp), stats]
       if (self%shocks_kept > 0) values = [values, reshape(self%rows(:, :self%shocks_kept), [n_shock_columns* &
          & self%shocks_kept])]
    end subroutine pack_observer
@@ -259,7 +273,7 @@ contains
       !> Set when the vector is not an observer's.
       type(error_type), allocatable, intent(out) :: error
       integer :: at, n_log, n_stats
-      if (size(values) < 7) then
+      if (size(values) < 8) then
          call fatal_error(error, 'the checkpoint''s shock log is damaged')
          return
       end if
@@ -267,9 +281,10 @@ contains
       self%rho = values(2)
       self%dt = values(3)
       self%dissipated_seen = values(4)
-      self%shocks_kept = nint(values(5))
-      n_log = nint(values(6))
-      at = 7
+      self%t_stop = values(5)
+      self%shocks_kept = nint(values(6))
+      n_log = nint(values(7))
+      at = 8
       if (at + n_log > size(values)) then
          call fatal_error(error, 'the checkpoint''s shock log is damaged')
          return
