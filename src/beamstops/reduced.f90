@@ -483,7 +483,7 @@ contains
       real(wp), intent(in), optional :: stiffness_ii(:, :)
       real(wp), allocatable :: sa(:, :), ma(:, :), sb(:, :), mb(:, :), q(:, :), w(:), work(:)
       integer, allocatable :: iwork(:), ifail(:)
-      integer :: ni, found, info, stat
+      integer :: ni, found, info, stat, ka, kb
       character :: range, jobz
       ni = size(interior)
       allocate (sa(kd + 1, ni), ma(kd + 1, ni))
@@ -510,7 +510,14 @@ contains
       end if
       range = 'I'
       if (r == ni) range = 'A'
-      call dsbgvx(jobz, range, 'U', ni, size(sa, 1) - 1, kd, sa, size(sa, 1), ma, kd + 1, q, size(q, 1), 0.0_wp, 0.0_wp, 1, r, &
+      ! LAPACK's band routines read beyond the last column when a half-bandwidth is not below the
+      ! order (dpbstf's split index (n + kb)/2 exceeds n): with fewer interior unknowns than the
+      ! band (one element), the bands are cut to ni - 1, the rows of the band storage kept.
+      ka = min(size(sa, 1) - 1, ni - 1)
+      kb = min(kd, ni - 1)
+      sa = sa(size(sa, 1) - ka:, :)
+      ma = ma(kd + 1 - kb:, :)
+      call dsbgvx(jobz, range, 'U', ni, ka, kb, sa, ka + 1, ma, kb + 1, q, size(q, 1), 0.0_wp, 0.0_wp, 1, r, &
          & 2*tiny(1.0_wp), found, w, phi, ni, work, iwork, ifail, info)
       if (info /= 0) then
          call fatal_error(error, 'reduced model: '//dsbgvx_message(info, ni))

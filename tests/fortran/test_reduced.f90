@@ -44,7 +44,8 @@ contains
          & new_unittest('no contact: the energy balance closes to round-off', test_energy_free), &
          & new_unittest('modes by inverse iteration (the default) and by dsbgvx: the same reduced runs', test_inverse_iteration), &
          & new_unittest('snapshots: u = T q at the nodes, the full run''s with all modes', test_snapshots), &
-         & new_unittest('&mesh modes: range checks with messages', test_validate) &
+         & new_unittest('&mesh modes: range checks with messages', test_validate), &
+         & new_unittest('one element, its one interior unknown as the mode: the full engine', test_one_element) &
          & ]
    end subroutine collect_reduced
 
@@ -717,4 +718,36 @@ contains
       call note(error%message)
       deallocate (error)
    end subroutine test_validate
+
+   !> One element with tip stops leaves one interior unknown (the tip's slope), fewer than the
+   !> band's half-bandwidth: the fixed-interface mode is still found (LAPACK's band eigensolver
+   !> read past the last column, a heap corruption in the program) and with r = n - m = 1 the
+   !> reduced run is the full one to round-off; consistent and redistributed mass.
+   subroutine test_one_element(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene, reduced_scene
+      type(array_recorder) :: full, red
+      type(run_summary) :: sf, sr
+      integer :: variant
+      real(wp) :: diff
+      do variant = 1, 2
+         scene = scene_type()
+         scene%elements = 1
+         scene%law = law_signorini
+         scene%redistributed_mass = variant == 2
+         scene%dt = 1e-4_wp
+         scene%t_end = 0.05_wp
+         reduced_scene = scene
+         reduced_scene%modes = 1
+         call run_recorded(scene, full, sf, error)
+         if (allocated(error)) return
+         call run_reduced_recorded(reduced_scene, red, sr, error)
+         if (allocated(error)) return
+         call check(error, red%filled == full%filled, 'as many records'); if (allocated(error)) return
+         diff = column_difference(full, red, col_u, full%filled)
+         call note('variant '//int_text(variant)//': tip difference / scale '//real_text(diff))
+         call check(error, diff, 0.0_wp, 'tip of the full and the one-mode reduced run', thr=1e-10_wp)
+         if (allocated(error)) return
+      end do
+   end subroutine test_one_element
 end module test_reduced
