@@ -12,7 +12,7 @@ program beamstops_main
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use beamstops
    use beamstops_checkpoint, only: checkpoint_path, read_checkpoint, is_checkpoint
-   use beamstops_files, only: file_exists, remove_file, same_file
+   use beamstops_files, only: file_exists, remove_file, same_file, same_path
    use beamstops_recorder_hdf5, only: partial_path, check_output_path
    use beamstops_run, only: continue_run, continue_reduced
    use beamstops_writer_thread, only: writer_thread, start_writer, stop_writer
@@ -515,8 +515,7 @@ contains
             if (allocated(error)) exit
             if (j /= i .and. same_file(output, paths(j)%text)) call fatal_error(error, output//': is the input '// &
                & 'file '//paths(j)%text//'; writing the output of '//paths(i)%text//' there would destroy it')
-            if (j < i .and. scenes(j)%output_file == output) call fatal_error(error, output//': is the output of '// &
-               & 'both '//paths(j)%text//' and '//paths(i)%text//'; give each scene its own (&output file)')
+            if (j < i) call check_shared_files(output, paths(i)%text, scenes(j)%output_file, paths(j)%text, error)
          end do
          if (.not. allocated(error)) call check_checkpoint_path(checkpoint_path(output), error)
          call refuse_all(error, exit_output, n)
@@ -548,6 +547,49 @@ contains
          & ' scenes did not complete (messages above)'
       call quit(maxval(status))
    end subroutine run_several
+
+   !> Refuse two scenes of one command whose files meet: the output, the partial output, the
+   !> checkpoint or its temporary file of one is one of the other's, however spelt (`out.h5` and
+   !> `./out.h5`; `a.h5.partial` as the output of one and the partial output of `a.h5`): one run
+   !> would overwrite what the other writes.
+   subroutine check_shared_files(output, path, other_output, other_path, error)
+      character(len=*), intent(in) :: output, path, other_output, other_path
+      type(error_type), allocatable, intent(inout) :: error
+      character(len=*), parameter :: kinds(4) = [character(len=27) :: 'output', 'partial output', 'checkpoint', &
+         & 'checkpoint''s temporary file']
+      integer :: a, b
+      do a = 1, size(kinds)
+         do b = 1, size(kinds)
+            if (allocated(error)) return
+            if (.not. same_path(written_file(output, a), written_file(other_output, b))) cycle
+            if (a == 1 .and. b == 1) then
+               call fatal_error(error, output//': is the output of both '//other_path//' and '//path// &
+                  & '; give each scene its own (&output file)')
+            else
+               call fatal_error(error, written_file(output, a)//': is the '//trim(kinds(a))//' of '//path// &
+                  & ' and the '//trim(kinds(b))//' of '//other_path//'; give each scene its own (&output file)')
+            end if
+         end do
+      end do
+   end subroutine check_shared_files
+
+   !> The files a run with this output writes: 1 the output, 2 its partial output, 3 its
+   !> checkpoint, 4 the checkpoint's temporary file.
+   pure function written_file(output, kind) result(path)
+      character(len=*), intent(in) :: output
+      integer, intent(in) :: kind
+      character(len=:), allocatable :: path
+      select case (kind)
+      case (1)
+         path = output
+      case (2)
+         path = partial_path(output)
+      case (3)
+         path = checkpoint_path(output)
+      case default
+         path = checkpoint_path(output)//'.tmp'
+      end select
+   end function written_file
 
    !> One of n inputs cannot run: its message, and nothing runs.
    subroutine refuse_all(error, code, n)

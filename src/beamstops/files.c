@@ -1,4 +1,7 @@
 /* What standard Fortran cannot ask of the file system (used by src/beamstops/files.f90). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 #include <sys/stat.h>
 
 /* 1 when the paths name the same file (same device and inode: a hard link, a symbolic
@@ -16,4 +19,53 @@ int beamstops_is_directory(const char *path)
 {
     struct stat s;
     return stat(path, &s) == 0 && S_ISDIR(s.st_mode);
+}
+
+/* The folder part of a path (".", "/" or the path up to its last slash) into dir, and a
+   pointer to its last component. */
+static const char *split_path(const char *path, char *dir, size_t size)
+{
+    const char *slash = strrchr(path, '/');
+    size_t n;
+    if (slash == NULL) {
+        snprintf(dir, size, ".");
+        return path;
+    }
+    n = (size_t)(slash - path);
+    if (n == 0)
+        n = 1; /* "/name": the root */
+    if (n >= size)
+        n = size - 1;
+    memcpy(dir, path, n);
+    dir[n] = '\0';
+    return slash + 1;
+}
+
+/* 1 when the two paths name one file, whether or not it exists yet: the same existing file
+   (beamstops_same_file), or the same name in the same existing folder however the folder is
+   spelt ("out.h5", "./out.h5", "sub/../out.h5"); 0 otherwise. */
+int beamstops_same_path(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    const char *name_a, *name_b;
+    char *dir_a, *dir_b;
+    size_t la = strlen(a) + 2, lb = strlen(b) + 2;
+    int same = 0;
+    if (beamstops_same_file(a, b))
+        return 1;
+    dir_a = malloc(la);
+    dir_b = malloc(lb);
+    if (dir_a != NULL && dir_b != NULL) {
+        name_a = split_path(a, dir_a, la);
+        name_b = split_path(b, dir_b, lb);
+        if (strcmp(name_a, name_b) == 0) {
+            if (strcmp(dir_a, dir_b) == 0)
+                same = 1;
+            else if (stat(dir_a, &sa) == 0 && stat(dir_b, &sb) == 0)
+                same = sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+        }
+    }
+    free(dir_a);
+    free(dir_b);
+    return same;
 }

@@ -4,7 +4,7 @@ module beamstops_files
    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
    implicit none
    private
-   public :: file_exists, is_directory, same_file, rename_file, remove_file
+   public :: file_exists, is_directory, same_file, same_path, rename_file, remove_file
 
    interface
       function c_rename(from, to) bind(c, name='rename') result(status)
@@ -22,6 +22,11 @@ module beamstops_files
          character(kind=c_char), intent(in) :: a(*), b(*)
          integer(c_int) :: same
       end function c_same_file
+      function c_same_path(a, b) bind(c, name='beamstops_same_path') result(same)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: a(*), b(*)
+         integer(c_int) :: same
+      end function c_same_path
       function c_is_directory(path) bind(c, name='beamstops_is_directory') result(directory)
          import :: c_char, c_int
          character(kind=c_char), intent(in) :: path(*)
@@ -56,6 +61,17 @@ contains
       logical :: same
       same = c_same_file(a//c_null_char, b//c_null_char) == 1
    end function same_file
+
+   !> Whether two paths name one file, existing or not: the same existing file, or the same
+   !> name in the same existing folder however spelt (`out.h5`, `./out.h5`, `sub/../out.h5`).
+   function same_path(a, b) result(same)
+      !> First path.
+      character(len=*), intent(in) :: a
+      !> Second path.
+      character(len=*), intent(in) :: b
+      logical :: same
+      same = c_same_path(a//c_null_char, b//c_null_char) == 1
+   end function same_path
 
    !> Rename `from` onto `to` (replacing `to` atomically when on the same file system).
    subroutine rename_file(from, to, ok)

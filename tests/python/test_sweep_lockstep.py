@@ -102,6 +102,27 @@ def test_bad_command_lines_and_a_bad_file_among_several_run_nothing(tmp_path: Pa
     assert done.returncode == 2 and "unexpected argument 'b.nml'" in done.stderr
 
 
+def test_scenes_whose_files_meet_under_other_spellings_run_nothing(tmp_path: Path, program: str) -> None:
+    """One output spelt two ways (`b.h5`, `./b.h5`, `sub/../b.h5`), or the output of one scene
+    at the partial output of another (`a.h5.partial`): refused before anything runs. They ran,
+    and the second run failed to create its partial file, or overwrote the first one's output."""
+    files = write_scenes(tmp_path, "ab")
+    (tmp_path / "sub").mkdir()
+    for spelling in ("./b.h5", "sub/../b.h5"):
+        (tmp_path / "twin.nml").write_text(SCENES["a"] + f"&output file = '{spelling}' /\n")
+        done = subprocess.run([program, "run", *files, "twin.nml"], cwd=tmp_path, capture_output=True, text=True)
+        assert done.returncode == 4, done.stderr
+        assert f"{spelling}: is the output of both b.nml and twin.nml" in done.stderr
+        assert "none of the 3 scenes was run" in done.stderr
+        assert not list(tmp_path.glob("*.h5*"))
+    (tmp_path / "twin.nml").write_text(SCENES["c"] + "&output file = 'a.h5.partial' /\n")
+    for order in (["twin.nml", files[0]], [files[0], "twin.nml"]):
+        done = subprocess.run([program, "run", *order], cwd=tmp_path, capture_output=True, text=True)
+        assert done.returncode == 4, done.stderr
+        assert "a.h5.partial: is the" in done.stderr and "partial output of a.nml" in done.stderr
+        assert not list(tmp_path.glob("*.h5*"))
+
+
 SWEEP = """
 [sweep]
 lockstep = {lockstep}
