@@ -435,3 +435,18 @@ def test_non_positive_timeout_and_interval_are_refused(option: str, value: str, 
     last = done.stderr.strip().splitlines()[-1]
     assert f"argument {option}: '{value}': allowed: a number of seconds > 0" in last
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "two"])
+def test_fewer_than_one_worker_is_refused_before_the_folder_is_made(value: str, tmp_path: Path,
+                                                                    write_spec: Callable[..., Path]) -> None:
+    """-j 0 was refused only after the folder, its summary (every point 'pending') and its
+    specification were written."""
+    done = sweep_command(write_spec(UNSTABLE), "-o", tmp_path / "out", "-j", value, cwd=tmp_path)
+    assert done.returncode == 2
+    assert f"argument -j/--jobs: '{value}': allowed: a whole number of worker processes >= 1" in \
+        done.stderr.strip().splitlines()[-1]
+    assert not (tmp_path / "out").exists()
+    with pytest.raises(ValueError, match="-j 0: the number of workers must be >= 1"):
+        run_sweep(load_spec(write_spec(UNSTABLE)), tmp_path / "api", jobs=0)
+    assert not (tmp_path / "api").exists()

@@ -63,6 +63,17 @@ def _positive(unit: str) -> Callable[[str], float]:
     return parse
 
 
+def _workers(text: str) -> int:
+    """An argparse type: a whole number of worker processes >= 1 (checked before the folder is made)."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: allowed: a whole number of worker processes >= 1")
+    return value
+
+
 def _dry_run(spec, args: argparse.Namespace) -> int:  # type: ignore[no-untyped-def]
     from ..engine import validate
 
@@ -96,7 +107,7 @@ def register_sweep(subparsers: argparse._SubParsersAction) -> None:
         epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("spec", type=Path, help="sweep specification (TOML; see input/sweeps/)")
     parser.add_argument("-o", "--output", type=Path, help="the sweep's folder (created; reused to resume)")
-    parser.add_argument("-j", "--jobs", type=int, help="local worker processes (default: every core)")
+    parser.add_argument("-j", "--jobs", type=_workers, help="local worker processes, >= 1 (default: every core)")
     parser.add_argument("--executor", choices=EXECUTORS, default="auto",
                         help="auto (default): MPI under `python -m mpi4py.futures`, else local processes")
     parser.add_argument("--set", action="append", metavar="TABLE.KEY=VALUE",

@@ -546,6 +546,8 @@ def run_sweep(spec: Spec, out: str | os.PathLike[str], *, executor: str = "auto"
     is refused (ValueError) with this one's pid and host.
     """
     _check_not_plain_mpi()
+    if jobs is not None and jobs < 1:  # before the folder is made: a refused sweep writes nothing
+        raise ValueError(f"-j {jobs}: the number of workers must be >= 1")
     program = find_program(program)
     check_folder(Path(out))  # before the lock file is written into it
     with FolderLock(Path(out)) as lock:
