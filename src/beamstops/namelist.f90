@@ -736,6 +736,14 @@ contains
       used = 0
       cleaned = ''
       current = 0
+      ! Binary characters anywhere (an HDF5 output or an image given for the namelist) are told
+      ! first: the start of such a file was otherwise quoted as text outside any group.
+      line_no = first_binary_line(text)
+      if (line_no > 0) then
+         call fatal_error(error, source//': line '//itoa(line_no)//' holds binary characters; '// &
+            & 'allowed: a namelist text file')
+         return
+      end if
       line_no = 0
       first = 1
       do while (first <= len(text))
@@ -751,11 +759,6 @@ contains
          line_no = line_no + 1
          if (len(line) > 0) then
             if (line(len(line):) == achar(13)) line = line(:len(line) - 1)
-         end if
-         if (is_binary(line)) then
-            call fatal_error(error, source//': line '//itoa(line_no)//' holds binary characters; '// &
-               & 'allowed: a namelist text file')
-            return
          end if
          quoted = .false.
          quote = ' '
@@ -872,16 +875,23 @@ contains
       end do
    end function group_index
 
-   !> Whether a line holds control characters other than tab and carriage return.
-   pure logical function is_binary(s)
+   !> The first line (1, 2, ...) of a text holding control characters other than tab, carriage
+   !> return and the line ends; 0 when none does.
+   pure integer function first_binary_line(s)
       character(len=*), intent(in) :: s
-      integer :: i, code
-      is_binary = .false.
+      integer :: i, code, line_no
+      first_binary_line = 0
+      line_no = 1
       do i = 1, len(s)
          code = iachar(s(i:i))
-         if ((code < 32 .and. code /= 9 .and. code /= 13) .or. code == 127) is_binary = .true.
+         if (code == 10) then
+            line_no = line_no + 1
+         else if ((code < 32 .and. code /= 9 .and. code /= 13) .or. code == 127) then
+            first_binary_line = line_no
+            return
+         end if
       end do
-   end function is_binary
+   end function first_binary_line
 
 
 

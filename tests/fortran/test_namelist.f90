@@ -35,6 +35,7 @@ contains
          & new_unittest('record_every = 0 out of range', test_record_every), &
          & new_unittest('text outside any group is refused, quoted', test_outside_group), &
          & new_unittest('a file without any group is refused', test_no_group), &
+         & new_unittest('an HDF5 file given for the namelist: binary characters, not its start quoted', test_hdf5_signature), &
          & new_unittest('a malformed value names its key and kind', test_malformed_kind), &
          & new_unittest('canonical text reads back the same scene', test_canonical_round_trip) &
          & ]
@@ -311,6 +312,15 @@ contains
       call expect_error('no_group.nml', [character(len=ll) :: '! only a comment'], &
          & [character(len=32) :: 'no namelist group'], error)
    end subroutine test_no_group
+
+   !> An HDF5 output begins with the line \x89HDF\r and only its second line holds control
+   !> characters: the first line was quoted as text outside any group, its byte 0x89 (not
+   !> UTF-8) written raw into the message.
+   subroutine test_hdf5_signature(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('output.h5', [character(len=ll) :: achar(137)//'HDF'//achar(13), achar(26)//'x'//achar(0)//'y'], &
+         & [character(len=32) :: 'line 2', 'holds binary characters'], error)
+   end subroutine test_hdf5_signature
 
    subroutine test_malformed_kind(error)
       type(error_type), allocatable, intent(out) :: error
