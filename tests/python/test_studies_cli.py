@@ -20,3 +20,30 @@ def test_quick_study(tmp_path: Path, command: str, files: list[str], capsys: pyt
     for name in files:
         assert (tmp_path / name).stat().st_size > 0, name
     assert str(tmp_path) in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("command, option, value, allowed", [
+    ("converge", "--transient", "-1", "a time in s >= 0"),
+    ("converge", "--transient", "nan", "a time in s >= 0"),
+    ("converge", "--stat-window", "0", "a time in s > 0"),
+    ("converge", "--reference-window", "-4", "a time in s > 0"),
+    ("converge", "--members", "0", "a whole number of members >= 1"),
+    ("work-precision", "--members", "-3", "a whole number of members >= 1"),
+    ("work-precision", "--window", "-1", "a time in s > 0"),
+    ("compliance", "--cutoff", "-5", "a frequency in Hz > 0"),
+    ("compliance", "--cutoff", "nan", "a frequency in Hz > 0"),
+    ("stability-map", "--threshold", "-1", "a factor of energy growth > 0"),
+])
+def test_bad_study_options_are_refused_before_anything_runs(tmp_path: Path, command: str, option: str, value: str,
+                                                            allowed: str, capsys: pytest.CaptureFixture[str]) -> None:
+    """They ran: compliance and stability-map with the nonsense (exit 0), converge and
+    work-precision into the engine's message about a scene's &time t_end or &statistics
+    transient (the option unnamed), the output folder made."""
+    args = [command, "--quick", "--quiet", "-o", str(tmp_path / "out")]
+    if command in ("converge", "work-precision") and option not in ("--window",):
+        args += ["--qoi", "stop_power"]
+    with pytest.raises(SystemExit) as exit_:
+        cli.main(args + [f"{option}={value}"])
+    assert exit_.value.code == 2
+    assert f"argument {option}: '{value}': allowed: {allowed}" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
