@@ -429,3 +429,37 @@ def test_command_line_does_not_flood_stderr_with_font_lookups(output: Path, tmp_
                            "--kind", "psd"], capture_output=True, text=True, timeout=120, env=env)
     assert done.returncode == 0, done.stderr
     assert done.stderr == "" and (tmp_path / "p.png").read_bytes()[:8] == PNG
+
+
+def test_an_image_never_overwrites_an_hdf5_file(output: Path, tmp_path: Path, result: beamstops.Result) -> None:
+    """`plot run.png -o run.png` (an output named like an image), a link to the output, or any
+    other HDF5 file at -o (`-o noext` writes noext.png): refused, the file left as it was. The
+    image was written over it."""
+    data = output.read_bytes()
+    for name in ("run.png", "other.pdf", "noext.png"):
+        (tmp_path / name).write_bytes(data)
+    (tmp_path / "link.png").symlink_to(output)
+    for plotted, target, named in (("run.png", "run.png", "run.png"), (str(output), "link.png", "link.png"),
+                                   (str(output), "other.pdf", "other.pdf"), (str(output), "noext", "noext.png")):
+        done = plot_command(plotted, "-o", target, cwd=tmp_path)
+        assert done.returncode == 1 and done.stdout == "", done.stderr
+        assert done.stderr.strip() == (f"beamstops: error: {named}: exists and is an HDF5 file (a run's output?); "
+                                       "refusing to overwrite it with an image; name another file")
+    for name in ("run.png", "other.pdf", "noext.png"):
+        assert (tmp_path / name).read_bytes() == data
+    assert output.read_bytes() == data
+    with pytest.raises(FileExistsError, match="exists and is an HDF5 file"):
+        plots.save(result, tmp_path / "run.png", kind="energy")
+    (tmp_path / "link.gif").symlink_to(output)
+    with pytest.raises(FileExistsError, match="exists and is an HDF5 file"):
+        plots.save(result, tmp_path / "link.gif", kind="animation")
+    assert output.read_bytes() == data
+
+
+@pytest.mark.parametrize("dpi", ["0", "-5", "100000", "abc"])
+def test_a_resolution_out_of_range_is_refused_by_the_command_line(dpi: str, output: Path, tmp_path: Path) -> None:
+    """--dpi 100000 ended in a MemoryError traceback from the renderer; 0 in matplotlib's words."""
+    done = plot_command(output, "-o", "x.png", "--dpi", dpi, cwd=tmp_path)
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert f"argument --dpi: '{dpi}': allowed: a whole number of dots per inch, 1 ... 2400" in done.stderr
+    assert not (tmp_path / "x.png").exists()

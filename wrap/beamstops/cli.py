@@ -49,6 +49,18 @@ def _positive_int(text: str) -> int:
     return value
 
 
+def _dpi(text: str) -> int:
+    from .plots import MAX_DPI
+
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if not 1 <= value <= MAX_DPI:
+        raise argparse.ArgumentTypeError(f"{text!r}: allowed: a whole number of dots per inch, 1 ... {MAX_DPI}")
+    return value
+
+
 def _nonnegative(text: str) -> float:
     value = float(text)
     if not value >= 0:
@@ -81,7 +93,7 @@ def register_plot(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--frames", type=_positive_int, default=200,
                         help="animation: at most this many frames, spread over the snapshots (default: 200)")
     parser.add_argument("--fps", type=_positive_int, default=20, help="animation: frames per second (default: 20)")
-    parser.add_argument("--dpi", type=int, default=120, help="resolution of raster images (default: 120)")
+    parser.add_argument("--dpi", type=_dpi, default=120, help="resolution of raster images, 1 ... 2400 (default: 120)")
     parser.add_argument("--allow-incomplete", action="store_true",
                         help="plot a run that diverged or was interrupted")
     parser.set_defaults(handler=_plot)

@@ -331,14 +331,39 @@ def save(result: Result, path: str | os.PathLike[str], kind: str = "tip", dpi: i
     if names_folder(path):
         raise IsADirectoryError(f"{os.fspath(path)}: is a folder; name the image file to write, e.g. "
                                 f"{Path(path) / ('animation.gif' if kind == 'animation' else kind + '.png')}")
+    if isinstance(dpi, bool) or not isinstance(dpi, (int, float)) or not 0 < dpi <= MAX_DPI:
+        raise ValueError(f"dpi {dpi!r}: allowed: 0 < dpi <= {MAX_DPI} (dots per inch)")
     if kind == "animation":
         from .animation import animate
 
+        refuse_data_file(Path(path))
         return animate(result, path, dpi=dpi, **options)
-    fig = figure(result, kind, **options)
     path = Path(path)
+    if not path.suffix:  # what matplotlib would do, named here so that the caller knows the file
+        path = path.with_name(f"{path.name}.{rcParams['savefig.format']}")
+    refuse_data_file(path)
+    fig = figure(result, kind, **options)
     with rc_context({"agg.path.chunksize": 20000}):
-        if not path.suffix:  # what matplotlib would do, named here so that the caller knows the file
-            path = path.with_name(f"{path.name}.{rcParams['savefig.format']}")
         fig.savefig(path, dpi=dpi)
     return path
+
+
+#: Largest resolution of an image (dots per inch): a page-sized figure stays within what the
+#: Agg renderer allocates (--dpi 100000 ended in a MemoryError traceback).
+MAX_DPI = 2400
+
+#: The first bytes of an HDF5 file.
+_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+def refuse_data_file(path: Path) -> None:
+    """Refuse to write an image over an HDF5 file (a run's output, the very file plotted under
+    another name or a link): FileExistsError naming it."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(len(_HDF5_SIGNATURE))
+    except OSError:
+        return  # not there (or unreadable): savefig says what is wrong when it writes
+    if head == _HDF5_SIGNATURE:
+        raise FileExistsError(f"{path}: exists and is an HDF5 file (a run's output?); refusing to overwrite it "
+                              f"with an image; name another file")
