@@ -114,6 +114,14 @@ def test_cli_writes_the_chosen_scene(tmp_path: Path, capsys: pytest.CaptureFixtu
     (["--qoi", "tip", "--tol", "1e-3"], "until"),
     (["--qoi", "tip", "--until", "0.5", "--tol", "1e-3"],
      "--until 0.5: beyond the scene's t_end = 0.1 s"),
+    # these ran into the engine's messages on a scene's t_end or record_every, or read the last
+    # entry of a per-stop statistic for --stop -1
+    (["--qoi", "power", "--tol", "0.1", "--max-window", "-1"], "max_window -1.0: allowed: a window after the "
+                                                               "transient > 0 s"),
+    (["--qoi", "power", "--tol", "0.1", "--max-window", "nan"], "max_window nan"),
+    (["--qoi", "power", "--tol", "0.1", "--finer", "100"], "2 <= finer <= 20"),
+    (["--qoi", "power", "--tol", "0.1", "--coarser", "-1"], "0 <= coarser <= 20"),
+    (["--qoi", "power", "--tol", "0.1", "--stop", "-1"], "stop -1: allowed: an entry 0, 1, ..."),
 ])
 def test_cli_bad_input_is_one_line_and_exit_1(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                 arguments: list[str], message: str) -> None:

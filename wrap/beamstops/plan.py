@@ -41,6 +41,9 @@ from .studies.common import progress
 __all__ = ["QUANTITIES", "STATISTICAL", "LAWS", "Quantity", "Model", "Candidate", "Check", "Plan", "plan",
            "parse_tolerance", "reduced_available"]
 
+#: Most rungs of the Δt ladder either way: Δt·2^20 or Δt/2^20 (a million times the scene's steps).
+MAX_RUNGS = 20
+
 
 # ----------------------------------------------------------------------------------- search
 
@@ -69,8 +72,12 @@ def plan(scene: Scene, qoi: Union[str, Quantity], tol: Union[str, float], *, unt
     fraction, relative = parse_tolerance(tol)
     if budget is not None and not budget > 0:
         raise ValueError(f"budget {budget!r}: CPU seconds > 0")
-    if coarser < 0 or finer < 2 or extend < 0:
-        raise ValueError("the Δt ladder needs coarser >= 0, finer >= 2 and extend >= 0")
+    if not (0 <= coarser <= MAX_RUNGS and 2 <= finer <= MAX_RUNGS and 0 <= extend <= MAX_RUNGS):
+        raise ValueError(f"the Δt ladder (coarser {coarser}, finer {finer}, extend {extend}) needs "
+                         f"0 <= coarser <= {MAX_RUNGS}, 2 <= finer <= {MAX_RUNGS} and 0 <= extend <= {MAX_RUNGS} "
+                         f"(powers of 2 of the scene's Δt)")
+    if max_window is not None and not (math.isfinite(max_window) and max_window > 0):
+        raise ValueError(f"max_window {max_window!r}: allowed: a window after the transient > 0 s")
     reference_law = "redistributed" if (scene.law == "signorini" and scene.mass == "redistributed") else scene.law
     chosen_laws = list(dict.fromkeys(laws)) if laws else [reference_law]
     unknown = [law for law in chosen_laws if law not in LAWS]

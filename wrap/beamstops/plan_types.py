@@ -53,6 +53,9 @@ class Quantity:
             raise ValueError(f"unknown quantity {self.name!r}; choose one of {', '.join(QUANTITIES)}")
         if self.deterministic and not (self.until is not None and self.until > 0):
             raise ValueError("quantity 'tip' needs a window end until > 0 (s), e.g. --until 0.08")
+        if isinstance(self.stop, bool) or not isinstance(self.stop, int) or self.stop < 0:
+            raise ValueError(f"stop {self.stop!r}: allowed: an entry 0, 1, ... of the per-stop statistic "
+                             "(0: the tip's stops, or the first stop along the span)")
 
     @property
     def deterministic(self) -> bool:
