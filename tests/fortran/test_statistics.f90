@@ -89,7 +89,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(statistics_type) :: stats
       call validate_statistics(1.0_wp, 10.0_wp, 1, 10, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
-      call expect_message(error, 'in.nml: &statistics batches = 1 is out of range; allowed: batches >= 2')
+      call expect_message(error, 'in.nml: &statistics batches = 1 is out of range; allowed: 2 <= batches <= 1000')
       if (allocated(error)) return
       call validate_statistics(10.0_wp, 10.0_wp, 20, 10, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
       call expect_message(error, 'in.nml: &statistics transient = 10 is out of range; allowed: 0 <= transient < 10 s,'// &
@@ -103,21 +103,39 @@ contains
       call expect_message(error, 'in.nml: &statistics rest_time = -0.002 is out of range; allowed: rest_time >= 0 s')
       if (allocated(error)) return
       call validate_statistics(1.0_wp, 10.0_wp, 20, 0, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
-      call expect_message(error, 'in.nml: &statistics bins = 0 is out of range; allowed: bins >= 1')
+      call expect_message(error, 'in.nml: &statistics bins = 0 is out of range; allowed: 1 <= bins <= 1000000')
       if (allocated(error)) return
       call validate_statistics(1.0_wp, 10.0_wp, 20, 10, 0.0_wp, 0.1_wp, 0.1_wp, 'in.nml', error)
       call expect_message(error, 'in.nml: &statistics histogram_upper = 0.1 is out of range; allowed: histogram_upper >'// &
          & ' histogram_lower = 0.1 m')
       if (allocated(error)) return
       call validate_ensemble(0, 'in.nml', error)
-      call expect_message(error, 'in.nml: &ensemble members = 0 is out of range; allowed: members >= 1')
+      call expect_message(error, 'in.nml: &ensemble members = 0 is out of range; allowed: 1 <= members <= 10000')
       if (allocated(error)) return
+      ! Beyond these the tables did not fit in memory: the program ended with a backtrace.
+      call validate_statistics(1.0_wp, 10.0_wp, 100000000, 10, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
+      call expect_message(error, 'in.nml: &statistics batches = 100000000 is out of range; allowed: 2 <= batches <= 1000')
+      if (allocated(error)) return
+      call validate_statistics(1.0_wp, 10.0_wp, 20, 2000000000, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
+      call expect_message(error, 'in.nml: &statistics bins = 2000000000 is out of range; allowed: 1 <= bins <= 1000000')
+      if (allocated(error)) return
+      call validate_statistics(1.0_wp, 10.0_wp, 11, 1000000, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
+      call expect_message(error, 'in.nml: &statistics bins = 1000000 is out of range; allowed: bins*batches <= '// &
+         & '10000000 (every batch keeps its histogram; batches = 11)')
+      if (allocated(error)) return
+      call validate_ensemble(2000000000, 'in.nml', error)
+      call expect_message(error, 'in.nml: &ensemble members = 2000000000 is out of range; allowed: 1 <= members <= 10000')
+      if (allocated(error)) return
+      call validate_statistics(1.0_wp, 10.0_wp, 1000, 10000, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
+      call check(error, .not. allocated(error), 'batches = 1000, bins = 10000 accepted'); if (allocated(error)) return
+      call validate_ensemble(10000, 'in.nml', error)
+      call check(error, .not. allocated(error), 'members = 10000 accepted'); if (allocated(error)) return
       call validate_statistics(1.0_wp, 10.0_wp, 2, 1, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
       call check(error, .not. allocated(error), 'batches = 2, bins = 1 accepted'); if (allocated(error)) return
       call validate_ensemble(1, 'in.nml', error)
       call check(error, .not. allocated(error), 'members = 1 accepted'); if (allocated(error)) return
       call new_statistics(stats, 1, 0.0_wp, 1.0_wp, 1, 4, -1.0_wp, 1.0_wp, error)
-      call expect_message(error, 'statistics: &statistics batches = 1 is out of range; allowed: batches >= 2')
+      call expect_message(error, 'statistics: &statistics batches = 1 is out of range; allowed: 2 <= batches <= 1000')
    end subroutine test_bad_inputs
 
    !> Feed a one-stop sequence (t_k = k dt) to a shock log and to statistics, shocks drained every
@@ -726,7 +744,7 @@ contains
          call test_failed(error, 'no members accepted')
          return
       end if
-      if (error%message /= 'ensemble: &ensemble members = 0 is out of range; allowed: members >= 1') then
+      if (error%message /= 'ensemble: &ensemble members = 0 is out of range; allowed: 1 <= members <= 10000') then
          call test_failed(error, 'message: '//error%message)
          return
       end if

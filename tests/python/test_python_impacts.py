@@ -128,11 +128,15 @@ def test_ensembles_identical_members_and_decorrelated_members(physics: dict[str,
 
 
 @pytest.mark.parametrize(("text", "needle"), [
-    ("&statistics batches = 1 /", "&statistics batches = 1 is out of range; allowed: batches >= 2"),
+    ("&statistics batches = 1 /", "&statistics batches = 1 is out of range; allowed: 2 <= batches <= 1000"),
     ("&statistics transient = 5 /", "&statistics transient = 5 is out of range"),
     ("&statistics rest_time = -1 /", "&statistics rest_time = -1 is out of range"),
     ("&ensemble members = 0 /", "&ensemble members = 0 is out of range"),
     ("&statistics bins = 0 /", "&statistics bins = 0 is out of range"),
+    # tables beyond memory: a failed allocation ended the program (and the Python process) with a backtrace
+    ("&statistics batches = 100000000 /", "&statistics batches = 100000000 is out of range; allowed: 2 <= batches <= 1000"),
+    ("&statistics bins = 2000000000 /", "&statistics bins = 2000000000 is out of range; allowed: 1 <= bins <= 1000000"),
+    ("&ensemble members = 2000000000 /", "&ensemble members = 2000000000 is out of range; allowed: 1 <= members <= 10000"),
 ])
 def test_bad_statistics_inputs(text: str, needle: str, tmp_path: Path) -> None:
     path = tmp_path / "bad.nml"

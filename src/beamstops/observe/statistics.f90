@@ -126,6 +126,12 @@ module beamstops_observe_statistics
       procedure, private :: new_run
    end type statistics_type
 
+   !> Largest numbers of batches, of histogram bins, of both together (every batch keeps its
+   !> histogram) and of members of an ensemble: beyond them the tables did not fit in memory (a
+   !> failed allocation ended the program with a backtrace).
+   integer, parameter :: max_batches = 1000, max_bins = 1000000, max_members = 10000
+   integer(ik), parameter :: max_batch_bins = 10000000_ik
+
    !> First two values of packed statistics: their tag and the version of the layout.
    real(wp), parameter :: pack_tag = 7302, pack_version = 1
    !> Values of the header and of the scalars of packed statistics.
@@ -151,11 +157,16 @@ contains
       character(len=*), intent(in) :: source
       !> Set on the first value out of range.
       type(error_type), allocatable, intent(out) :: error
-      if (batches < 2) then
-         call say('batches', fmt_int(int(batches, ik)), 'batches >= 2'); return
+      if (batches < 2 .or. batches > max_batches) then
+         call say('batches', fmt_int(int(batches, ik)), '2 <= batches <= '//fmt_int(int(max_batches, ik))); return
       end if
-      if (bins < 1) then
-         call say('bins', fmt_int(int(bins, ik)), 'bins >= 1'); return
+      if (bins < 1 .or. bins > max_bins) then
+         call say('bins', fmt_int(int(bins, ik)), '1 <= bins <= '//fmt_int(int(max_bins, ik))); return
+      end if
+      ! Each batch keeps its own histogram: bins x batches values.
+      if (int(bins, ik)*batches > max_batch_bins) then
+         call say('bins', fmt_int(int(bins, ik)), 'bins*batches <= '//fmt_int(max_batch_bins)//' (every batch keeps '// &
+            & 'its histogram; batches = '//fmt_int(int(batches, ik))//')'); return
       end if
       if (.not. (ieee_is_finite(rest_time) .and. rest_time >= 0)) then
          call say('rest_time', fmt_real(rest_time), 'rest_time >= 0 s'); return
@@ -186,8 +197,8 @@ contains
       character(len=*), intent(in) :: source
       !> Set when out of range.
       type(error_type), allocatable, intent(out) :: error
-      if (members < 1) call fatal_error(error, source//': &ensemble members = '//fmt_int(int(members, ik))// &
-         & ' is out of range; allowed: members >= 1')
+      if (members < 1 .or. members > max_members) call fatal_error(error, source//': &ensemble members = '// &
+         & fmt_int(int(members, ik))//' is out of range; allowed: 1 <= members <= '//fmt_int(int(max_members, ik)))
    end subroutine validate_ensemble
 
    !> Statistics of `stops` stops over [transient, t_end] in `batches` batches, with a tip
