@@ -9,7 +9,7 @@ module beamstops_namelist
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
    use beamstops_scene, only: scene_type, validate_scene, tube_beam, law_code, law_compliance, max_stops, stop_count, &
-      & steps_of
+      & steps_of, min_stiffness_per_mass, max_stiffness_per_mass
    use beamstops_strings, only: fmt_real, itoa, lower, squeeze
    use beamstops_physics_checks, only: validate_physics
    use beamstops_observe_statistics, only: validate_statistics, validate_ensemble
@@ -206,6 +206,16 @@ contains
                return
             end if
             scene%stiffness_per_mass = stiffness/scene%mass_per_length
+            ! The range is stiffness_per_mass's (validate_scene), told here in the key given.
+            if (scene%mass_per_length > 0 .and. .not. (scene%stiffness_per_mass >= min_stiffness_per_mass .and. &
+               & scene%stiffness_per_mass <= max_stiffness_per_mass)) then
+               call fatal_error(error, source//': &stops stiffness = '//fmt_real(stiffness)//' is out of range; '// &
+                  & 'allowed: '//fmt_real(min_stiffness_per_mass*scene%mass_per_length)//' <= stiffness <= '// &
+                  & fmt_real(max_stiffness_per_mass*scene%mass_per_length)//' N/m (stiffness_per_mass '// &
+                  & fmt_real(min_stiffness_per_mass)//' ... '//fmt_real(max_stiffness_per_mass)// &
+                  & ' 1/s^2 times mass_per_length = '//fmt_real(scene%mass_per_length)//' kg/m)')
+               return
+            end if
          else
             scene%stiffness_per_mass = stiffness_per_mass
          end if

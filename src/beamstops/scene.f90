@@ -12,6 +12,7 @@ module beamstops_scene
    public :: tube_section, tube_beam, fmt_real, fmt_int
    public :: law_none, law_signorini, law_compliance, law_name, law_code
    public :: max_elements, max_stops, stop_count, scene_table, canonical_text
+   public :: min_stiffness_per_mass, max_stiffness_per_mass
 
    !> Contact law codes.
    integer, parameter :: law_none = 0, law_signorini = 1, law_compliance = 2
@@ -19,6 +20,9 @@ module beamstops_scene
    integer, parameter :: max_elements = 1000000
    !> Most stops along the span (&stops nodes or x).
    integer, parameter :: max_stops = 1000
+   !> Range of the compliance spring per unit mass (1/s^2); &stops stiffness (N/m) is told in it
+   !> times mass_per_length.
+   real(wp), parameter :: min_stiffness_per_mass = 1.0e-12_wp, max_stiffness_per_mass = 1.0e20_wp
 
    !> Every input of a run. Defaults reproduce the paper's scene (Figure 2).
    type :: scene_type
@@ -333,7 +337,8 @@ contains
          call say('stops', 'law', '?', "'signorini', 'compliance' or 'none'"); return
       end if
       if (scene%law == law_compliance) then
-         call within('stops', 'stiffness_per_mass', scene%stiffness_per_mass, 1.0e-12_wp, 1.0e20_wp)
+         call within('stops', 'stiffness_per_mass', scene%stiffness_per_mass, min_stiffness_per_mass, &
+            & max_stiffness_per_mass)
          if (allocated(error)) return
       end if
       if (scene%elements < 1 .or. scene%elements > max_elements) then

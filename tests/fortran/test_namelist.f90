@@ -32,6 +32,7 @@ contains
          & new_unittest('elements = 0 out of range', test_elements), &
          & new_unittest('law = ''glue'' unknown', test_law), &
          & new_unittest('compliance without stiffness', test_compliance_stiffness), &
+         & new_unittest('a stiffness (N/m) out of range is told in its own key and unit', test_stiffness_range), &
          & new_unittest('record_every = 0 out of range', test_record_every), &
          & new_unittest('text outside any group is refused, quoted', test_outside_group), &
          & new_unittest('a file without any group is refused', test_no_group), &
@@ -321,6 +322,15 @@ contains
       call expect_error('output.h5', [character(len=ll) :: achar(137)//'HDF'//achar(13), achar(26)//'x'//achar(0)//'y'], &
          & [character(len=32) :: 'line 2', 'holds binary characters'], error)
    end subroutine test_hdf5_signature
+
+   !> stiffness = 1e300 was refused as 'stiffness_per_mass = 8.4e+300', a key the file does not
+   !> hold, with the range in 1/s^2.
+   subroutine test_stiffness_range(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('stiffness.nml', [character(len=ll) :: '&stops law = ''compliance'', stiffness = 1e300 /'], &
+         & [character(len=48) :: '&stops stiffness = 1e+300 is out of range', &
+         & '1.1938e-13 <= stiffness <= 1.1938e+19 N/m'], error)
+   end subroutine test_stiffness_range
 
    subroutine test_malformed_kind(error)
       type(error_type), allocatable, intent(out) :: error
