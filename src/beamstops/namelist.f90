@@ -9,7 +9,7 @@ module beamstops_namelist
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
    use beamstops_scene, only: scene_type, validate_scene, tube_beam, law_code, law_compliance, max_stops, stop_count, &
-      & steps_of, min_stiffness_per_mass, max_stiffness_per_mass
+      & steps_of, min_stiffness_per_mass, max_stiffness_per_mass, k2_range, mass_per_length_range
    use beamstops_strings, only: fmt_real, itoa, lower, squeeze
    use beamstops_physics_checks, only: validate_physics
    use beamstops_observe_statistics, only: validate_statistics, validate_ensemble
@@ -725,6 +725,22 @@ contains
          return
       end if
       call tube_beam(youngs_modulus, density, outer_diameter, wall_thickness, scene%k2, scene%mass_per_length)
+      ! What the material gives is told in the keys given (the file holds no k2 or mass_per_length).
+      if (.not. (scene%k2 >= k2_range(1) .and. scene%k2 <= k2_range(2))) then
+         call fatal_error(error, path//': &beam youngs_modulus = '//fmt_real(youngs_modulus)//', density = '// &
+            & fmt_real(density)//', outer_diameter = '//fmt_real(outer_diameter)//', wall_thickness = '// &
+            & fmt_real(wall_thickness)//' give k2 = EI/(rho S) = '//fmt_real(scene%k2)//' m^4/s^2, out of range; '// &
+            & 'allowed: '//fmt_real(k2_range(1))//' <= k2 <= '//fmt_real(k2_range(2))//' m^4/s^2')
+         return
+      end if
+      if (.not. (scene%mass_per_length >= mass_per_length_range(1) .and. &
+         & scene%mass_per_length <= mass_per_length_range(2))) then
+         call fatal_error(error, path//': &beam density = '//fmt_real(density)//', outer_diameter = '// &
+            & fmt_real(outer_diameter)//', wall_thickness = '//fmt_real(wall_thickness)// &
+            & ' give mass_per_length = rho S = '//fmt_real(scene%mass_per_length)//' kg/m, out of range; allowed: '// &
+            & fmt_real(mass_per_length_range(1))//' <= mass_per_length <= '//fmt_real(mass_per_length_range(2))//' kg/m')
+         return
+      end if
    end subroutine derive_beam
 
    !> Which groups the text holds (and their text, for messages); unknown or repeated groups,

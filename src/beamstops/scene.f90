@@ -12,7 +12,7 @@ module beamstops_scene
    public :: tube_section, tube_beam, fmt_real, fmt_int
    public :: law_none, law_signorini, law_compliance, law_name, law_code
    public :: max_elements, max_stops, stop_count, scene_table, canonical_text
-   public :: min_stiffness_per_mass, max_stiffness_per_mass
+   public :: min_stiffness_per_mass, max_stiffness_per_mass, k2_range, mass_per_length_range
 
    !> Contact law codes.
    integer, parameter :: law_none = 0, law_signorini = 1, law_compliance = 2
@@ -23,6 +23,8 @@ module beamstops_scene
    !> Range of the compliance spring per unit mass (1/s^2); &stops stiffness (N/m) is told in it
    !> times mass_per_length.
    real(wp), parameter :: min_stiffness_per_mass = 1.0e-12_wp, max_stiffness_per_mass = 1.0e20_wp
+   !> Ranges of k2 (m^4/s^2) and mass_per_length (kg/m), given or derived from a tube's material.
+   real(wp), parameter :: k2_range(2) = [1.0e-12_wp, 1.0e15_wp], mass_per_length_range(2) = [1.0e-12_wp, 1.0e9_wp]
 
    !> Every input of a run. Defaults reproduce the paper's scene (Figure 2).
    type :: scene_type
@@ -322,8 +324,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
 
       call within('beam', 'length', scene%length, 1.0e-6_wp, 1.0e6_wp); if (allocated(error)) return
-      call within('beam', 'k2', scene%k2, 1.0e-12_wp, 1.0e15_wp); if (allocated(error)) return
-      call within('beam', 'mass_per_length', scene%mass_per_length, 1.0e-12_wp, 1.0e9_wp)
+      call within('beam', 'k2', scene%k2, k2_range(1), k2_range(2)); if (allocated(error)) return
+      call within('beam', 'mass_per_length', scene%mass_per_length, mass_per_length_range(1), mass_per_length_range(2))
       if (allocated(error)) return
       call within('support', 'amplitude', scene%amplitude, -1.0e3_wp, 1.0e3_wp); if (allocated(error)) return
       call within('support', 'omega', scene%omega, 0.0_wp, 1.0e9_wp); if (allocated(error)) return

@@ -33,6 +33,7 @@ contains
          & new_unittest('law = ''glue'' unknown', test_law), &
          & new_unittest('compliance without stiffness', test_compliance_stiffness), &
          & new_unittest('a stiffness (N/m) out of range is told in its own key and unit', test_stiffness_range), &
+         & new_unittest('a material giving k2 or mass_per_length out of range is told in its keys', test_material_range), &
          & new_unittest('record_every = 0 out of range', test_record_every), &
          & new_unittest('text outside any group is refused, quoted', test_outside_group), &
          & new_unittest('a file without any group is refused', test_no_group), &
@@ -331,6 +332,20 @@ contains
          & [character(len=48) :: '&stops stiffness = 1e+300 is out of range', &
          & '1.1938e-13 <= stiffness <= 1.1938e+19 N/m'], error)
    end subroutine test_stiffness_range
+
+   !> youngs_modulus = 1e30 was refused as 'k2 = 1.4e+21', a key the file does not hold.
+   subroutine test_material_range(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('material.nml', [character(len=ll) :: '&beam youngs_modulus = 1e30, density = 8e3,', &
+         & '      outer_diameter = 0.01, wall_thickness = 5e-4 /'], &
+         & [character(len=48) :: '&beam youngs_modulus = 1e+30', 'give k2 = EI/(rho S)', &
+         & '1e-12 <= k2 <= 1e+15 m^4/s^2'], error)
+      if (allocated(error)) return
+      call expect_error('material.nml', [character(len=ll) :: '&beam youngs_modulus = 2e11, density = 1e20,', &
+         & '      outer_diameter = 1, wall_thickness = 0.5 /'], &
+         & [character(len=48) :: '&beam density = 1e+20', 'give mass_per_length = rho S', &
+         & '1e-12 <= mass_per_length <= 1e+09 kg/m'], error)
+   end subroutine test_material_range
 
    subroutine test_malformed_kind(error)
       type(error_type), allocatable, intent(out) :: error
