@@ -47,3 +47,14 @@ def test_bad_study_options_are_refused_before_anything_runs(tmp_path: Path, comm
     assert exit_.value.code == 2
     assert f"argument {option}: '{value}': allowed: {allowed}" in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
+
+
+def test_output_that_is_a_file_is_refused_and_kept(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """-o naming an existing file: one line that says -o takes a folder (it read '[Errno 17] File
+    exists'), exit 1, the file untouched."""
+    target = tmp_path / "notes.txt"
+    target.write_text("keep me")
+    assert cli.main(["stability-map", "--quick", "--quiet", "-o", str(target)]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "is not a folder" in err[0] and str(target) in err[0]
+    assert target.read_text() == "keep me"

@@ -48,6 +48,8 @@ def progress(items: Iterable[T], desc: str, total: Optional[int] = None, quiet: 
 def out_dir(path: Optional[os.PathLike[str] | str], study: str) -> Path:
     """The output folder of a study (default out/<study>), created."""
     folder = Path(path) if path is not None else Path("out") / study
+    if folder.exists() and not folder.is_dir():
+        raise NotADirectoryError(f"{folder}: exists and is not a folder (-o takes the study's output folder)")
     folder.mkdir(parents=True, exist_ok=True)
     return folder
 
