@@ -218,3 +218,13 @@ def test_any_file_name_goes_through(tmp_path: Path) -> None:
 def test_from_text_of_something_not_text_is_a_type_error(text: object, kind: str) -> None:
     with pytest.raises(TypeError, match=rf"^Scene.from_text: text must be a str of namelist text, not {kind}\b"):
         Scene.from_text(text)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("changes, kind", [({"dt": None}, TypeError), ({"elements": []}, TypeError),
+                                           ({"file": "x\ny.h5"}, ValueError), ({"law": "sig\tnorini"}, ValueError)])
+def test_none_empty_or_control_characters_are_refused(changes: dict, kind: type) -> None:
+    """None or [] for a key whose default is a value read as 'the default' (dt=None ran at
+    5e-5 s), and a line break in a text became a blank ('x\\ny.h5' wrote 'x y.h5')."""
+    with pytest.raises(kind, match="scene key"):
+        Scene(**changes)
+    assert Scene(file=None).file is None and Scene(nodes=()).nodes == ()

@@ -157,6 +157,13 @@ class Scene:
 
     def __post_init__(self) -> None:
         values = {field.name: getattr(self, field.name) for field in dataclasses.fields(self)}
+        for field in dataclasses.fields(self):
+            value = values[field.name]
+            if field.default is None or isinstance(field.default, tuple):
+                continue  # None or () mean "not given" only where they are the default
+            if value is None or (isinstance(value, (list, tuple)) and len(value) == 0):
+                raise TypeError(f"scene key {field.name} cannot hold {value!r} (a number, a text, a logical or "
+                                f"a list of them; leave the key out for its default)")
         _adopt(self, _canonical(_namelist(values), "scene"))
 
     # ------------------------------------------------------------------ construction
@@ -263,6 +270,9 @@ def namelist_value(value: Any, key: str = "value") -> str:
     if isinstance(value, bool):
         return ".true." if value else ".false."
     if isinstance(value, str):
+        if any(ord(c) < 32 or ord(c) == 127 for c in value):
+            raise ValueError(f"scene key {key} = {value!r} holds a control character (a line break, a tab, ...); "
+                             f"allowed: printable text")
         return "'" + value.replace("'", "''") + "'"
     if isinstance(value, numbers.Integral):
         return str(int(value))
