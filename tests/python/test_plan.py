@@ -133,6 +133,32 @@ def test_cli_bad_input_is_one_line_and_exit_1(tmp_path: Path, capsys: pytest.Cap
     assert not (tmp_path / "free_plan.nml").exists()
 
 
+@pytest.mark.parametrize("kind", ["hdf5", "hand", "folder"])
+def test_cli_output_is_written_only_over_its_own_scenes(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                         kind: str) -> None:
+    """-o at an existing file plan did not write (an output, a namelist of one's own) or at a
+    folder: refused before planning, one line, exit 1, the file kept (it was overwritten)."""
+    scene_file = tmp_path / "free.nml"
+    FREE.to_namelist(scene_file)
+    target = tmp_path / ("run.h5" if kind == "hdf5" else "mine.nml" if kind == "hand" else "folder")
+    if kind == "folder":
+        target.mkdir()
+    else:
+        target.write_bytes(b"\x89HDF\r\n\x1a\n" if kind == "hdf5" else b"&time dt = 1e-5 /\n")
+    before = None if kind == "folder" else target.read_bytes()
+    arguments = ["plan", str(scene_file), "--qoi", "tip", "--until", "0.08", "--tol", "1e-3", "--quiet", "-o", str(target)]
+    assert cli.main(arguments) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(target) in err[0], err
+    if before is not None:
+        assert target.read_bytes() == before
+    # its own earlier output is written over
+    own = tmp_path / "own.nml"
+    FREE.to_namelist(own)
+    assert cli.main([*arguments[:-1], str(own)]) == 0
+    assert beamstops.Scene.from_namelist(own).law == "none"
+
+
 def test_mesh_ladder_with_and_without_the_reduced_model(monkeypatch: pytest.MonkeyPatch) -> None:
     from beamstops import plan_runs as module
 

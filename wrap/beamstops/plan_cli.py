@@ -33,6 +33,7 @@ def _handler(args: argparse.Namespace) -> int:
     out = args.output or args.scene.with_name(f"{args.scene.stem}_plan.nml")
     if out.resolve() == args.scene.resolve():
         raise ValueError(f"{out}: the output would overwrite the scene read")
+    _check_output(out)
     laws = [law.strip() for law in args.laws.split(",") if law.strip()] if args.laws else None
     result = plan(scene, Quantity(args.qoi, until=args.until, stop=args.stop), args.tol, until=args.until, budget=args.budget, laws=laws, safety=args.safety,
                   coarser=args.coarser, finer=args.finer, exhaustive=args.all, max_window=args.max_window,
@@ -83,3 +84,22 @@ def register_plan(subparsers: argparse._SubParsersAction) -> None:
                         help="chosen scene (default SCENE_plan.nml), written only when the plan meets the tolerance")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.set_defaults(handler=_handler)
+
+
+def _check_output(out: Path) -> None:
+    """Refuse, before planning, an output that exists and is not a scene plan (or Scene.to_namelist)
+    wrote: a folder, an HDF5 output, a namelist written by hand."""
+    if not out.exists() and not out.is_symlink():
+        return
+    if out.is_dir():
+        raise ValueError(f"{out}: is a folder; -o takes the file the chosen scene is written to")
+    from .scene import NAMELIST_HEADER
+
+    try:
+        with open(out, encoding="utf-8") as handle:
+            first = handle.readline().rstrip("\n")
+    except (OSError, UnicodeDecodeError):
+        first = ""
+    if first != NAMELIST_HEADER:
+        raise ValueError(f"{out}: exists and was not written by beamstops (plan writes over its own scenes "
+                         f"only); remove it or choose another -o")

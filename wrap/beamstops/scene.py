@@ -236,8 +236,7 @@ class Scene:
 
     def to_namelist(self, path: PathLike) -> None:
         """Write the scene as a namelist file the program reads (reals read back exactly)."""
-        Path(path).write_text("! beamstops scene (written by beamstops.Scene.to_namelist)\n" + self.to_text(),
-                              encoding="utf-8")
+        Path(path).write_text(NAMELIST_HEADER + "\n" + self.to_text(), encoding="utf-8")
 
     def to_dict(self) -> dict[str, Any]:
         """The fields as a flat dictionary."""
@@ -264,6 +263,9 @@ class Scene:
 
 
 # ---------------------------------------------------------------------- text
+
+#: The first line of a namelist file Scene.to_namelist writes.
+NAMELIST_HEADER = "! beamstops scene (written by beamstops.Scene.to_namelist)"
 
 def namelist_value(value: Any, key: str = "value") -> str:
     """A Python value as a namelist value: reals that read back exactly, lists by commas, quoted texts."""
