@@ -19,6 +19,8 @@ import sys
 from pathlib import Path
 from typing import Callable, Optional, Sequence
 
+from .arguments import MAX_DPI, number, whole
+
 
 def _plot(args: argparse.Namespace) -> int:
     from . import plots
@@ -42,32 +44,6 @@ def _plot(args: argparse.Namespace) -> int:
     return 0
 
 
-def _positive_int(text: str) -> int:
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text}: at least 1")
-    return value
-
-
-def _dpi(text: str) -> int:
-    from .plots import MAX_DPI
-
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if not 1 <= value <= MAX_DPI:
-        raise argparse.ArgumentTypeError(f"{text!r}: allowed: a whole number of dots per inch, 1 ... {MAX_DPI}")
-    return value
-
-
-def _nonnegative(text: str) -> float:
-    value = float(text)
-    if not value >= 0:
-        raise argparse.ArgumentTypeError(f"{text}: a time ≥ 0 (s)")
-    return value
-
-
 def register_plot(subparsers: argparse._SubParsersAction) -> None:
     """``plot OUT.h5 [-o PNG] [--kind KIND]``: draw a run written by ``beamstops run``."""
     from .plot_kinds import KINDS
@@ -87,13 +63,13 @@ def register_plot(subparsers: argparse._SubParsersAction) -> None:
                              "of the tip displacement and the reaction; poincare: (u, v) of the tip at t = kT, "
                              "T = 2π/ω; animation: the beam between its stops (.gif, or .mp4 with ffmpeg); all: "
                              "every still kind the run has data for (default: tip)")
-    parser.add_argument("--transient", type=_nonnegative, metavar="SECONDS",
+    parser.add_argument("--transient", type=number("a time in s", strict=False), metavar="SECONDS",
                         help="pdf, psd, poincare: draw only t ≥ SECONDS (pdf: the engine's histogram covers its own "
                              "transient; another one draws a histogram of the records)")
-    parser.add_argument("--frames", type=_positive_int, default=200,
+    parser.add_argument("--frames", type=whole("frames"), default=200,
                         help="animation: at most this many frames, spread over the snapshots (default: 200)")
-    parser.add_argument("--fps", type=_positive_int, default=20, help="animation: frames per second (default: 20)")
-    parser.add_argument("--dpi", type=_dpi, default=120, help="resolution of raster images, 1 ... 2400 (default: 120)")
+    parser.add_argument("--fps", type=whole("frames per second"), default=20, help="animation: frames per second (default: 20)")
+    parser.add_argument("--dpi", type=whole("dots per inch", 1, MAX_DPI), default=120, help="resolution of raster images, 1 ... 2400 (default: 120)")
     parser.add_argument("--allow-incomplete", action="store_true",
                         help="plot a run that diverged or was interrupted")
     parser.set_defaults(handler=_plot)

@@ -35,6 +35,7 @@ from matplotlib import rc_context, rcParams
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
+from .arguments import MAX_DPI
 from .plot_kinds import FIGURE_KINDS, KINDS, TRANSIENT_KINDS
 from .plotbase import LINE as _LINE
 from .plotbase import STOP as _STOP
@@ -347,10 +348,6 @@ def save(result: Result, path: str | os.PathLike[str], kind: str = "tip", dpi: i
         fig.savefig(path, dpi=dpi)
     return path
 
-
-#: Largest resolution of an image (dots per inch): a page-sized figure stays within what the
-#: Agg renderer allocates (--dpi 100000 ended in a MemoryError traceback).
-MAX_DPI = 2400
 
 #: The first bytes of an HDF5 file.
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"

@@ -5,58 +5,28 @@ the command line every study shares (its subcommand and the ``main`` of its scri
 from __future__ import annotations
 
 import argparse
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Optional
 
+from ..arguments import number, whole
 from .common import out_dir
 
 
 def positive(what: str) -> Callable[[str], float]:
     """An argparse type: a finite number > 0 (argparse's message names the option, this one the range)."""
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
-        if not (math.isfinite(value) and value > 0):
-            raise argparse.ArgumentTypeError(f"{text!r}: allowed: {what} > 0")
-        return value
-
-    return parse
+    return number(what)
 
 
 def nonnegative(what: str) -> Callable[[str], float]:
     """An argparse type: a finite number >= 0."""
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
-        if not (math.isfinite(value) and value >= 0):
-            raise argparse.ArgumentTypeError(f"{text!r}: allowed: {what} >= 0")
-        return value
-
-    return parse
+    return number(what, strict=False)
 
 
 def at_least_one(what: str) -> Callable[[str], int]:
     """An argparse type: a whole number >= 1."""
-
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            value = 0
-        if value < 1:
-            raise argparse.ArgumentTypeError(f"{text!r}: allowed: a whole number of {what} >= 1")
-        return value
-
-    return parse
+    return whole(what)
 
 
 @dataclass(frozen=True)

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
-from typing import Callable
+
+from ..arguments import number, whole
 
 EPILOG = """\
 examples:
@@ -48,32 +48,6 @@ def _sweep(args: argparse.Namespace) -> int:
     return INCOMPLETE
 
 
-def _positive(unit: str) -> Callable[[str], float]:
-    """An argparse type: a finite number > 0; argparse's message names the option, this one the range."""
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
-        if not (math.isfinite(value) and value > 0):
-            raise argparse.ArgumentTypeError(f"{text!r}: allowed: a number of {unit} > 0")
-        return value
-
-    return parse
-
-
-def _workers(text: str) -> int:
-    """An argparse type: a whole number of worker processes >= 1 (checked before the folder is made)."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r}: allowed: a whole number of worker processes >= 1")
-    return value
-
-
 def _dry_run(spec, args: argparse.Namespace) -> int:  # type: ignore[no-untyped-def]
     from ..engine import validate
 
@@ -107,18 +81,18 @@ def register_sweep(subparsers: argparse._SubParsersAction) -> None:
         epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("spec", type=Path, help="sweep specification (TOML; see input/sweeps/)")
     parser.add_argument("-o", "--output", type=Path, help="the sweep's folder (created; reused to resume)")
-    parser.add_argument("-j", "--jobs", type=_workers, help="local worker processes, >= 1 (default: every core)")
+    parser.add_argument("-j", "--jobs", type=whole("worker processes"), help="local worker processes, >= 1 (default: every core)")
     parser.add_argument("--executor", choices=EXECUTORS, default="auto",
                         help="auto (default): MPI under `python -m mpi4py.futures`, else local processes")
     parser.add_argument("--set", action="append", metavar="TABLE.KEY=VALUE",
                         help="change the specification, e.g. --set axes.omega.num=20 (a TOML value; repeatable; "
                              "changes the hash, so use another folder)")
-    parser.add_argument("--timeout", type=_positive("seconds"),
+    parser.add_argument("--timeout", type=number("a number of seconds"),
                         help="wall-time limit of one point, s > 0 (default: [sweep] timeout)")
     parser.add_argument("--program", help="the beamstops program to run (default: the one installed with "
                                           "this package)")
     parser.add_argument("--dry-run", action="store_true", help="check the specification, list points, run nothing")
-    parser.add_argument("--interval", type=_positive("seconds"), default=10.0,
+    parser.add_argument("--interval", type=number("a number of seconds"), default=10.0,
                         help="seconds between progress lines when not on a terminal, > 0 (default: 10)")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress and no notes")
     parser.set_defaults(handler=_sweep)
