@@ -628,7 +628,7 @@ contains
          ! the shock log and statistics of each member that keeps them
          if (observing) then
             do k = 1, ms%k
-               if (ms%observers(k)%active .and. ms%active(k)) then
+               if (ms%observers(k)%takes(real(step + 1, wp)*model%dt) .and. ms%active(k)) then
                   associate (ln => lanes(chunk(k)), i => lane(k))
                      call ms%observers(k)%tip(real(step + 1, wp)*model%dt, ln%u_tip(i), ln%reaction(i), &
                         & ln%dissipated(i))

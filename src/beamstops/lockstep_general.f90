@@ -178,8 +178,8 @@ contains
          ! the shock log and statistics of each member that keeps them
          if (observing) then
             do k = 1, ms%k
-               if (ms%observers(k)%active .and. ms%active(k)) call ms%observers(k)%tip(real(step + 1, wp)*model%dt, &
-                  & ms%u_tip(k), merge(ms%reaction(k), 0.0_wp, ms%in_contact(k)), ms%dissipated(k))
+               if (ms%observers(k)%takes(real(step + 1, wp)*model%dt) .and. ms%active(k)) call ms%observers(k)%tip( &
+                  & real(step + 1, wp)*model%dt, ms%u_tip(k), merge(ms%reaction(k), 0.0_wp, ms%in_contact(k)), ms%dissipated(k))
             end do
          end if
          ! the energy the damping took (damping_loss), C d^n for the next step

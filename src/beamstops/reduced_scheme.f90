@@ -470,8 +470,8 @@ contains
             state%dissipated = state%dissipated - 0.5_wp*r_step*(state%d(pt) + old_dtip)
             if (damped) call damping_loss(reduced, state)
             state%reaction = r_step
-            if (state%observer%active) call state%observer%tip(real(step + 1, wp)*reduced%dt, state%q(pt), r_step, &
-               & state%dissipated)
+            if (state%observer%takes(real(step + 1, wp)*reduced%dt)) call state%observer%tip(real(step + 1, wp)* &
+               & reduced%dt, state%q(pt), r_step, state%dissipated)
          end if
          state%gd_prev = gd
          state%sigma_prev = state%sigma_now
@@ -566,8 +566,8 @@ contains
          if (reduced%damped) call damping_loss(reduced, state)
          ! recorded only where the stop acts (tip_step_massless)
          state%reaction = merge(r_step, 0.0_wp, contact)
-         if (state%observer%active) call state%observer%tip(real(step + 1, wp)*reduced%dt, state%q(pt), &
-            & state%reaction, state%dissipated)
+         if (state%observer%takes(real(step + 1, wp)*reduced%dt)) call state%observer%tip(real(step + 1, wp)* &
+            & reduced%dt, state%q(pt), state%reaction, state%dissipated)
          state%gd_prev = gd
          state%sigma_prev = state%sigma_now
          state%sigma_now = sigma_next

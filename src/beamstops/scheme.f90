@@ -188,8 +188,8 @@ contains
          else
             call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
          end if
-         if (state%observer%active) call state%observer%tip(real(step + 1, wp)*model%dt, state%u(tip), &
-            & merge(state%reaction, 0.0_wp, state%in_contact), state%dissipated)
+         if (state%observer%takes(real(step + 1, wp)*model%dt)) call state%observer%tip(real(step + 1, wp)*model%dt, &
+            & state%u(tip), merge(state%reaction, 0.0_wp, state%in_contact), state%dissipated)
          if (model%damped) call damping_loss(model, state)
          if (step == next_record) u_old_su = dot_product(state%u, state%su) - dot_product(state%d, state%su)
          call band_matvec(model%stiffness, state%u, state%su)
@@ -302,8 +302,8 @@ contains
       state%d(model%tip) = d_tip
       r_prev = state%reaction
       call settle_tip(scene, model, state, outcome, gd, weight)
-      if (state%observer%active) call state%observer%tip(real(step + 1, wp)*model%dt, state%u(model%tip), &
-         & merge(state%reaction, 0.0_wp, state%in_contact), state%dissipated)
+      if (state%observer%takes(real(step + 1, wp)*model%dt)) call state%observer%tip(real(step + 1, wp)*model%dt, &
+         & state%u(model%tip), merge(state%reaction, 0.0_wp, state%in_contact), state%dissipated)
       if (step == next_record) then
          next_record = next_record + scene%record_every
          call fill_row(scene, model, state, step, outcome%u_tip_prev, outcome%d_tip_prev, r_prev, row)
@@ -361,8 +361,8 @@ contains
          else
             call tip_step(scene, model, state, weight, sigma_next, u_tip_prev, d_tip_prev, r_prev)
          end if
-         if (state%observer%active) call state%observer%tip(real(step + 1, wp)*model%dt, state%u(tip), &
-            & merge(state%reaction, 0.0_wp, state%in_contact), state%dissipated)
+         if (state%observer%takes(real(step + 1, wp)*model%dt)) call state%observer%tip(real(step + 1, wp)*model%dt, &
+            & state%u(tip), merge(state%reaction, 0.0_wp, state%in_contact), state%dissipated)
          if (model%damped) call damping_loss(model, state)
          if (step == next_record) then
             next_record = next_record + scene%record_every

@@ -40,6 +40,8 @@ module beamstops_observe_observer
       !> Number of finished shocks kept in rows.
       integer :: shocks_kept = 0
    contains
+      !> Whether it takes the sample of a time (ask before tip).
+      procedure :: takes
       !> The sample of a step of the tip-only scene.
       procedure :: tip
       !> The sample of a step with stops along the span.
@@ -133,15 +135,26 @@ contains
       end if
    end subroutine observe_scene
 
-   !> The sample of step n of the tip-only scene: t_{n+1}, u^{n+1}_tip (physical: the lifting is 0
-   !> at the tip), the reaction of step n and the stops' energy so far, both per unit mass.
+   !> Whether the observer takes the sample of time t: active, and t within the samples t_1 .. t_N
+   !> (the loops ask before calling tip, which stays small enough for the compiler to inline the
+   !> statistics' update into it).
+   pure logical function takes(self, t)
+      !> Observer.
+      class(observer_type), intent(in) :: self
+      !> t_{n+1} (s).
+      real(wp), intent(in) :: t
+      takes = self%active .and. t <= self%t_stop
+   end function takes
+
+   !> The sample of step n of the tip-only scene (when takes(t)): t_{n+1}, u^{n+1}_tip (physical:
+   !> the lifting is 0 at the tip), the reaction of step n and the stops' energy so far, both per
+   !> unit mass.
    subroutine tip(self, t, u_tip, reaction, dissipated)
       !> Observer.
       class(observer_type), intent(inout) :: self
       !> t_{n+1} (s), u^{n+1}_tip (m), reaction per unit mass, energy taken so far per unit mass.
       real(wp), intent(in) :: t, u_tip, reaction, dissipated
       real(wp) :: r, e
-      if (t > self%t_stop) return
       r = self%rho*reaction
       e = self%rho*(dissipated - self%dissipated_seen)
       self%dissipated_seen = dissipated
