@@ -802,7 +802,7 @@ contains
       !> histogram bins made its finish cost about 1 ms).
       real(wp), intent(in) :: t_all
       real(wp) :: h
-      real(wp) :: mean, s2
+      real(wp) :: shift, mean, s2
       integer :: nb
       logical :: use(size(x))
       use = ieee_is_finite(x)
@@ -811,8 +811,10 @@ contains
          h = ieee_value(h, ieee_quiet_nan)
          return
       end if
-      mean = sum(x, mask=use)/nb
-      s2 = sum((x - mean)**2, mask=use)/(nb - 1)
+      ! about the first value: equal values give exactly 0 (sum(x)/nb need not be x)
+      shift = x(findloc(use, .true., dim=1))
+      mean = sum(x - shift, mask=use)/nb
+      s2 = sum((x - shift - mean)**2, mask=use)/(nb - 1)
       if (nb == size(x)) then
          h = t_all*sqrt(s2/nb)
       else
@@ -860,7 +862,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: k, q, e, nk
       real(wp), allocatable :: x(:)
-      real(wp) :: t_all
+      real(wp) :: t_all, shift
       call validate_ensemble(size(members), 'ensemble', error)
       if (allocated(error)) return
       nk = size(members)
@@ -892,7 +894,10 @@ contains
                x(k) = members(k)%quantity(q)%value(e)
             end do
             if (count(.not. ieee_is_nan(x)) > 0) then
-               ensemble%quantity(q)%value(e) = sum(x, mask=.not. ieee_is_nan(x))/count(.not. ieee_is_nan(x))
+               ! about the first value: K equal members give it exactly
+               shift = x(findloc(.not. ieee_is_nan(x), .true., dim=1))
+               ensemble%quantity(q)%value(e) = shift + sum(x - shift, mask=.not. ieee_is_nan(x))/ &
+                  & count(.not. ieee_is_nan(x))
             else
                ensemble%quantity(q)%value(e) = ieee_value(x(1), ieee_quiet_nan)
             end if
