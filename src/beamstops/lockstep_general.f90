@@ -179,7 +179,8 @@ contains
          if (observing) then
             do k = 1, ms%k
                if (ms%observers(k)%takes(real(step + 1, wp)*model%dt) .and. ms%active(k)) call ms%observers(k)%tip( &
-                  & real(step + 1, wp)*model%dt, ms%u_tip(k), merge(ms%reaction(k), 0.0_wp, ms%in_contact(k)), ms%dissipated(k))
+                  & real(step + 1, wp)*model%dt, ms%u_tip(k), merge(ms%reaction(k), 0.0_wp, ms%in_contact(k)), &
+                  & ms%dissipated(k))
             end do
          end if
          ! the energy the damping took (damping_loss), C d^n for the next step

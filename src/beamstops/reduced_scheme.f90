@@ -439,7 +439,8 @@ contains
                call recorder%record_stops(state%span%record_u, state%span%record_reaction)
             end if
             state%stop_reaction = state%span%lambda/dt2
-            if (state%observer%active) call state%observer%span(real(step + 1, wp)*reduced%dt, &
+            if (state%observer%takes(real(step + 1, wp)*reduced%dt)) call state%observer%span(real(step + 1, wp)* &
+               & reduced%dt, &
                & state%q(reduced%r + 1:) + reduced%stops%lift*phi_next, state%stop_reaction, &
                & dot_product(reduced%tip_row, state%q), state%span%taken)
             phi_prev = phi_now
@@ -675,7 +676,8 @@ contains
          end if
          ! (with massless stops a free stop's row residual is not a contact: only the active ones count)
          state%stop_reaction = merge(state%span%reaction, 0.0_wp, state%span%lambda /= 0)
-         if (state%observer%active) call state%observer%span(real(step + 1, wp)*reduced%dt, &
+         if (state%observer%takes(real(step + 1, wp)*reduced%dt)) call state%observer%span(real(step + 1, wp)* &
+            & reduced%dt, &
             & state%q(r + 1:) + reduced%stops%lift*phi_next, state%stop_reaction, &
             & tip_value_of(reduced, state%q), state%span%taken)
          state%gd_prev = gd

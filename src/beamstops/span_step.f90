@@ -170,7 +170,8 @@ contains
       else
          state%stop_reaction = state%span%lambda/model%dt2
       end if
-      if (state%observer%active) call state%observer%span_indexed(real(step + 1, wp)*model%dt, state%u, &
+      if (state%observer%takes(real(step + 1, wp)*model%dt)) call state%observer%span_indexed(real(step + 1, wp)* &
+         & model%dt, state%u, &
          & model%stops%unknown, model%stops%lift, lp%phi_next, state%stop_reaction, state%span%lambda, &
          & state%u(tip), state%span%taken)
       if (step == lp%next_snapshot) then

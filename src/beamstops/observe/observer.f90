@@ -129,15 +129,15 @@ contains
          else
             call self%span(dt, u1, reaction, tip1, 0*reaction)
          end if
-         self%dissipated_seen = dissipated
       else
          call self%tip(dt, u1(1), reaction(1), dissipated)
       end if
    end subroutine observe_scene
 
-   !> Whether the observer takes the sample of time t: active, and t within the samples t_1 .. t_N
-   !> (the loops ask before calling tip, which stays small enough for the compiler to inline the
-   !> statistics' update into it).
+   !> Whether the observer takes the sample of time t: active, and t within the samples t_1 .. t_N.
+   !> The loops ask before calling tip, span or span_indexed (tip then stays small enough for the
+   !> compiler to inline the statistics' update into it, and a span sample's array arguments are
+   !> not built for nothing).
    pure logical function takes(self, t)
       !> Observer.
       class(observer_type), intent(in) :: self
@@ -162,9 +162,10 @@ contains
       call self%stats%step_tip(t, self%dt, u_tip, r, e)
    end subroutine tip
 
-   !> The sample of step n with stops along the span: t_{n+1}, the stops' physical displacement,
-   !> their reactions per unit mass, the tip displacement and the energy each stop took in the
-   !> step per unit mass (span_energy's `taken`: -1/2 r_i (u~^{n+1}_i - u~^{n-1}_i)).
+   !> The sample of step n with stops along the span (when takes(t)): t_{n+1}, the stops'
+   !> physical displacement, their reactions per unit mass, the tip displacement and the energy
+   !> each stop took in the step per unit mass (span_energy's `taken`:
+   !> -1/2 r_i (u~^{n+1}_i - u~^{n-1}_i)).
    subroutine span(self, t, u, reaction, u_tip, taken)
       !> Observer.
       class(observer_type), intent(inout) :: self
@@ -176,7 +177,6 @@ contains
       real(wp), intent(in) :: u_tip
       !> Energy each stop took in the step, per unit mass (m each).
       real(wp), intent(in) :: taken(:)
-      if (t > self%t_stop) return
       self%u = u
       self%r = self%rho*reaction
       call span_sample(self, t, u_tip, taken)
@@ -203,7 +203,6 @@ contains
       !> Energy each stop took in the step, per unit mass (m).
       real(wp), intent(in) :: taken(:)
       integer :: i
-      if (t > self%t_stop) return
       do i = 1, self%m
          self%u(i) = u(unknown(i)) + lift(i)*phi
          if (lambda(i) /= 0) then
@@ -260,8 +259,9 @@ contains
       table = self%stats%results()
       shocks = self%rows(:, :self%shocks_kept)
    end subroutine finish
-   !> The whole observer as reals: [m, rho, dt, dissipated_seen, t_stop, kept, size of the log's vector,
-   !> the log's vector (shock_log%pack), size of the statistics' vector, its vector
+
+   !> The whole observer as reals: [m, rho, dt, dissipated_seen, t_stop, kept, size of the log's
+   !> vector, the log's vector (shock_log%pack), size of the statistics' vector, its vector
    !> (statistics_type%pack), the kept rows (13 per shock)].
    subroutine pack_observer(self, values)
       !> Observer (active).

@@ -862,6 +862,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: k, q, e, nk
       real(wp), allocatable :: x(:)
+      logical, allocatable :: kept(:)
       real(wp) :: t_all, shift
       call validate_ensemble(size(members), 'ensemble', error)
       if (allocated(error)) return
@@ -885,7 +886,7 @@ contains
          end do
       end do
       ensemble%quantity = members(1)%quantity
-      allocate (x(nk))
+      allocate (x(nk), kept(nk))
       t_all = interval_factor(nk)
       do q = 1, size(ensemble%quantity)
          if (ensemble%quantity(q)%axis == 'edge') cycle
@@ -893,11 +894,11 @@ contains
             do k = 1, nk
                x(k) = members(k)%quantity(q)%value(e)
             end do
-            if (count(.not. ieee_is_nan(x)) > 0) then
+            kept = .not. ieee_is_nan(x)
+            if (any(kept)) then
                ! about the first value: K equal members give it exactly
-               shift = x(findloc(.not. ieee_is_nan(x), .true., dim=1))
-               ensemble%quantity(q)%value(e) = shift + sum(x - shift, mask=.not. ieee_is_nan(x))/ &
-                  & count(.not. ieee_is_nan(x))
+               shift = x(findloc(kept, .true., dim=1))
+               ensemble%quantity(q)%value(e) = shift + sum(x - shift, mask=kept)/count(kept)
             else
                ensemble%quantity(q)%value(e) = ieee_value(x(1), ieee_quiet_nan)
             end if
