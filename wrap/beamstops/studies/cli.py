@@ -10,23 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Optional
 
-from ..arguments import number, whole
 from .common import out_dir
-
-
-def positive(what: str) -> Callable[[str], float]:
-    """An argparse type: a finite number > 0 (argparse's message names the option, this one the range)."""
-    return number(what)
-
-
-def nonnegative(what: str) -> Callable[[str], float]:
-    """An argparse type: a finite number >= 0."""
-    return number(what, strict=False)
-
-
-def at_least_one(what: str) -> Callable[[str], int]:
-    """An argparse type: a whole number >= 1."""
-    return whole(what)
 
 
 @dataclass(frozen=True)

@@ -26,7 +26,8 @@ import numpy as np
 from ..engine import run
 from ..result import Result
 from ..scene import Scene
-from .cli import StudyCommand, positive
+from ..arguments import number
+from .cli import StudyCommand
 from .common import Table, out_dir, progress
 
 __all__ = ["reversals", "hf_fraction", "study", "main", "register"]
@@ -129,7 +130,7 @@ def draw(table: Table, path: Path) -> Path:
 
 
 def _options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--cutoff", type=positive("a frequency in Hz"), default=5000.0, help="cut-off frequency in Hz (default 5000)")
+    parser.add_argument("--cutoff", type=number("a frequency in Hz"), default=5000.0, help="cut-off frequency in Hz (default 5000)")
 
 
 def _run(folder: Path, args: argparse.Namespace) -> Path:

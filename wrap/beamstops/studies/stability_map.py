@@ -27,7 +27,8 @@ import numpy as np
 from ..engine import run, stability
 from ..result import IncompleteRunError, Result
 from ..scene import Scene
-from .cli import StudyCommand, positive
+from ..arguments import number
+from .cli import StudyCommand
 from .common import Table, out_dir, progress
 
 __all__ = ["classify", "energy_scale", "beta_map", "mesh_map", "answer", "study", "main", "register"]
@@ -184,7 +185,7 @@ def study(folder: Optional[Path] = None, *, quick: bool = False, threshold: floa
 
 
 def _options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--threshold", type=positive("a factor of energy growth"), default=10.0, help="energy growth that means unstable (default 10)")
+    parser.add_argument("--threshold", type=number("a factor of energy growth"), default=10.0, help="energy growth that means unstable (default 10)")
 
 
 def _run(folder: Path, args: argparse.Namespace) -> Path:

@@ -27,7 +27,8 @@ from typing import Optional
 import numpy as np
 
 from ..scene import Scene
-from .cli import StudyCommand, at_least_one, nonnegative, positive
+from ..arguments import number, whole
+from .cli import StudyCommand
 from .common import Table, out_dir, progress, run_tip, tip_error
 
 __all__ = ["Method", "methods", "study", "draw", "qoi_options", "split_qois", "main", "register"]
@@ -143,13 +144,13 @@ def qoi_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--half-width", type=half_width, default="2%", metavar="H",
                         help="requested 95 %% half-width h* of each QoI: a percentage of the reference's value "
                              "(default 2%%) or a number in the QoI's unit")
-    parser.add_argument("--transient", type=nonnegative("a time in s"),
+    parser.add_argument("--transient", type=number("a time in s", strict=False),
                         help="start of the statistics' window (s; default 2, quick 0.5)")
-    parser.add_argument("--stat-window", type=positive("a time in s"), metavar="T",
+    parser.add_argument("--stat-window", type=number("a time in s"), metavar="T",
                         help="window of the statistics after the transient (s; default 20, quick 2)")
-    parser.add_argument("--reference-window", type=positive("a time in s"), metavar="T",
+    parser.add_argument("--reference-window", type=number("a time in s"), metavar="T",
                         help="window of the references (s; default 40, quick 4)")
-    parser.add_argument("--members", type=at_least_one("members"),
+    parser.add_argument("--members", type=whole("members"),
                         help="members of the reference's ensemble (default 4, quick 3)")
 
 
@@ -164,7 +165,7 @@ def split_qois(names: Sequence[str]) -> tuple[bool, list[str]]:
 
 
 def _options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--window", type=positive("a time in s"), nargs="+", default=[0.08, 0.2],
+    parser.add_argument("--window", type=number("a time in s"), nargs="+", default=[0.08, 0.2],
                         help="compare on [0, W] s for each W (default 0.08 0.2: before the first impact, "
                              "the first contact period)")
     qoi_options(parser)
