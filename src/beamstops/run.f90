@@ -34,7 +34,11 @@ contains
       !> Set when the scene cannot run.
       type(error_type), allocatable, intent(out) :: error
       call build_model(scene, model, error)
-      if (allocated(error)) return
+      if (allocated(error)) then
+         ! the model's messages name group and key; the file is named here, as the reader does
+         error%message = source//': '//error%message
+         return
+      end if
       ! A reduced model (modes > 0) has its own spectrum: simulate checks it.
       if (scene%modes == 0) call check_stability(scene, model, source, error)
    end subroutine prepare_run

@@ -97,3 +97,18 @@ def test_bad_physics_inputs_end_in_one_message(text: str, needle: str, tmp_path:
         Scene.from_namelist(path)
     assert needle in str(caught.value)
     assert not (tmp_path / "bad.h5").exists()
+
+
+def test_a_model_refusal_names_the_file(tmp_path, program) -> None:  # type: ignore[no-untyped-def]
+    """The model's refusals (here the ratio pair that gives b < 0) name the file, as the
+    reader's do; they named the group and key only."""
+    import subprocess
+
+    scene = tmp_path / "pair.nml"
+    scene.write_text("&time dt = 1e-5, t_end = 0.01 /\n&damping ratio = 0.02, 0 /\n")
+    done = subprocess.run([program, "run", str(scene), "-o", str(tmp_path / "out.h5")], capture_output=True,
+                          text=True)
+    lines = done.stderr.strip().splitlines()
+    assert done.returncode == 1 and len(lines) == 1
+    assert lines[0].startswith(f"beamstops: error: {scene}: &damping ratio = 0.02, 0 "), lines
+    assert not (tmp_path / "out.h5").exists()
