@@ -53,6 +53,7 @@ module beamstops_lockstep
    use beamstops_lockstep_members, only: operators_type, members_type, lane, chunk, take_snapshot, first_events, &
       & energy
    use beamstops_lockstep_general, only: advance_members_general
+   use beamstops_observe_lanes, only: observer_lanes, gather_observers, scatter_observers, observe_lanes
    use beamstops_lockstep_span, only: simulate_span_lockstep
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
       & col_work, col_dissipated, col_damped
@@ -563,6 +564,7 @@ contains
       class(recorder_type), intent(inout) :: recorders(:)
       integer(ik), intent(in) :: last
       type(lanes_type), allocatable :: lanes(:)
+      type(observer_lanes), allocatable :: watch(:)
       integer(ik) :: step, next_record, next_snapshot, load_k
       integer :: k, c, n, tip, law
       logical :: energy_wanted, pending, observing, restart
@@ -582,6 +584,12 @@ contains
       pending = .false.
       allocate (lanes(ms%chunks))
       call gather_lanes(scenes, ms, lanes)
+      if (observing) then
+         allocate (watch(ms%chunks))
+         do c = 1, ms%chunks
+            call gather_observers(watch(c), ms%observers, (c - 1)*lockstep_lanes, ms%active(:ms%k))
+         end do
+      end if
       load_k = start_lanes_loads(lanes, ms%step + 1, model%dt)
       do step = ms%step, last
          restart = mod(load_k + 1, restart_every) == 0
@@ -625,15 +633,12 @@ contains
             call lockstep_dot(n, ms%g(:, :, c), ms%d(:, :, c), ms%partial, lanes(c)%gd, model%dt2)
             call lanes_close(lanes(c), law, ms%u(:, tip, c), ms%d(:, tip, c))
          end do
-         ! the shock log and statistics of each member that keeps them
+         ! the shock log and statistics of each member that keeps them (its quiet samples lane by
+         ! lane, beamstops_observe_lanes)
          if (observing) then
-            do k = 1, ms%k
-               if (ms%observers(k)%takes(real(step + 1, wp)*model%dt) .and. ms%active(k)) then
-                  associate (ln => lanes(chunk(k)), i => lane(k))
-                     call ms%observers(k)%tip(real(step + 1, wp)*model%dt, ln%u_tip(i), ln%reaction(i), &
-                        & ln%dissipated(i))
-                  end associate
-               end if
+            do c = 1, ms%chunks
+               call observe_lanes(watch(c), ms%observers, real(step + 1, wp)*model%dt, lanes(c)%u_tip, &
+                  & lanes(c)%reaction, lanes(c)%dissipated)
             end do
          end if
          ! records and snapshots
@@ -655,6 +660,11 @@ contains
          end if
       end do
       call scatter_lanes(lanes, ms)
+      if (observing) then
+         do c = 1, ms%chunks
+            call scatter_observers(watch(c), ms%observers)
+         end do
+      end if
       ! S u^{last+1}; it also completes the waiting records, as advance_fused does (one member
       ! at a time, with the one-member products and dot products).
       do c = 1, ms%chunks

@@ -24,6 +24,7 @@ module beamstops_lockstep_general
    use beamstops_kinds, only: wp, ik
    use beamstops_scene, only: scene_type, law_signorini, law_compliance
    use beamstops_model, only: model_type
+   use beamstops_observe_lanes, only: observer_lanes, gather_observers, scatter_observers, observe_lanes
    use beamstops_band_solve, only: energy_dots
    use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_matvec_rhs, lockstep_forward, &
       & lockstep_energy_dots, lockstep_back, lockstep_update, lockstep_dot, lockstep_matvec
@@ -57,7 +58,8 @@ contains
       integer(ik) :: step, next_record, next_snapshot
       integer :: k, c, lo, hi, n, tip, law
       logical :: energy_wanted, pending, observing, damped, massless
-      real(wp) :: sums(3)
+      real(wp) :: sums(3), reaction(lockstep_lanes)
+      type(observer_lanes), allocatable :: watch(:)
 
       n = ms%n
       tip = model%tip
@@ -70,6 +72,12 @@ contains
       next_record = minval(ms%next_record)
       next_snapshot = minval(ms%next_snapshot)
       observing = any(ms%observers%active)
+      if (observing) then
+         allocate (watch(ms%chunks))
+         do c = 1, ms%chunks
+            call gather_observers(watch(c), ms%observers, (c - 1)*lockstep_lanes, ms%active(:ms%k))
+         end do
+      end if
       ms%pending = .false.
       pending = .false.
       ms%u_old_su = 0
@@ -177,10 +185,12 @@ contains
          end if
          ! the shock log and statistics of each member that keeps them
          if (observing) then
-            do k = 1, ms%k
-               if (ms%observers(k)%takes(real(step + 1, wp)*model%dt) .and. ms%active(k)) call ms%observers(k)%tip( &
-                  & real(step + 1, wp)*model%dt, ms%u_tip(k), merge(ms%reaction(k), 0.0_wp, ms%in_contact(k)), &
-                  & ms%dissipated(k))
+            do c = 1, ms%chunks
+               lo = (c - 1)*lockstep_lanes + 1
+               hi = c*lockstep_lanes
+               reaction = merge(ms%reaction(lo:hi), 0.0_wp, ms%in_contact(lo:hi))
+               call observe_lanes(watch(c), ms%observers, real(step + 1, wp)*model%dt, ms%u_tip(lo:hi), reaction, &
+                  & ms%dissipated(lo:hi))
             end do
          end if
          ! the energy the damping took (damping_loss), C d^n for the next step
@@ -212,6 +222,11 @@ contains
             next_snapshot = minval(ms%next_snapshot)
          end if
       end do
+      if (observing) then
+         do c = 1, ms%chunks
+            call scatter_observers(watch(c), ms%observers)
+         end do
+      end if
       ! S u^{last+1}; it also completes the waiting records (advance_members)
       do c = 1, ms%chunks
          call lockstep_matvec(ops%stiffness, ms%u(:, :, c), ms%su(:, :, c))

@@ -134,6 +134,11 @@ module beamstops_observe_shocks
       procedure :: step_tip
       !> Energy a stop took in a step without contact, to its open shock.
       procedure :: trailing_energy
+      !> What a quiet sample of the tip reads and changes: samples seen, the tip at the last two
+      !> samples, the sample that needs attention (beamstops_observe_lanes).
+      procedure :: quiet_tip
+      !> Those values after quiet samples taken elsewhere.
+      procedure :: set_quiet_tip
       !> Close the open shocks at the end of a run.
       procedure :: finish
       !> Whether a completed row waits.
@@ -275,6 +280,34 @@ contains
       self%u2(1) = self%u1(1)
       self%u1(1) = u
    end subroutine step_tip
+
+   !> What a quiet sample of the tip (no reaction, no energy taken, before the deadline: step_tip
+   !> only counts it and shifts the tip's last two values) reads and changes.
+   pure subroutine quiet_tip(self, k, u1, u2, deadline)
+      !> Log of one stop.
+      class(shock_log), intent(in) :: self
+      !> Samples seen, the sample that needs attention.
+      integer(ik), intent(out) :: k, deadline
+      !> The tip at the last and the one-before-last sample (m).
+      real(wp), intent(out) :: u1, u2
+      k = self%k
+      u1 = self%u1(1)
+      u2 = self%u2(1)
+      deadline = self%deadline(1)
+   end subroutine quiet_tip
+
+   !> The samples seen and the tip's last two values after quiet samples taken elsewhere.
+   pure subroutine set_quiet_tip(self, k, u1, u2)
+      !> Log of one stop.
+      class(shock_log), intent(inout) :: self
+      !> Samples seen.
+      integer(ik), intent(in) :: k
+      !> The tip at the last and the one-before-last sample (m).
+      real(wp), intent(in) :: u1, u2
+      self%k = k
+      self%u1(1) = u1
+      self%u2(1) = u2
+   end subroutine set_quiet_tip
 
    !> A contact sample of stop i: continue the phase, merge a new phase into the open shock, or
    !> close the open shock and open a new one.

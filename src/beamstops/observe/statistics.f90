@@ -46,6 +46,7 @@ module beamstops_observe_statistics
    public :: statistics_type, new_statistics, validate_statistics, validate_ensemble
    public :: quantity_type, statistics_table, ensemble_table
    public :: student_t_quantile, student_t_cdf, incomplete_beta, batch_interval
+   public :: quiet_tip_stats
 
    !> One quantity of a table: name, unit, what its entries run over, and value and
    !> half-width of its 95 % interval per entry.
@@ -70,6 +71,21 @@ module beamstops_observe_statistics
       !> Index of a quantity by name (0: none).
       procedure :: find
    end type statistics_table
+
+   !> What a quiet tip sample reads and changes of the statistics: one in the current batch
+   !> (t < next_edge) and histogram bin (run_bin), without contact or energy taken, so that it only
+   !> adds to the tip's sums and extremes and counts (beamstops_observe_lanes keeps these across
+   !> lockstep lanes; quiet_tip and set_quiet_tip move them).
+   type :: quiet_tip_stats
+      !> End of the current batch (s); histogram's lower end (m), bins per metre, bins - 1/2.
+      real(wp) :: next_edge = 0, lower = 0, scale = 0, top = 0
+      !> The current batch's tip sum, sum of squares and extremes (m, m^2).
+      real(wp) :: su = 0, suu = 0, umin = 0, umax = 0
+      !> Bin of the current run of samples, and bins.
+      integer :: run_bin = 0, bins = 0
+      !> Samples of the current batch.
+      integer(ik) :: n = 0
+   end type quiet_tip_stats
 
    !> Running statistics of m stops and the tip.
    type :: statistics_type
@@ -111,6 +127,10 @@ module beamstops_observe_statistics
       procedure :: step_tip
       !> Take one completed shock.
       procedure :: add_shock
+      !> What a quiet tip sample reads and changes.
+      procedure :: quiet_tip
+      !> The sums, extremes and count after quiet tip samples taken elsewhere.
+      procedure :: set_quiet_tip
       !> Close the current batch at the end of a run.
       procedure :: finish
       !> The table of quantities.
@@ -328,6 +348,39 @@ contains
       self%se(1) = self%se(1) + energy_taken
       if (reaction /= 0) call self%contact_sample(1, reaction)
    end subroutine step_tip
+
+   !> What a quiet tip sample reads and changes (quiet_tip_stats).
+   pure function quiet_tip(self) result(q)
+      !> Statistics of the tip.
+      class(statistics_type), intent(in) :: self
+      !> Their values.
+      type(quiet_tip_stats) :: q
+      q%next_edge = self%next_edge
+      q%lower = self%lower
+      q%scale = self%scale
+      q%top = self%bins - 0.5_wp
+      q%su = self%su
+      q%suu = self%suu
+      q%umin = self%umin
+      q%umax = self%umax
+      q%run_bin = self%run_bin
+      q%bins = self%bins
+      q%n = self%n
+   end function quiet_tip
+
+   !> The tip's sums, extremes and count after quiet samples taken elsewhere (from quiet_tip, each
+   !> sample as tip_sample takes it: the same bits).
+   pure subroutine set_quiet_tip(self, q)
+      !> Statistics of the tip.
+      class(statistics_type), intent(inout) :: self
+      !> Their values after the quiet samples.
+      type(quiet_tip_stats), intent(in) :: q
+      self%su = q%su
+      self%suu = q%suu
+      self%umin = q%umin
+      self%umax = q%umax
+      self%n = q%n
+   end subroutine set_quiet_tip
 
    !> The batch, the count and the tip's sums, extremes and histogram of a sample.
    pure subroutine tip_sample(self, t, dt, u_tip)

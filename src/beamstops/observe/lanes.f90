@@ -1,0 +1,167 @@
+!> The observers of one chunk of lockstep lanes (beamstops_lockstep): the quiet samples of every
+!> member at once, the others by the member's own observer.
+!>
+!> Most samples of a run are quiet: the tip off the stops (no reaction), no energy taken, in the
+!> same batch and histogram bin as the sample before, and before the shock log's next deadline.
+!> The observer's tip then only counts the sample, shifts the tip's last two values and adds to
+!> the tip's sums and extremes. Here those few values are kept lane by lane (the member index
+!> innermost, as the lanes of the step), so that a quiet sample of the chunk is a few
+!> whole-register operations instead of a call per member. A lane whose sample is not quiet
+!> hands its values back to its member's observer, which takes the sample (observer_type's tip)
+!> and gives them again.
+!>
+!> Bit for bit: a quiet sample performs the operations of the statistics' tip_sample and the
+!> log's step_tip on the same values in the same order; which samples are quiet is decided
+!> conservatively (anything else goes to the member's observer: contact, energy, a new batch or
+!> bin, a deadline, a value not finite). tests/fortran/test_lockstep.f90 checks the shock logs
+!> and statistics of whole lockstep runs against the same scenes run alone.
+module beamstops_observe_lanes
+   use beamstops_kinds, only: wp, ik
+   use beamstops_band_solve_lockstep, only: lockstep_lanes
+   use beamstops_observe_observer, only: observer_type
+   use beamstops_observe_statistics, only: quiet_tip_stats
+   implicit none
+   private
+   public :: observer_lanes, gather_observers, scatter_observers, observe_lanes
+
+   !> The values quiet samples read and change, per lane of a chunk.
+   type :: observer_lanes
+      !> Member index of each lane (0: no member) and whether its observer takes samples now
+      !> (the member runs and observes).
+      integer :: member(lockstep_lanes) = 0
+      logical :: live(lockstep_lanes) = .false.
+      !> The observer's last sample time (s) and the stops' energy it has seen (per unit mass).
+      real(wp) :: t_stop(lockstep_lanes) = 0, seen(lockstep_lanes) = 0
+      !> The shock log: samples seen, the sample that needs attention, the tip's last two values.
+      integer(ik) :: k(lockstep_lanes) = 0, deadline(lockstep_lanes) = 0
+      real(wp) :: u1(lockstep_lanes) = 0, u2(lockstep_lanes) = 0
+      !> The statistics (quiet_tip_stats, lane by lane).
+      real(wp) :: next_edge(lockstep_lanes) = 0, lower(lockstep_lanes) = 0, scale(lockstep_lanes) = 0, &
+         & top(lockstep_lanes) = 0, su(lockstep_lanes) = 0, suu(lockstep_lanes) = 0, umin(lockstep_lanes) = 0, &
+         & umax(lockstep_lanes) = 0
+      integer :: run_bin(lockstep_lanes) = 0, bins(lockstep_lanes) = 1
+      integer(ik) :: n(lockstep_lanes) = 0
+   end type observer_lanes
+
+contains
+
+   !> The lanes of a chunk from its members' observers: lane i holds member first + i when there
+   !> is one (first: the members of the chunks before), live when it runs and observes.
+   subroutine gather_observers(lanes, observers, first, running)
+      !> The chunk's lanes.
+      type(observer_lanes), intent(out) :: lanes
+      !> Every member's observer (K).
+      type(observer_type), intent(in) :: observers(:)
+      !> Members before the chunk's first.
+      integer, intent(in) :: first
+      !> Whether each member runs (K).
+      logical, intent(in) :: running(:)
+      integer :: i, k
+      do i = 1, lockstep_lanes
+         k = first + i
+         if (k > size(observers)) exit
+         lanes%member(i) = k
+         lanes%live(i) = running(k) .and. observers(k)%active
+         if (lanes%live(i)) call take(lanes, i, observers(k))
+      end do
+   end subroutine gather_observers
+
+   !> The lanes' values back into their members' observers.
+   subroutine scatter_observers(lanes, observers)
+      !> The chunk's lanes.
+      type(observer_lanes), intent(in) :: lanes
+      !> Every member's observer.
+      type(observer_type), intent(inout) :: observers(:)
+      integer :: i
+      do i = 1, lockstep_lanes
+         if (lanes%live(i)) call give(lanes, i, observers(lanes%member(i)))
+      end do
+   end subroutine scatter_observers
+
+   !> The sample of t_{n+1} of every live lane: u^{n+1}_tip, the reaction of step n and the
+   !> stops' energy so far, per unit mass (observer_type's tip, lane by lane).
+   subroutine observe_lanes(lanes, observers, t, u_tip, reaction, dissipated)
+      !> The chunk's lanes.
+      type(observer_lanes), intent(inout) :: lanes
+      !> Every member's observer.
+      type(observer_type), intent(inout) :: observers(:)
+      !> t_{n+1} (s).
+      real(wp), intent(in) :: t
+      !> Tip displacement (m), reaction and energy taken so far per unit mass, of every lane.
+      real(wp), intent(in) :: u_tip(lockstep_lanes), reaction(lockstep_lanes), dissipated(lockstep_lanes)
+      logical :: quiet(lockstep_lanes), other(lockstep_lanes)
+      real(wp) :: x
+      integer :: i, bin
+!GCC$ ivdep
+!GCC$ vector
+      do i = 1, lockstep_lanes
+         x = min(max((u_tip(i) - lanes%lower(i))*lanes%scale(i), 0.0_wp), lanes%top(i))
+         bin = min(max(int(x), 0), lanes%bins(i) - 1)
+         quiet(i) = lanes%live(i) .and. t <= lanes%t_stop(i) .and. reaction(i) == 0 .and. &
+            & dissipated(i) == lanes%seen(i) .and. lanes%k(i) + 1 < lanes%deadline(i) .and. &
+            & t < lanes%next_edge(i) .and. bin == lanes%run_bin(i) .and. abs(u_tip(i)) <= huge(1.0_wp)
+         other(i) = lanes%live(i) .and. t <= lanes%t_stop(i) .and. .not. quiet(i)
+      end do
+!GCC$ ivdep
+!GCC$ vector
+      do i = 1, lockstep_lanes
+         if (quiet(i)) then
+            lanes%k(i) = lanes%k(i) + 1
+            lanes%u2(i) = lanes%u1(i)
+            lanes%u1(i) = u_tip(i)
+            lanes%su(i) = lanes%su(i) + u_tip(i)
+            lanes%suu(i) = lanes%suu(i) + u_tip(i)*u_tip(i)
+            lanes%umin(i) = min(lanes%umin(i), u_tip(i))
+            lanes%umax(i) = max(lanes%umax(i), u_tip(i))
+            lanes%n(i) = lanes%n(i) + 1
+         end if
+      end do
+      if (.not. any(other)) return
+      do i = 1, lockstep_lanes
+         if (.not. other(i)) cycle
+         associate (observer => observers(lanes%member(i)))
+            call give(lanes, i, observer)
+            call observer%tip(t, u_tip(i), reaction(i), dissipated(i))
+            call take(lanes, i, observer)
+         end associate
+      end do
+   end subroutine observe_lanes
+
+   !> Lane i's values from its member's observer.
+   subroutine take(lanes, i, observer)
+      type(observer_lanes), intent(inout) :: lanes
+      integer, intent(in) :: i
+      type(observer_type), intent(in) :: observer
+      type(quiet_tip_stats) :: q
+      lanes%t_stop(i) = observer%t_stop
+      lanes%seen(i) = observer%dissipated_seen
+      call observer%shocks%quiet_tip(lanes%k(i), lanes%u1(i), lanes%u2(i), lanes%deadline(i))
+      q = observer%stats%quiet_tip()
+      lanes%next_edge(i) = q%next_edge
+      lanes%lower(i) = q%lower
+      lanes%scale(i) = q%scale
+      lanes%top(i) = q%top
+      lanes%su(i) = q%su
+      lanes%suu(i) = q%suu
+      lanes%umin(i) = q%umin
+      lanes%umax(i) = q%umax
+      lanes%run_bin(i) = q%run_bin
+      lanes%bins(i) = q%bins
+      lanes%n(i) = q%n
+   end subroutine take
+
+   !> Lane i's values into its member's observer.
+   subroutine give(lanes, i, observer)
+      type(observer_lanes), intent(in) :: lanes
+      integer, intent(in) :: i
+      type(observer_type), intent(inout) :: observer
+      type(quiet_tip_stats) :: q
+      call observer%shocks%set_quiet_tip(lanes%k(i), lanes%u1(i), lanes%u2(i))
+      q%su = lanes%su(i)
+      q%suu = lanes%suu(i)
+      q%umin = lanes%umin(i)
+      q%umax = lanes%umax(i)
+      q%n = lanes%n(i)
+      call observer%stats%set_quiet_tip(q)
+   end subroutine give
+end module beamstops_observe_lanes
