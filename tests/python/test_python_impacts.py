@@ -164,6 +164,27 @@ def test_samples_are_the_records_times() -> None:
     assert float(run.statistics["tip_min"]) == run.tip_u[kept].min()
 
 
+def test_batches_are_those_of_the_documented_edges() -> None:
+    """tip_mean's value and 95 % half-width from the records with docs/statistics.md's batches:
+    w = (t_end - transient)/B, e_j = transient + j*w (the product rounded, then the sum), a sample at
+    t in batch j when e_{j-1} <= t < e_j. Here samples fall on edges: t = 0.9 on e_7 (0.9 + 1 ulp by
+    that rule, 0.9 as one multiply-add), so a fused edge would move a sample to the next batch."""
+    scipy_stats = pytest.importorskip("scipy.stats")
+    transient, t_end, batches = 0.2, 1.0, 8
+    run = beamstops.run(Scene(elements=4, dt=2e-5, t_end=t_end, transient=transient, batches=batches))
+    w = (t_end - transient) / batches
+    edges = np.array([transient + j * w for j in range(1, batches)])
+    kept = (run.t >= transient) & (run.t > 0)
+    t, u = run.t[kept], run.tip_u[kept]
+    which = np.searchsorted(edges, t, side="right")
+    assert np.any(np.isin(t, edges)), "some sample lies on an edge"
+    means = np.array([u[which == j].mean() for j in range(batches)])
+    half = scipy_stats.t.ppf(0.975, batches - 1) * means.std(ddof=1) / math.sqrt(batches)
+    statistic = run.statistics["tip_mean"]
+    assert float(statistic.value[0]) == pytest.approx(u.mean(), rel=1e-12)
+    assert float(statistic.half_width[0]) == pytest.approx(half, rel=1e-9)
+
+
 def energy_per_sample(u: np.ndarray, reaction: np.ndarray) -> np.ndarray:
     """The energy a stop took in the step that brought row k, -1/2 R_k (u_k - u_{k-2}) (J), from
     the records (record_every = 1; rows 0 and 1: 0, no contact at the start here)."""

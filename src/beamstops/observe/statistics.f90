@@ -261,7 +261,7 @@ contains
       stats%scale = bins/(upper - lower)
       allocate (stats%edge(b))
       do j = 1, b - 1
-         stats%edge(j) = transient + j*((t_end - transient)/b)
+         stats%edge(j) = rounded_sum(transient, j, (t_end - transient)/b)
       end do
       stats%edge(b) = huge(1.0_wp)
       stats%batch = 0
@@ -348,6 +348,18 @@ contains
       self%se(1) = self%se(1) + energy_taken
       if (reaction /= 0) call self%contact_sample(1, reaction)
    end subroutine step_tip
+
+   !> start + j width with the product rounded before the sum, never as one multiply-add: the
+   !> form docs/statistics.md gives the batch and histogram edges in, so that they can be
+   !> reproduced outside the engine (a sample on an edge is in the same batch for both).
+   function rounded_sum(start, j, width) result(edge)
+      real(wp), intent(in) :: start, width
+      integer, intent(in) :: j
+      real(wp) :: edge
+      real(wp), volatile :: product
+      product = j*width
+      edge = start + product
+   end function rounded_sum
 
    !> What a quiet tip sample reads and changes (quiet_tip_stats).
    pure function quiet_tip(self) result(q)
@@ -614,7 +626,7 @@ contains
       deallocate (v)
       allocate (v(s%bins + 1))
       do k = 0, s%bins
-         v(k + 1) = s%lower + k*((s%upper - s%lower)/s%bins)
+         v(k + 1) = rounded_sum(s%lower, k, (s%upper - s%lower)/s%bins)
       end do
       v(s%bins + 1) = s%upper
       call put('tip_histogram_edges', 'm', 'edge', v, spread(0.0_wp, 1, s%bins + 1))
