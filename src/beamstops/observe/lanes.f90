@@ -24,22 +24,28 @@ module beamstops_observe_lanes
    private
    public :: observer_lanes, gather_observers, scatter_observers, observe_lanes
 
-   !> The values quiet samples read and change, per lane of a chunk.
+   !> The values quiet samples read and change, per lane of a chunk. Each test of a quiet sample is
+   !> a compare of doubles (so that the chunk's test is a few whole-register compares): the lane's
+   !> last sample time is -huge when it takes none, the histogram's current bin is the interval
+   !> [bin_low, bin_low + 1) of (u - lower) scale, and the shock log's deadline is counted down
+   !> in `left` = deadline - k - 1, the quiet samples still allowed (exact below 2^53; a deadline
+   !> of huge stays above 0).
    type :: observer_lanes
       !> Member index of each lane (0: no member) and whether its observer takes samples now
       !> (the member runs and observes).
       integer :: member(lockstep_lanes) = 0
       logical :: live(lockstep_lanes) = .false.
-      !> The observer's last sample time (s) and the stops' energy it has seen (per unit mass).
-      real(wp) :: t_stop(lockstep_lanes) = 0, seen(lockstep_lanes) = 0
-      !> The shock log: samples seen, the sample that needs attention, the tip's last two values.
-      integer(ik) :: k(lockstep_lanes) = 0, deadline(lockstep_lanes) = 0
-      real(wp) :: u1(lockstep_lanes) = 0, u2(lockstep_lanes) = 0
-      !> The statistics (quiet_tip_stats, lane by lane).
+      !> The observer's last sample time (s; -huge: none) and the stops' energy it has seen (per
+      !> unit mass).
+      real(wp) :: t_stop(lockstep_lanes) = -huge(1.0_wp), seen(lockstep_lanes) = 0
+      !> The shock log: samples seen; quiet samples left before the deadline; the tip's last two
+      !> values.
+      integer(ik) :: k(lockstep_lanes) = 0
+      real(wp) :: left(lockstep_lanes) = 0, u1(lockstep_lanes) = 0, u2(lockstep_lanes) = 0
+      !> The statistics (quiet_tip_stats, lane by lane; bin_low: the current run's bin).
       real(wp) :: next_edge(lockstep_lanes) = 0, lower(lockstep_lanes) = 0, scale(lockstep_lanes) = 0, &
-         & top(lockstep_lanes) = 0, su(lockstep_lanes) = 0, suu(lockstep_lanes) = 0, umin(lockstep_lanes) = 0, &
-         & umax(lockstep_lanes) = 0
-      integer :: run_bin(lockstep_lanes) = 0, bins(lockstep_lanes) = 1
+         & top(lockstep_lanes) = 0, bin_low(lockstep_lanes) = 0, su(lockstep_lanes) = 0, suu(lockstep_lanes) = 0, &
+         & umin(lockstep_lanes) = 0, umax(lockstep_lanes) = 0
       integer(ik) :: n(lockstep_lanes) = 0
    end type observer_lanes
 
@@ -62,7 +68,11 @@ contains
          if (k > size(observers)) exit
          lanes%member(i) = k
          lanes%live(i) = running(k) .and. observers(k)%active
-         if (lanes%live(i)) call take(lanes, i, observers(k))
+         if (lanes%live(i)) then
+            call take(lanes, i, observers(k))
+         else
+            lanes%t_stop(i) = -huge(1.0_wp)
+         end if
       end do
    end subroutine gather_observers
 
@@ -89,24 +99,39 @@ contains
       real(wp), intent(in) :: t
       !> Tip displacement (m), reaction and energy taken so far per unit mass, of every lane.
       real(wp), intent(in) :: u_tip(lockstep_lanes), reaction(lockstep_lanes), dissipated(lockstep_lanes)
-      logical :: quiet(lockstep_lanes), other(lockstep_lanes)
+      logical :: quiet(lockstep_lanes), other(lockstep_lanes), test(lockstep_lanes, 8)
       real(wp) :: x
-      integer :: i, bin
+      integer :: i
+      ! quiet: taken, no reaction, no energy, before the deadline and the batch's end, in the run's
+      ! bin (tip_sample's bin is int(x), x clamped to [0, bins - 1/2]), finite. Each compare is
+      ! stored on its own, then the masks combined: compares joined by .and. become branches (a
+      ! compare may trap, so the compiler keeps them in order), which do not vectorize.
 !GCC$ ivdep
 !GCC$ vector
       do i = 1, lockstep_lanes
          x = min(max((u_tip(i) - lanes%lower(i))*lanes%scale(i), 0.0_wp), lanes%top(i))
-         bin = min(max(int(x), 0), lanes%bins(i) - 1)
-         quiet(i) = lanes%live(i) .and. t <= lanes%t_stop(i) .and. reaction(i) == 0 .and. &
-            & dissipated(i) == lanes%seen(i) .and. lanes%k(i) + 1 < lanes%deadline(i) .and. &
-            & t < lanes%next_edge(i) .and. bin == lanes%run_bin(i) .and. abs(u_tip(i)) <= huge(1.0_wp)
-         other(i) = lanes%live(i) .and. t <= lanes%t_stop(i) .and. .not. quiet(i)
+         test(i, 1) = t <= lanes%t_stop(i)
+         test(i, 2) = reaction(i) == 0
+         test(i, 3) = dissipated(i) == lanes%seen(i)
+         test(i, 4) = lanes%left(i) > 0
+         test(i, 5) = t < lanes%next_edge(i)
+         test(i, 6) = x >= lanes%bin_low(i)
+         test(i, 7) = x < lanes%bin_low(i) + 1
+         test(i, 8) = abs(u_tip(i)) <= huge(1.0_wp)
+      end do
+!GCC$ ivdep
+!GCC$ vector
+      do i = 1, lockstep_lanes
+         quiet(i) = test(i, 1) .and. test(i, 2) .and. test(i, 3) .and. test(i, 4) .and. test(i, 5) .and. test(i, 6) &
+            & .and. test(i, 7) .and. test(i, 8)
+         other(i) = test(i, 1) .and. .not. quiet(i)
       end do
 !GCC$ ivdep
 !GCC$ vector
       do i = 1, lockstep_lanes
          if (quiet(i)) then
             lanes%k(i) = lanes%k(i) + 1
+            lanes%left(i) = lanes%left(i) - 1
             lanes%u2(i) = lanes%u1(i)
             lanes%u1(i) = u_tip(i)
             lanes%su(i) = lanes%su(i) + u_tip(i)
@@ -133,20 +158,21 @@ contains
       integer, intent(in) :: i
       type(observer_type), intent(in) :: observer
       type(quiet_tip_stats) :: q
+      integer(ik) :: deadline
       lanes%t_stop(i) = observer%t_stop
       lanes%seen(i) = observer%dissipated_seen
-      call observer%shocks%quiet_tip(lanes%k(i), lanes%u1(i), lanes%u2(i), lanes%deadline(i))
+      call observer%shocks%quiet_tip(lanes%k(i), lanes%u1(i), lanes%u2(i), deadline)
+      lanes%left(i) = real(deadline - lanes%k(i) - 1, wp)
       q = observer%stats%quiet_tip()
       lanes%next_edge(i) = q%next_edge
       lanes%lower(i) = q%lower
       lanes%scale(i) = q%scale
       lanes%top(i) = q%top
+      lanes%bin_low(i) = real(q%run_bin, wp)
       lanes%su(i) = q%su
       lanes%suu(i) = q%suu
       lanes%umin(i) = q%umin
       lanes%umax(i) = q%umax
-      lanes%run_bin(i) = q%run_bin
-      lanes%bins(i) = q%bins
       lanes%n(i) = q%n
    end subroutine take
 
