@@ -15,6 +15,7 @@ module beamstops_lockstep_members
    use beamstops_scene, only: scene_type, law_none, law_signorini, law_compliance
    use beamstops_model, only: model_type
    use beamstops_band_solve, only: band_solver, band_diagonals
+   use beamstops_band, only: kd
    use beamstops_band_solve_lockstep, only: lockstep_lanes
    use beamstops_forcing, only: load_average, support_position, restart_every
    use beamstops_contact_compliance, only: compliance_step
@@ -37,6 +38,11 @@ module beamstops_lockstep_members
       type(band_diagonals) :: stiffness, mass
       !> C by diagonals (Rayleigh damping; n = 0 without).
       type(band_diagonals) :: damping
+      !> Whether the interior rows of S repeat with period 2 (a uniform mesh: always, unless
+      !> rounding made two sums differ), and its two interior rows' coefficients
+      !> (lockstep_periodic_rows): the product by S then keeps them in registers.
+      logical :: periodic = .false.
+      real(wp) :: stiffness_rows(2*kd + 1, 2) = 0
    end type operators_type
 
    !> The state of K members, the member index first: what advance_fused keeps in a

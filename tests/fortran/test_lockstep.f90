@@ -24,7 +24,7 @@ module test_lockstep
       & back_substitution_edge, back_substitution_update
    use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_work_columns, lockstep_matvec, &
       & lockstep_forward, lockstep_energy_dots, lockstep_back, lockstep_dot, lockstep_update, lockstep_back_edge, &
-      & lockstep_back_update
+      & lockstep_back_update, lockstep_matvec_rhs, lockstep_matvec_rhs_periodic, lockstep_periodic_rows
    use beamstops_contact_tip_contact, only: update
    use test_support, only: base_scene
    implicit none
@@ -295,7 +295,9 @@ contains
       type(band_diagonals) :: s, m
       real(wp), allocatable :: x(:, :), y(:, :), b(:, :), u(:, :), d(:, :), ub(:, :), v(:), w(:), uk(:)
       real(wp) :: work(lanes, lockstep_work_columns), usu(lanes), dsu(lanes), dmd(lanes), dd(lanes), c(lanes)
-      real(wp) :: e(3), f(3), g(3)
+      real(wp) :: e(3), f(3), g(3), rows(7, 2)
+      real(wp), allocatable :: w2(:, :)
+      logical :: periodic
       integer :: a, rep, k, n
       character(len=:), allocatable :: where
       do a = 1, size(meshes)
@@ -307,8 +309,9 @@ contains
          call prepare_diagonals(model%stiffness, s)
          call prepare_diagonals(model%mass, m)
          n = model%n
-         if (allocated(x)) deallocate (x, y, b, u, d, ub, v, w, uk)
-         allocate (x(lanes, n), y(lanes, n), b(lanes, n), u(lanes, n), d(lanes, n), ub(lanes, n), v(n), w(n), uk(n))
+         if (allocated(x)) deallocate (x, y, b, u, d, ub, v, w, uk, w2)
+         allocate (x(lanes, n), y(lanes, n), b(lanes, n), u(lanes, n), d(lanes, n), ub(lanes, n), v(n), w(n), uk(n), &
+            & w2(lanes, n))
          do rep = 1, 20
             call random_number(x)
             call random_number(u)
@@ -323,6 +326,14 @@ contains
                call diagonal_matvec(s, x(k, :), v)
                if (.not. all(same_bits(v, y(k, :)))) call test_failed(error, where//'S x, lane '//int_text(k))
             end do
+            ! the product by S with the interior rows' coefficients kept in registers: a uniform
+            ! mesh's S has period-2 interior rows, and the kernel gives lockstep_matvec_rhs's bits
+            call lockstep_periodic_rows(s, periodic, rows)
+            if (.not. periodic) call test_failed(error, where//'the interior rows of S repeat with period 2')
+            call lockstep_matvec_rhs(s, x, c, u, 1.0e-10_wp, d(:, 1), y, b)
+            call lockstep_matvec_rhs_periodic(s, rows, x, c, u, 1.0e-10_wp, d(:, 1), ub, w2)
+            if (.not. (all(same_bits(y, ub)) .and. all(same_bits(b, w2)))) &
+               & call test_failed(error, where//'S x and the right-hand side with period-2 rows')
             b = x
             call lockstep_forward(solver, b)
             do k = 1, lanes
