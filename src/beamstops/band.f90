@@ -130,20 +130,10 @@ contains
       real(wp), intent(out) :: kappa
       !> Set when LAPACK fails.
       type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: sa(:, :), ma(:, :), w(:), work(:)
-      real(wp) :: zdum(1, 1)
-      integer :: n, info
-      n = size(s, 2)
-      allocate (sa, source=s)
-      allocate (ma, source=m)
-      allocate (w(n), work(3*n))
-      call dsbgv('N', 'U', n, kd, kd, sa, kd + 1, ma, kd + 1, w, zdum, 1, work, info)
-      if (info /= 0) then
-         call fatal_error(error, dsbgv_message(info, n))
-         kappa = 0
-         return
-      end if
-      kappa = w(n)
+      real(wp), allocatable :: w(:)
+      kappa = 0
+      call pencil_eigenvalues(s, m, w, error)
+      if (.not. allocated(error)) kappa = w(size(w))
    end subroutine largest_eigenvalue_exact
 
    !> All finite eigenvalues kappa of S v = kappa M v, ascending (LAPACK dsbgv; O(n^2): small n
@@ -166,17 +156,12 @@ contains
       real(wp), allocatable, intent(out) :: kappa(:)
       !> Set when LAPACK fails.
       type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: sa(:, :), ma(:, :), w(:), work(:), low(:)
-      real(wp) :: zdum(1, 1)
-      integer :: n, info, j
+      real(wp), allocatable :: w(:), low(:)
+      integer :: n, j
       n = size(s, 2)
-      allocate (w(n), work(3*n))
       ! M v = mu S v: mu ascending, kappa = 1/mu descending
-      allocate (sa, source=s)
-      allocate (ma, source=m)
-      call dsbgv('N', 'U', n, kd, kd, ma, kd + 1, sa, kd + 1, w, zdum, 1, work, info)
-      if (info /= 0) then
-         call fatal_error(error, dsbgv_message(info, n))
+      call pencil_eigenvalues(m, s, w, error)
+      if (allocated(error)) then
          allocate (kappa(0))
          return
       end if
@@ -186,11 +171,8 @@ contains
          return
       end if
       ! S v = kappa M v: the high end
-      sa = s
-      ma = m
-      call dsbgv('N', 'U', n, kd, kd, sa, kd + 1, ma, kd + 1, w, zdum, 1, work, info)
-      if (info /= 0) then
-         call fatal_error(error, dsbgv_message(info, n))
+      call pencil_eigenvalues(s, m, w, error)
+      if (allocated(error)) then
          allocate (kappa(0))
          return
       end if
@@ -199,6 +181,22 @@ contains
          if (w(j)**2 < w(1)*w(n)) kappa(j) = low(j)
       end do
    end subroutine generalized_eigenvalues
+
+   !> The eigenvalues w of a v = w b v, ascending (dsbgv; a symmetric, b positive definite).
+   subroutine pencil_eigenvalues(a, b, w, error)
+      real(wp), intent(in) :: a(:, :), b(:, :)
+      real(wp), allocatable, intent(out) :: w(:)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: aa(:, :), bb(:, :), work(:)
+      real(wp) :: zdum(1, 1)
+      integer :: n, info
+      n = size(a, 2)
+      allocate (aa, source=a)
+      allocate (bb, source=b)
+      allocate (w(n), work(3*n))
+      call dsbgv('N', 'U', n, kd, kd, aa, kd + 1, bb, kd + 1, w, zdum, 1, work, info)
+      if (info /= 0) call fatal_error(error, dsbgv_message(info, n))
+   end subroutine pencil_eigenvalues
 
    !> Largest eigenvalue of S v = kappa M v by inverse iteration shifted at an upper bound
    !> `shift` (O(n) per iteration; for meshes too large for dsbgv). Converges to the top of

@@ -27,7 +27,7 @@ module beamstops_band_solve_lockstep
    implicit none
    private
    public :: lockstep_forward, lockstep_energy_dots, lockstep_back, lockstep_matvec, lockstep_dot
-   public :: lockstep_rhs, lockstep_update, lockstep_matvec_rhs, lockstep_matvec_rhs_periodic, lockstep_periodic_rows
+   public :: lockstep_rhs, lockstep_update, lockstep_matvec_rhs, lockstep_periodic_rows
    public :: lockstep_back_edge, lockstep_back_update
    public :: lockstep_min_unknowns, lockstep_work_columns, lockstep_lanes
 
@@ -390,8 +390,12 @@ contains
       call dot_tail(n, j, x, y, partial, s, positive)
    end subroutine lockstep_dot
 
-   !> lockstep_matvec (S u) and lockstep_rhs (rhs = a g - b S u + spring e_{n-1}) in one pass.
-   pure subroutine lockstep_matvec_rhs(stiffness, u, a, g, b, spring, su, rhs)
+   !> lockstep_matvec (S u) and lockstep_rhs (rhs = a g - b S u + spring e_{n-1}) in one pass. With
+   !> `rows`, for an S whose interior rows kd+1 .. n-kd repeat with period 2 (a uniform mesh:
+   !> lockstep_periodic_rows says whether they do), the two rows' coefficients, given once, stay in
+   !> registers for the whole pass instead of being broadcast row by row: the same products of the
+   !> same values in the same order, the same bits.
+   pure subroutine lockstep_matvec_rhs(stiffness, u, a, g, b, spring, su, rhs, rows)
       !> S by diagonals.
       type(band_diagonals), intent(in) :: stiffness
       !> u of every lane (lanes, n).
@@ -408,77 +412,60 @@ contains
       real(wp), intent(out) :: su(lockstep_lanes, stiffness%n)
       !> Right-hand sides (lanes, n).
       real(wp), intent(out) :: rhs(lockstep_lanes, stiffness%n)
+      !> The coefficients of interior rows kd+1 and kd+2 of a periodic S in the order of a row's
+      !> products (lockstep_periodic_rows).
+      real(wp), intent(in), optional :: rows(2*kd + 1, 2)
       integer :: j, k, n
       n = stiffness%n
       call matvec_rhs_first_rows(stiffness, u, a, g, b, su, rhs)
-      associate (s => stiffness%a, x => u, y => su)
-         do j = kd + 1, n - kd
+      if (present(rows)) then
+         call matvec_rhs_periodic_rows(n, rows, u, a, g, b, su, rhs)
+      else
+         associate (s => stiffness%a, x => u, y => su)
+            do j = kd + 1, n - kd
 !GCC$ ivdep
 !GCC$ vector
-            do k = 1, lockstep_lanes
-               y(k, j) = s(j, 3)*x(k, j - 3) + s(j, 2)*x(k, j - 2) + s(j, 1)*x(k, j - 1) + s(j, 0)*x(k, j) &
-                  & + s(j + 1, 1)*x(k, j + 1) + s(j + 2, 2)*x(k, j + 2) + s(j + 3, 3)*x(k, j + 3)
-               rhs(k, j) = a(k)*g(k, j) - b*y(k, j)
+               do k = 1, lockstep_lanes
+                  y(k, j) = s(j, 3)*x(k, j - 3) + s(j, 2)*x(k, j - 2) + s(j, 1)*x(k, j - 1) + s(j, 0)*x(k, j) &
+                     & + s(j + 1, 1)*x(k, j + 1) + s(j + 2, 2)*x(k, j + 2) + s(j + 3, 3)*x(k, j + 3)
+                  rhs(k, j) = a(k)*g(k, j) - b*y(k, j)
+               end do
             end do
-         end do
-      end associate
+         end associate
+      end if
       call matvec_rhs_last_rows(stiffness, u, a, g, b, spring, su, rhs)
    end subroutine lockstep_matvec_rhs
 
-   !> lockstep_matvec_rhs for an S whose interior rows kd+1 .. n-kd repeat with period 2 (a uniform
-   !> mesh: lockstep_periodic_rows says whether they do): the two rows' coefficients, given
-   !> once, stay in registers for the whole pass instead of being broadcast row by row. The same
-   !> products of the same values in the same order: the same bits.
-   pure subroutine lockstep_matvec_rhs_periodic(stiffness, rows, u, a, g, b, spring, su, rhs)
-      !> S by diagonals.
-      type(band_diagonals), intent(in) :: stiffness
-      !> The coefficients of interior rows kd+1 and kd+2 in the order of the products of a row
-      !> (lockstep_periodic_rows).
-      real(wp), intent(in) :: rows(2*kd + 1, 2)
-      !> u of every lane (lanes, n).
-      real(wp), intent(in) :: u(lockstep_lanes, stiffness%n)
-      !> dt^2 times the load weight of every lane (lanes).
-      real(wp), intent(in) :: a(lockstep_lanes)
-      !> Load vectors (lanes, n).
-      real(wp), intent(in) :: g(lockstep_lanes, stiffness%n)
-      !> dt^2.
-      real(wp), intent(in) :: b
-      !> Force term of the tip row (lanes).
-      real(wp), intent(in) :: spring(lockstep_lanes)
-      !> S u (lanes, n).
-      real(wp), intent(out) :: su(lockstep_lanes, stiffness%n)
-      !> Right-hand sides (lanes, n).
-      real(wp), intent(out) :: rhs(lockstep_lanes, stiffness%n)
+   !> The interior rows of lockstep_matvec_rhs with period-2 coefficients `rows`.
+   pure subroutine matvec_rhs_periodic_rows(n, rows, x, a, g, b, y, rhs)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: rows(2*kd + 1, 2), x(lockstep_lanes, n), a(lockstep_lanes), g(lockstep_lanes, n), b
+      real(wp), intent(inout) :: y(lockstep_lanes, n), rhs(lockstep_lanes, n)
       real(wp) :: p1, p2, p3, p4, p5, p6, p7, q1, q2, q3, q4, q5, q6, q7
-      integer :: j, k, n
-      n = stiffness%n
-      call matvec_rhs_first_rows(stiffness, u, a, g, b, su, rhs)
+      integer :: j, k
       p1 = rows(1, 1); p2 = rows(2, 1); p3 = rows(3, 1); p4 = rows(4, 1); p5 = rows(5, 1); p6 = rows(6, 1)
       p7 = rows(7, 1)
       q1 = rows(1, 2); q2 = rows(2, 2); q3 = rows(3, 2); q4 = rows(4, 2); q5 = rows(5, 2); q6 = rows(6, 2)
       q7 = rows(7, 2)
-      associate (x => u, y => su)
-         ! n - 2 kd interior rows: n = 2J and 2 kd are even, so whole pairs
-         do j = kd + 1, n - kd - 1, 2
+      ! n - 2 kd interior rows: n = 2J and 2 kd are even, so whole pairs
+      do j = kd + 1, n - kd - 1, 2
 !GCC$ ivdep
 !GCC$ vector
-            do k = 1, lockstep_lanes
-               y(k, j) = p1*x(k, j - 3) + p2*x(k, j - 2) + p3*x(k, j - 1) + p4*x(k, j) + p5*x(k, j + 1) &
-                  & + p6*x(k, j + 2) + p7*x(k, j + 3)
-               rhs(k, j) = a(k)*g(k, j) - b*y(k, j)
-               y(k, j + 1) = q1*x(k, j - 2) + q2*x(k, j - 1) + q3*x(k, j) + q4*x(k, j + 1) + q5*x(k, j + 2) &
-                  & + q6*x(k, j + 3) + q7*x(k, j + 4)
-               rhs(k, j + 1) = a(k)*g(k, j + 1) - b*y(k, j + 1)
-            end do
+         do k = 1, lockstep_lanes
+            y(k, j) = p1*x(k, j - 3) + p2*x(k, j - 2) + p3*x(k, j - 1) + p4*x(k, j) + p5*x(k, j + 1) &
+               & + p6*x(k, j + 2) + p7*x(k, j + 3)
+            rhs(k, j) = a(k)*g(k, j) - b*y(k, j)
+            y(k, j + 1) = q1*x(k, j - 2) + q2*x(k, j - 1) + q3*x(k, j) + q4*x(k, j + 1) + q5*x(k, j + 2) &
+               & + q6*x(k, j + 3) + q7*x(k, j + 4)
+            rhs(k, j + 1) = a(k)*g(k, j + 1) - b*y(k, j + 1)
          end do
-      end associate
-      call matvec_rhs_last_rows(stiffness, u, a, g, b, spring, su, rhs)
-   end subroutine lockstep_matvec_rhs_periodic
+      end do
+   end subroutine matvec_rhs_periodic_rows
 
    !> Whether the interior rows kd+1 .. n-kd of a band matrix repeat with period 2, and the
    !> coefficients of the first two in the order of a row's products (A(j, j-3), A(j, j-2),
    !> A(j, j-1), A(j, j), A(j, j+1), A(j, j+2), A(j, j+3)): exactly, value for value, so that
-   !> lockstep_matvec_rhs_periodic computes what lockstep_matvec_rhs does.
+   !> lockstep_matvec_rhs computes the same with them as without.
    pure subroutine lockstep_periodic_rows(diagonals, periodic, rows)
       !> Matrix by diagonals (n >= 2 kd + 2).
       type(band_diagonals), intent(in) :: diagonals

@@ -42,7 +42,7 @@ module beamstops_lockstep
    use beamstops_band_solve, only: prepare_solver, prepare_diagonals, energy_dots
    use beamstops_band_solve_lockstep, only: lockstep_forward, lockstep_energy_dots, lockstep_back_edge, &
       & lockstep_back_update, lockstep_matvec, lockstep_dot, lockstep_min_unknowns, lockstep_work_columns, &
-      & lockstep_lanes, lockstep_matvec_rhs, lockstep_matvec_rhs_periodic, lockstep_periodic_rows
+      & lockstep_lanes, lockstep_matvec_rhs, lockstep_periodic_rows
    use beamstops_lockstep_lanes, only: lanes_type, lanes_restart_loads, lanes_next_loads, lanes_begin_step, &
       & lanes_contact, lanes_close
    use beamstops_state, only: state_type
@@ -585,12 +585,7 @@ contains
       pending = .false.
       allocate (lanes(ms%chunks))
       call gather_lanes(scenes, ms, lanes)
-      if (observing) then
-         allocate (watch(ms%chunks))
-         do c = 1, ms%chunks
-            call gather_observers(watch(c), ms%observers, (c - 1)*lockstep_lanes, ms%active(:ms%k))
-         end do
-      end if
+      if (observing) call gather_observers(watch, ms%observers, ms%active(:ms%k))
       load_k = start_lanes_loads(lanes, ms%step + 1, model%dt)
       do step = ms%step, last
          restart = mod(load_k + 1, restart_every) == 0
@@ -599,8 +594,8 @@ contains
          do c = 1, ms%chunks
             call lanes_begin_step(lanes(c), law, model%beta, model%dt2, restart, load_k + 1, model%dt)
             if (ops%periodic) then
-               call lockstep_matvec_rhs_periodic(ops%stiffness, ops%stiffness_rows, ms%u(:, :, c), lanes(c)%coef, &
-                  & ms%g(:, :, c), model%dt2, lanes(c)%spring, ms%su(:, :, c), ms%rhs(:, :, c))
+               call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), lanes(c)%coef, ms%g(:, :, c), model%dt2, &
+                  & lanes(c)%spring, ms%su(:, :, c), ms%rhs(:, :, c), ops%stiffness_rows)
             else
                call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), lanes(c)%coef, ms%g(:, :, c), model%dt2, &
                   & lanes(c)%spring, ms%su(:, :, c), ms%rhs(:, :, c))
@@ -666,11 +661,7 @@ contains
          end if
       end do
       call scatter_lanes(lanes, ms)
-      if (observing) then
-         do c = 1, ms%chunks
-            call scatter_observers(watch(c), ms%observers)
-         end do
-      end if
+      if (observing) call scatter_observers(watch, ms%observers)
       ! S u^{last+1}; it also completes the waiting records, as advance_fused does (one member
       ! at a time, with the one-member products and dot products).
       do c = 1, ms%chunks

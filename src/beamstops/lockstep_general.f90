@@ -72,12 +72,7 @@ contains
       next_record = minval(ms%next_record)
       next_snapshot = minval(ms%next_snapshot)
       observing = any(ms%observers%active)
-      if (observing) then
-         allocate (watch(ms%chunks))
-         do c = 1, ms%chunks
-            call gather_observers(watch(c), ms%observers, (c - 1)*lockstep_lanes, ms%active(:ms%k))
-         end do
-      end if
+      if (observing) call gather_observers(watch, ms%observers, ms%active(:ms%k))
       ms%pending = .false.
       pending = .false.
       ms%u_old_su = 0
@@ -222,11 +217,7 @@ contains
             next_snapshot = minval(ms%next_snapshot)
          end if
       end do
-      if (observing) then
-         do c = 1, ms%chunks
-            call scatter_observers(watch(c), ms%observers)
-         end do
-      end if
+      if (observing) call scatter_observers(watch, ms%observers)
       ! S u^{last+1}; it also completes the waiting records (advance_members)
       do c = 1, ms%chunks
          call lockstep_matvec(ops%stiffness, ms%u(:, :, c), ms%su(:, :, c))

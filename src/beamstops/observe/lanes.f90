@@ -51,40 +51,39 @@ module beamstops_observe_lanes
 
 contains
 
-   !> The lanes of a chunk from its members' observers: lane i holds member first + i when there
-   !> is one (first: the members of the chunks before), live when it runs and observes.
-   subroutine gather_observers(lanes, observers, first, running)
-      !> The chunk's lanes.
-      type(observer_lanes), intent(out) :: lanes
+   !> The lanes of every chunk (lockstep_lanes members each, in order) from the members'
+   !> observers, live for the members that run and observe.
+   subroutine gather_observers(lanes, observers, running)
+      !> The chunks' lanes, one per chunk.
+      type(observer_lanes), allocatable, intent(out) :: lanes(:)
       !> Every member's observer (K).
       type(observer_type), intent(in) :: observers(:)
-      !> Members before the chunk's first.
-      integer, intent(in) :: first
       !> Whether each member runs (K).
       logical, intent(in) :: running(:)
-      integer :: i, k
-      do i = 1, lockstep_lanes
-         k = first + i
-         if (k > size(observers)) exit
-         lanes%member(i) = k
-         lanes%live(i) = running(k) .and. observers(k)%active
-         if (lanes%live(i)) then
-            call take(lanes, i, observers(k))
-         else
-            lanes%t_stop(i) = -huge(1.0_wp)
-         end if
+      integer :: c, i, k
+      allocate (lanes((size(observers) + lockstep_lanes - 1)/lockstep_lanes))
+      do c = 1, size(lanes)
+         do i = 1, lockstep_lanes
+            k = (c - 1)*lockstep_lanes + i
+            if (k > size(observers)) exit
+            lanes(c)%member(i) = k
+            lanes(c)%live(i) = running(k) .and. observers(k)%active
+            if (lanes(c)%live(i)) call take(lanes(c), i, observers(k))
+         end do
       end do
    end subroutine gather_observers
 
    !> The lanes' values back into their members' observers.
    subroutine scatter_observers(lanes, observers)
-      !> The chunk's lanes.
-      type(observer_lanes), intent(in) :: lanes
+      !> The chunks' lanes.
+      type(observer_lanes), intent(in) :: lanes(:)
       !> Every member's observer.
       type(observer_type), intent(inout) :: observers(:)
-      integer :: i
-      do i = 1, lockstep_lanes
-         if (lanes%live(i)) call give(lanes, i, observers(lanes%member(i)))
+      integer :: c, i
+      do c = 1, size(lanes)
+         do i = 1, lockstep_lanes
+            if (lanes(c)%live(i)) call give(lanes(c), i, observers(lanes(c)%member(i)))
+         end do
       end do
    end subroutine scatter_observers
 
