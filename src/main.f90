@@ -706,7 +706,7 @@ contains
    subroutine print_info(scene, model)
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
-      character(len=*), parameter :: f = '(a,t24,es13.6,1x,a)', fi = '(a,t24,i0,1x,a)', fa = '(a,t24,a)'
+      character(len=*), parameter :: f = '(a,t30,es13.6,1x,a)', fi = '(a,t30,i0,1x,a)', fa = '(a,t30,a)'
       integer :: i
       write (output_unit, fa) 'file', path
       write (output_unit, f) '&beam length', scene%length, 'm'
@@ -729,10 +729,15 @@ contains
          & '1/s^2'
       write (output_unit, f) '      restitution', scene%restitution, ''
       write (output_unit, fa) '      mass', trim(merge('redistributed', 'consistent   ', scene%redistributed_mass))
-      if (scene%damping_by_ratio) write (output_unit, '(a,t24,2(es13.6,1x),a,2(1x,i0))') '&damping ratio', &
-         & scene%damping_ratio, 'at modes', scene%damping_modes
-      write (output_unit, f) '      a (C = a M + b S)', model%damping_a, '1/s'
-      write (output_unit, f) '      b', model%damping_b, 's'
+      if (scene%damping_by_ratio) then
+         write (output_unit, '(a,t30,2(es13.6,1x),a,2(1x,i0))') '&damping ratio', scene%damping_ratio, 'at modes', &
+            & scene%damping_modes
+         write (output_unit, f) '      a (C = a M + b S)', model%damping_a, '1/s'
+         write (output_unit, f) '      b', model%damping_b, 's'
+      else
+         write (output_unit, f) '&damping mass_coefficient', model%damping_a, '1/s (a of C = a M + b S)'
+         write (output_unit, f) '      stiffness_coefficient', model%damping_b, 's (b)'
+      end if
       write (output_unit, fi) '&mesh elements', scene%elements, ''
       write (output_unit, fi) '      modes', scene%modes, trim(merge('(a reduced model: r modes)', &
          & '(0: the full model)       ', scene%modes > 0))
@@ -758,7 +763,7 @@ contains
       write (output_unit, f) '      perturbation', scene%perturbation, 'm'
       write (output_unit, fi) '      seed', scene%seed, ''
       if (scene%modes > 0) then
-         write (output_unit, '(a,t24,i0,a,i0,a)') 'unknowns n', model%n, ' of the full model (the run: a reduced '// &
+         write (output_unit, '(a,t30,i0,a,i0,a)') 'unknowns n', model%n, ' of the full model (the run: a reduced '// &
             & 'model of ', scene%modes, ' modes)'
       else
          write (output_unit, fi) 'unknowns n', model%n, ''

@@ -71,8 +71,9 @@ def test_info_prints_limits_without_running(tmp_path: Path) -> None:
     scene = write(tmp_path, "&mesh modes=5 /\n&output record_every=10 /\n&statistics transient=0.05, bins=7 /\n"
                             "&ensemble members=1, seed=9 /\n")
     lines = beamstops("info", scene, cwd=tmp_path).stdout.splitlines()
-    shown = {line[:23].strip(" &"): line[23:].split() for line in lines}
+    shown = {line[:29].strip(" &"): line[29:].split() for line in lines}
     assert shown["modes"][0] == "5" and shown["record_every"][0] == "10" and shown["bins"][0] == "7"
+    assert float(shown["damping mass_coefficient"][0]) == 0 and float(shown["stiffness_coefficient"][0]) == 0
     assert float(shown["transient"][0]) == 0.05 and shown["seed"][0] == "9" and "reduced" in " ".join(shown["unknowns n"])
 
 

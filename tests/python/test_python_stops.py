@@ -125,6 +125,10 @@ def test_program_writes_stops_as_run_does(program: str, tmp_path: Path) -> None:
         assert f["stops/u"].shape == (ran.t.size, 3) and f["stops/u"].chunks is not None
         assert f["stops/reaction"].attrs["units"] == b"N"
         assert list(f["stops/node"][()]) == [10.0, 20.0, 30.0]
+        units = {name: f[name].attrs["units"] for name in ("stops/x", "stops/node", "stops/lower", "stops/upper",
+                                                            "snapshots/x")}
+        assert units == {"stops/x": b"m", "stops/node": b"1", "stops/lower": b"m", "stops/upper": b"m",
+                         "snapshots/x": b"m"}
         assert "lower" not in f.attrs and f.attrs["stops"] == 3
     cpu = [r.attrs.pop("cpu_seconds") for r in (loaded, ran)]
     assert all(c >= 0 for c in cpu) and loaded.attrs == ran.attrs

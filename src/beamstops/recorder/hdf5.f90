@@ -117,7 +117,7 @@ contains
          call create_series(self, '/snapshots/u', 'm', self%nodes, self%order%snap_u)
       end if
       call allocate_stops_buffer(self)
-      call write_vector(self%file, '/snapshots/x', model%x, ok)
+      call write_fixed(self%file, '/snapshots/x', model%x, 'm', ok)
       if (.not. ok) call fail(self, 'cannot write dataset /snapshots/x')
       if (stop_count(scene) > 0) call create_stops(self, scene, model)
       call attribute_text(self, 'status', status_running)
@@ -166,10 +166,10 @@ contains
       logical :: ok(4)
       call h5gcreate_f(self%file, 'stops', group, hdferr)
       call h5gclose_f(group, hdferr)
-      call write_vector(self%file, '/stops/x', model%stops%x, ok(1))
-      call write_vector(self%file, '/stops/node', real(scene%stop_nodes, wp), ok(2))
-      call write_vector(self%file, '/stops/lower', scene%stop_lower, ok(3))
-      call write_vector(self%file, '/stops/upper', scene%stop_upper, ok(4))
+      call write_fixed(self%file, '/stops/x', model%stops%x, 'm', ok(1))
+      call write_fixed(self%file, '/stops/node', real(scene%stop_nodes, wp), '1', ok(2))
+      call write_fixed(self%file, '/stops/lower', scene%stop_lower, 'm', ok(3))
+      call write_fixed(self%file, '/stops/upper', scene%stop_upper, 'm', ok(4))
       if (.not. all(ok)) call fail(self, 'cannot write the datasets of /stops')
       call create_series(self, '/stops/u', 'm', stop_count(scene), self%order%stops_u, matrix=.true.)
       call create_series(self, '/stops/reaction', 'N', stop_count(scene), self%order%stops_reaction, matrix=.true.)
@@ -591,6 +591,23 @@ contains
       call h5sclose_f(space, hdferr)
       call dataset_units(dset, units)
    end subroutine create_series
+
+   !> A whole 1-D dataset of doubles written once (write_vector) with its `units` attribute.
+   subroutine write_fixed(file, path, values, units, ok)
+      integer(hid_t), intent(in) :: file
+      character(len=*), intent(in) :: path, units
+      real(wp), intent(in) :: values(:)
+      logical, intent(out) :: ok
+      integer(hid_t) :: dset
+      integer :: hdferr
+      call write_vector(file, path, values, ok)
+      if (.not. ok) return
+      call h5dopen_f(file, path, dset, hdferr)
+      ok = hdferr == 0
+      if (.not. ok) return
+      call text_attribute_on(dset, 'units', units, ok)
+      call h5dclose_f(dset, hdferr)
+   end subroutine write_fixed
 
    subroutine dataset_units(dset, units)
       integer(hid_t), intent(in) :: dset
