@@ -153,8 +153,57 @@ def make_executor(kind: str = "auto", jobs: Optional[int] = None) -> tuple[Execu
                      else "MPI with one rank (tasks run on rank 0)")
             return MPIPoolExecutor(), where, workers
         workers = jobs or os.cpu_count() or 1
-        return MPIPoolExecutor(max_workers=workers), f"{workers} spawned MPI workers", workers
+        return _spawned(MPIPoolExecutor, workers), f"{workers} spawned MPI workers", workers
     raise ValueError(f"--executor {kind}: allowed: {', '.join(EXECUTORS)}")
+
+
+#: Seconds the spawned MPI workers of ``--executor mpi`` (outside mpiexec) have to answer a first task.
+SPAWN_TIMEOUT = 60.0
+
+_MPIEXEC = "mpiexec -n N python -m mpi4py.futures -m beamstops sweep ..."
+
+
+def _spawned(factory: Any, workers: int) -> Executor:
+    """An MPIPoolExecutor of ``workers`` spawned workers that answered a first task.
+
+    Outside mpiexec the pool spawns its workers (MPI_Comm_spawn) in a thread of its own; when
+    MPI cannot spawn them (Open MPI: "not enough slots"), that thread dies with MPI_ERR_SPAWN and
+    every task waits forever. So a first task is sent before any point: the thread's failure (or
+    no answer within :data:`SPAWN_TIMEOUT` s) is a ValueError naming the documented way instead.
+    """
+    import threading
+
+    failures: list[BaseException] = []
+    previous = threading.excepthook
+
+    def catch(args: Any) -> None:  # the pool's thread: keep its traceback off stderr, report it below
+        if args.thread is not threading.main_thread() and args.exc_value is not None:
+            failures.append(args.exc_value)
+        else:
+            previous(args)
+
+    threading.excepthook = catch
+    pool = factory(max_workers=workers)
+    try:
+        probe = pool.submit(int, 0)
+        deadline = time.monotonic() + SPAWN_TIMEOUT
+        while not failures and not probe.done() and time.monotonic() < deadline:
+            time.sleep(0.05)
+    finally:
+        threading.excepthook = previous
+    error = probe.exception() if probe.done() and not probe.cancelled() else None
+    if probe.done() and not probe.cancelled() and error is None and not failures:
+        return pool
+    try:
+        pool.shutdown(wait=False, cancel_futures=True)
+    except Exception:
+        pass
+    failure = failures[0] if failures else error
+    why = (" ".join(f"{type(failure).__name__}: {failure}".split()) if failure is not None
+           else f"no worker answered within {SPAWN_TIMEOUT:g} s")
+    raise ValueError(f"--executor mpi: MPI could not start {workers} worker{'s' if workers > 1 else ''} from this "
+                     f"process ({why}); run the sweep under MPI instead: `{_MPIEXEC}` (rank 0 runs the sweep, "
+                     "the other N-1 ranks are its workers), or use --executor local")
 
 
 # ---------------------------------------------------------------------- folder
