@@ -110,3 +110,21 @@ def test_workers_that_never_answer_time_out(monkeypatch: pytest.MonkeyPatch) -> 
     with pytest.raises(ValueError, match=r"no worker answered within 0\.3 s.*mpiexec -n N python -m mpi4py\.futures"):
         _in_thread(lambda: runner.make_executor("mpi", 3), seconds=10)
 
+
+def test_the_help_states_the_exit_status_of_a_bad_option(capsys: pytest.CaptureFixture[str],
+                                                         write_spec: Callable[..., Path], tmp_path: Path) -> None:
+    from beamstops import cli
+
+    with pytest.raises(SystemExit) as done:
+        cli.main(["sweep", "--help"])
+    assert done.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "2 a bad command-line option" in text and "1 a bad specification" in text
+    assert "option or folder" not in text
+    spec = write_spec(SPEC)
+    for bad in (["-j", "0"], ["--timeout", "-1"], ["--interval", "0"], ["--executor", "threads"], ["--no-such"]):
+        with pytest.raises(SystemExit) as done:
+            cli.main(["sweep", str(spec), "-o", str(tmp_path / "out"), *bad])
+        assert done.value.code == 2, bad
+    assert not (tmp_path / "out").exists()
+    assert cli.main(["sweep", str(spec), "-o", str(tmp_path / "out"), "--set", "scene.nonsense=1"]) == 1

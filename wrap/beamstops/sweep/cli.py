@@ -17,7 +17,11 @@ Running the same command again resumes: finished points are skipped. A folder ho
 specification only. Summary: DIR/summary.csv (and summary.json); outputs: DIR/points/.
 exit status: 0 every point complete; 3 some point failed (refused, timed out, crashed) or
 diverged (the summary says which; running the same command again retries the failed ones);
-1 a bad specification, option or folder; 130 interrupted.
+1 a bad specification (--set values included), no -o, a folder that cannot be used (another
+specification's, not a sweep's, or locked by a running sweep), no program, or MPI that cannot
+start its workers; 2 a bad command-line option (unknown, or a value
+out of range: -j, --timeout, --interval, --executor), refused before anything is written;
+130 interrupted.
 """
 
 #: Exit status of a sweep in which some point failed (refused, timed out) or diverged, as for
