@@ -209,6 +209,10 @@ def test_a_folder_holds_one_specification(tmp_path: Path, capsys: pytest.Capture
     assert err.startswith(f"beamstops: error: {out}: holds the results of another specification") and "hash" in err
     # the same spec with a --set is another spec too
     assert cli.main(["sweep", str(spec_path), "-o", str(out), "-q", "--set", "scene.elements=5"]) == 1
+    err = capsys.readouterr().err
+    assert f"({os.path.abspath(spec_path)} without --set, hash " in err, err
+    assert f"; {spec_path} with --set scene.elements=5 has hash " in err, err
+    assert "(--set values are part of the specification)" in err, err
     # a folder that is not a sweep's is not used
     (tmp_path / "busy").mkdir()
     (tmp_path / "busy" / "notes.txt").write_text("mine")

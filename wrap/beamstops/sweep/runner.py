@@ -333,9 +333,10 @@ def prepare_folder(spec: Spec, out: Path, program: str) -> tuple[Path, Optional[
         except (OSError, ValueError, KeyError, TypeError):
             raise ValueError(f"{out}: {MANIFEST} is unreadable; this is not a sweep folder to resume") from None
         if old_hash != spec.hash:
-            raise ValueError(f"{out}: holds the results of another specification ({old.get('spec_file')}, "
-                             f"hash {old_hash[:12]}); {spec.path} has hash {spec.hash[:12]}. Use another -o, "
-                             f"or remove {out} to start again")
+            raise ValueError(f"{out}: holds the results of another specification ({old.get('spec_file')}"
+                             f"{_with_sets(old.get('overrides'))}, hash {old_hash[:12]}); {spec.path}"
+                             f"{_with_sets(spec.overrides)} has hash {spec.hash[:12]} (--set values are part of "
+                             f"the specification). Use another -o, or remove {out} to start again")
         from .. import version
 
         if old.get("engine_version") != version() or old.get("program_sha256") != _program_hash(program):
@@ -351,6 +352,13 @@ def prepare_folder(spec: Spec, out: Path, program: str) -> tuple[Path, Optional[
         os.replace(tmp, manifest)
     (out / "points").mkdir(exist_ok=True)
     return out, note
+
+
+def _with_sets(overrides: Any) -> str:
+    """`` with --set A --set B`` for a specification's overrides, `` without --set`` for none."""
+    if not isinstance(overrides, (list, tuple)) or not overrides:
+        return " without --set"
+    return " with " + " ".join(f"--set {item}" for item in overrides)
 
 
 def _task(spec: Spec, point: Any, folder: Path, program: str, timeout: Optional[float]) -> dict[str, Any]:
