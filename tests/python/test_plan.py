@@ -248,3 +248,11 @@ def test_a_plan_whose_check_fails_exits_3(tmp_path: Path, capsys: pytest.Capture
     assert outcome.met
     assert cli.main(["plan", str(scene_file), "--qoi", "tip", "--until", "0.05", "--tol", "1e-3", "--quiet"]) == 0
     assert (tmp_path / "free_plan.nml").exists()
+
+
+def test_a_choice_on_the_coarsest_dt_rung_names_the_next_coarser_value() -> None:
+    loose = plan(FREE, "tip", 5e-2, until=0.08, coarser=0, quiet=True)
+    assert loose.choice is not None and loose.choice.qualifies and loose.choice.model.dt == FREE.dt
+    note = next(n for n in loose.notes if "coarsest Δt rung" in n)
+    assert "(coarser=1 from Python, --coarser 1 on the command line)" in note, note
+    assert "coarser=," not in " ".join(loose.notes)

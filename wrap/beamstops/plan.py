@@ -179,7 +179,8 @@ def plan(scene: Scene, qoi: Union[str, Quantity], tol: Union[str, float], *, unt
             out.notes.append(f"the chosen scene has no snapshots ({exc})")
         out.check = _check(out.choice, runner, meshes, reference_law, tolerance)
     if out.choice is not None and out.choice.qualifies and out.choice.model.dt == dts[0]:
-        out.notes.append("the choice is on the coarsest Δt rung: a coarser Δt may qualify too (coarser=, --coarser)")
+        out.notes.append("the choice is on the coarsest Δt rung: a coarser Δt may qualify too "
+                         f"(coarser={coarser + 1} from Python, --coarser {coarser + 1} on the command line)")
     if out.choice is not None and out.choice.qualifies and (out.choice.model.elements, out.choice.model.modes) == meshes.rungs[0]:
         out.notes.append("the choice is on the coarsest mesh rung")
     refused = {**pilot_runner.refused, **runner.refused}
