@@ -180,6 +180,18 @@ def test_stops_plot(tmp_path: Path) -> None:
         plots.figure(beamstops.run(Scene(t_end=0.01)), "stops")
 
 
+def test_all_has_a_panel_per_stop_along_the_span(tmp_path: Path) -> None:
+    from beamstops import plots
+
+    result = beamstops.run(SUPPORTS.replace(t_end=0.1))
+    titles = [ax.get_title() for ax in plots.figure(result, "all").axes]
+    for stop, node in enumerate((10, 20, 30), start=1):
+        assert any(t.startswith(f"stop {stop}: node {node}, x = ") for t in titles), (stop, titles)
+    # a tip-only run has none
+    bare = [ax.get_title() for ax in plots.figure(beamstops.run(Scene(t_end=0.01)), "all").axes]
+    assert not any(t.startswith("stop ") for t in bare)
+
+
 def test_cli_plot_stops(program: str, tmp_path: Path) -> None:
     SUPPORTS.replace(file="s.h5").to_namelist(tmp_path / "s.nml")
     assert subprocess.run([program, "run", "s.nml"], cwd=tmp_path, capture_output=True, timeout=60).returncode == 0

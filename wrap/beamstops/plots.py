@@ -253,6 +253,8 @@ def _all_figure(result: Result, transient: Optional[float], options: dict[str, A
         lambda ax: plot_phase(result, ax),
         lambda ax: plot_reaction(result, ax),
     ]
+    if missing(result, "stops") is None:  # one panel per stop along the span, as kind 'stops' draws them
+        panels += [lambda ax, i=int(index): plot_stop(result, i, ax) for index in np.argsort(result.stops_x)]
     if missing(result, "pdf", transient) is None:
         panels.append(lambda ax: plot_pdf(result, ax, transient=transient))
     if missing(result, "psd", transient) is None:
