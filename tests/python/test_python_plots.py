@@ -463,3 +463,13 @@ def test_a_resolution_out_of_range_is_refused_by_the_command_line(dpi: str, outp
     assert done.returncode == 2 and "Traceback" not in done.stderr
     assert f"argument --dpi: '{dpi}': allowed: a whole number of dots per inch, 1 ... 2400" in done.stderr
     assert not (tmp_path / "x.png").exists()
+
+
+def test_an_animation_named_without_extension_gets_gif(output: Path, result: beamstops.Result,
+                                                       tmp_path: Path) -> None:
+    done = plot_command(output, "--kind", "animation", "-o", "anim", "--frames", "4", "--dpi", "30", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "anim.gif"
+    assert (tmp_path / "anim.gif").read_bytes()[:6] == b"GIF89a"
+    path = plots.save(result, tmp_path / "beam", kind="animation", dpi=30, frames=4)
+    assert path == tmp_path / "beam.gif" and path.read_bytes()[:6] == b"GIF89a"

@@ -52,7 +52,8 @@ def register_plot(subparsers: argparse._SubParsersAction) -> None:
                                    description="Plot the HDF5 output of `beamstops run` (no display needed).")
     parser.add_argument("file", type=Path, help="HDF5 file written by `beamstops run`")
     parser.add_argument("-o", "--output",
-                        help="image file to write, not a folder; its extension gives the format (none: .png); "
+                        help="image file to write, not a folder; its extension gives the format (none: .png is added, "
+                             ".gif for animation); "
                              "the name written is printed (default: FILE_KIND.png next to FILE; "
                              "FILE_animation.gif for animation)")
     parser.add_argument("--kind", choices=KINDS, default="tip",

@@ -329,19 +329,21 @@ def save(result: Result, path: str | os.PathLike[str], kind: str = "tip", dpi: i
     The format follows the file's extension; a name without one gets matplotlib's default
     format's (``savefig.format``, .png), and the path given back has it. A folder is refused
     (IsADirectoryError). ``kind='animation'`` writes the beam moving between its stops to a .gif
-    (or .mp4 with ffmpeg); its options are ``frames`` (at most this many, default 200) and ``fps``.
+    (or .mp4 with ffmpeg; a name without extension gets .gif); its options are ``frames`` (at most this many, default 200) and ``fps``.
     """
     if names_folder(path):
         raise IsADirectoryError(f"{os.fspath(path)}: is a folder; name the image file to write, e.g. "
                                 f"{Path(path) / ('animation.gif' if kind == 'animation' else kind + '.png')}")
     if isinstance(dpi, bool) or not isinstance(dpi, (int, float)) or not 0 < dpi <= MAX_DPI:
         raise ValueError(f"dpi {dpi!r}: allowed: 0 < dpi <= {MAX_DPI} (dots per inch)")
+    path = Path(path)
     if kind == "animation":
         from .animation import animate
 
-        refuse_data_file(Path(path))
+        if not path.suffix:  # the animation's own default format, as without -o
+            path = path.with_name(f"{path.name}.gif")
+        refuse_data_file(path)
         return animate(result, path, dpi=dpi, **options)
-    path = Path(path)
     if not path.suffix:  # what matplotlib would do, named here so that the caller knows the file
         path = path.with_name(f"{path.name}.{rcParams['savefig.format']}")
     refuse_data_file(path)
