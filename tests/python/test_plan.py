@@ -256,3 +256,18 @@ def test_a_choice_on_the_coarsest_dt_rung_names_the_next_coarser_value() -> None
     note = next(n for n in loose.notes if "coarsest Δt rung" in n)
     assert "(coarser=1 from Python, --coarser 1 on the command line)" in note, note
     assert "coarser=," not in " ".join(loose.notes)
+
+
+def test_the_readme_states_the_mesh_ladder_and_the_check_the_code_uses() -> None:
+    from beamstops import plan_runs
+
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text(encoding="utf-8")
+    section = " ".join(readme.split("\n## Which model do I need?\n", 1)[1].split("\n## ", 1)[0].split())
+    assert "once the engine has that key" not in section and "(next J, Δt/2" not in section
+    assert "`modes` r = 4, 8, 16, 32, 64 below 2J − max(1, number of stops along the span)" in section
+    assert "the next mesh rung — the next J, or for a reduced model the next `modes` rung" in section
+    assert plan_runs.reduced_available()
+    ladder = plan_runs.mesh_ladder(beamstops.Scene(elements=40))
+    assert [r for j, r in ladder.rungs if r] == [4, 8, 16, 32, 64]
+    assert [r for j, r in plan_runs.mesh_ladder(PAPER_SHORT).rungs if r] == [4, 8, 16, 32]  # 32 < 2·19 − 1
+    assert ladder.finer[(40, 64)] == (40, 0) and ladder.finer[(40, 0)] == (80, 0)  # what the check runs
