@@ -199,3 +199,15 @@ def test_cli_plot_stops(program: str, tmp_path: Path) -> None:
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "s_stops.png").is_file()
+
+
+def test_the_readme_example_runs_as_written(monkeypatch: pytest.MonkeyPatch) -> None:
+    readme = (INPUT.parent / "README.md").read_text(encoding="utf-8")
+    section = readme.split("\n## Stops along the span\n", 1)[1].split("\n## ", 1)[0]
+    blocks = section.split("```python\n")[1:]
+    assert blocks, "the section has a Python example"
+    monkeypatch.chdir(INPUT.parent)  # its paths are the repository's
+    names: dict[str, object] = {}
+    exec(blocks[0].split("```", 1)[0], names)  # noqa: S102 (the README's own example)
+    assert names["scene"].nodes == names["same"].nodes == names["tube"].nodes == (10, 20, 30)
+    assert names["result"].stops_u.shape[1] == 3
