@@ -367,7 +367,9 @@ contains
          call say('output', 'checkpoint_every', fmt_int(scene%checkpoint_every), 'checkpoint_every >= 0 (0: none)')
          return
       end if
-      call within('output', 'max_output_gb', scene%max_output_gb, 0.0_wp, 1.0e6_wp); if (allocated(error)) return
+      if (.not. (scene%max_output_gb > 0 .and. scene%max_output_gb <= 1.0e6_wp)) then
+         call say('output', 'max_output_gb', fmt_real(scene%max_output_gb), '0 < max_output_gb <= 1e+06 (GB)'); return
+      end if
       call output_fits(); if (allocated(error)) return
 
    contains
@@ -425,29 +427,53 @@ contains
          end do
       end subroutine span_stops_valid
 
-      !> Refuse an output larger than max_output_gb, saying which record_every (or snapshot_every) fits.
+      !> Refuse an output larger than max_output_gb, saying which record_every (or snapshot_every)
+      !> fits, or, when none does, that the fixed part of the output alone exceeds it.
       subroutine output_fits()
-         real(wp) :: limit, snaps, per_record, row
-         real(wp) :: fits
+         real(wp) :: limit, row, snapshot, records, snaps, fixed
+         integer(ik) :: steps
+         character(len=:), allocatable :: given
          limit = scene%max_output_gb*1.0e9_wp
          if (output_bytes(scene) <= limit) return
-         snaps = 8*real(snapshot_count(scene), wp)*(scene%elements + 2)
-         row = 8*(8 + 2*stop_count(scene))
-         per_record = row*real(steps_of(scene), wp)
-         if (snaps < limit - row) then
-            fits = per_record/(limit - snaps - row)
+         steps = steps_of(scene)
+         row = 8*real(9 + 2*stop_count(scene), wp)
+         snapshot = 8*real(scene%elements + 2, wp)
+         records = row*real(record_count(scene), wp)
+         snaps = snapshot*real(snapshot_count(scene), wp)
+         ! The least any record_every (at most huge(1)) gives, without snapshots.
+         fixed = row*real(steps/huge(1) + 1, wp)
+         given = ' gives '//fmt_real(output_bytes(scene)/1.0e9_wp, 3)//' GB of output, more than max_output_gb = '// &
+            & fmt_real(scene%max_output_gb)
+         if (fixed > limit) then
+            call fatal_error(error, source//': &output max_output_gb = '//fmt_real(scene%max_output_gb)// &
+               & ' is too small: the fixed part of the output alone (its records with the largest record_every, '// &
+               & 'no snapshots) is '//fmt_real(fixed/1.0e9_wp, 3)//' GB; allowed: max_output_gb >= '// &
+               & fmt_real(fixed/1.0e9_wp, 3)//' (raise max_output_gb)')
+         else if (snaps > 0 .and. records + snapshot <= limit) then
+            call fatal_error(error, source//': &output snapshot_every = '//fmt_int(int(scene%snapshot_every, ik))// &
+               & given//'; allowed: snapshot_every >= '//fmt_int(least_every(snapshot, limit - records))// &
+               & ' or snapshot_every = 0 (or raise max_output_gb)')
+         else if (snaps + fixed <= limit) then
             call fatal_error(error, source//': &output record_every = '//fmt_int(int(scene%record_every, ik))// &
-               & ' gives '//fmt_real(output_bytes(scene)/1.0e9_wp, 3)//' GB of output, more than max_output_gb = '// &
-               & fmt_real(scene%max_output_gb)//'; allowed: record_every >= '//fmt_int(ceiling(fits, ik))// &
+               & given//'; allowed: record_every >= '//fmt_int(least_every(row, limit - snaps))// &
                & ' (or raise max_output_gb)')
          else
-            fits = 8*real(steps_of(scene), wp)*(scene%elements + 2)/(limit/2)
-            call fatal_error(error, source//': &output snapshot_every = '//fmt_int(int(scene%snapshot_every, ik))// &
-               & ' gives '//fmt_real(output_bytes(scene)/1.0e9_wp, 3)//' GB of output, more than max_output_gb = '// &
-               & fmt_real(scene%max_output_gb)//'; allowed: snapshot_every >= '//fmt_int(ceiling(fits, ik))// &
+            call fatal_error(error, source//': &output record_every = '//fmt_int(int(scene%record_every, ik))// &
+               & ' and snapshot_every = '//fmt_int(int(scene%snapshot_every, ik))//given// &
+               & '; allowed: snapshot_every = 0 and record_every >= '//fmt_int(least_every(row, limit))// &
                & ' (or raise max_output_gb)')
          end if
       end subroutine output_fits
+
+      !> The least `every` whose steps/every + 1 rows of `bytes` each fit in `room` bytes (room >= bytes).
+      pure function least_every(bytes, room) result(every)
+         real(wp), intent(in) :: bytes, room
+         integer(ik) :: every, rows, steps
+         steps = steps_of(scene)
+         ! rows - 1 = floor(steps/every) must be <= floor(room/bytes) - 1
+         rows = int(min(room/bytes, real(steps + 1, wp)), ik)
+         every = steps/rows + 1
+      end function least_every
 
       subroutine say(group, key, value, allowed)
          character(len=*), intent(in) :: group, key, value, allowed

@@ -39,7 +39,9 @@ contains
          & new_unittest('a file without any group is refused', test_no_group), &
          & new_unittest('an HDF5 file given for the namelist: binary characters, not its start quoted', test_hdf5_signature), &
          & new_unittest('a malformed value names its key and kind', test_malformed_kind), &
-         & new_unittest('canonical text reads back the same scene', test_canonical_round_trip) &
+         & new_unittest('canonical text reads back the same scene', test_canonical_round_trip), &
+         & new_unittest('max_output_gb: 0 refused, the fixed part too big named, no snapshots suggested', &
+         & test_max_output_gb) &
          & ]
    end subroutine collect_namelist
 
@@ -386,4 +388,32 @@ contains
       end do
       call check(error, first%output_file == 'it''s.h5', 'quotes in texts survive')
    end subroutine test_canonical_round_trip
+
+   !> max_output_gb = 0 was accepted (and refused every run naming snapshot_every, with an
+   !> overflowed bound); 1e-9 suggested turning snapshots on.
+   subroutine test_max_output_gb(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('gb0.nml', [character(len=ll) :: '&output max_output_gb = 0 /'], &
+         & [character(len=48) :: '&output max_output_gb = 0 is out of range', '0 < max_output_gb <= 1e+06'], error)
+      if (allocated(error)) return
+      call expect_error('gb_tiny.nml', [character(len=ll) :: '&output max_output_gb = 1e-9 /'], &
+         & [character(len=48) :: '&output max_output_gb = 1e-09', 'the fixed part of the output alone', &
+         & '7.2e-08 GB', 'raise max_output_gb'], error)
+      if (allocated(error)) return
+      call expect_error('gb_records.nml', [character(len=ll) :: '&output max_output_gb = 1e-5 /'], &
+         & [character(len=48) :: '&output record_every = 1', 'record_every >= 290'], error)
+      if (allocated(error)) return
+      call expect_error('gb_snapshots.nml', [character(len=ll) :: '&output max_output_gb = 0.003, snapshot_every = 1 /'], &
+         & [character(len=48) :: '&output snapshot_every = 1', 'snapshot_every = 0'], error)
+      if (allocated(error)) return
+      call expect_error('gb_both.nml', [character(len=ll) :: '&output max_output_gb = 1e-4, snapshot_every = 1 /'], &
+         & [character(len=48) :: 'snapshot_every = 0 and record_every >= 29'], error)
+   end subroutine test_max_output_gb
+
+
+
+
+
+
+
 end module test_namelist
