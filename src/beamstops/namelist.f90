@@ -157,7 +157,7 @@ contains
       lower = unset; upper = unset; nodes = unset_node; x = unset
       law = 'signorini'; stiffness = unset; stiffness_per_mass = unset
       restitution = scene%restitution; mass = 'consistent'
-      mass_coefficient = unset; stiffness_coefficient = unset; ratio = unset; modes = scene%damping_modes
+      mass_coefficient = unset; stiffness_coefficient = unset; ratio = unset; modes = unset_node
       enabled = scene%statistics; transient = scene%transient; batches = scene%batches; bins = scene%bins
       rest_time = scene%rest_time; histogram_lower = unset; histogram_upper = unset
       members = scene%members; perturbation = scene%perturbation; seed = scene%seed
@@ -191,6 +191,18 @@ contains
       if (scene%law < 0) then
          call fatal_error(error, source//": &stops law = '"//trim(law)//"' is out of range; allowed: "// &
             & "'signorini', 'compliance' or 'none'")
+         return
+      end if
+      if (scene%law /= law_compliance .and. (stiffness /= unset .or. stiffness_per_mass /= unset)) then
+         if (stiffness /= unset) then
+            call fatal_error(error, source//': &stops stiffness = '//fmt_real(stiffness)//' is out of range for '// &
+               & "law = '"//trim(law)//"'; allowed: stiffness only with law = 'compliance' (the spring of the "// &
+               & 'compliance law; other laws have none)')
+         else
+            call fatal_error(error, source//': &stops stiffness_per_mass = '//fmt_real(stiffness_per_mass)// &
+               & " is out of range for law = '"//trim(law)//"'; allowed: stiffness_per_mass only with law = "// &
+               & "'compliance' (the spring of the compliance law; other laws have none)")
+         end if
          return
       end if
       if (scene%law == law_compliance) then
@@ -276,6 +288,12 @@ contains
       if (allocated(error)) return
       call validate_ensemble(scene%members, source, error)
       if (allocated(error)) return
+      if (scene%members > 1 .and. .not. scene%statistics) then
+         call fatal_error(error, source//': &ensemble members = '//itoa(scene%members)//' with &statistics '// &
+            & 'enabled = .false. is out of range; allowed: members = 1 when enabled = .false., or enabled = '// &
+            & '.true. (an ensemble gives nothing but its statistics, in /ensemble)')
+         return
+      end if
       call validate_reduced(scene, 2*scene%elements, stop_unknowns(scene), source, error)
       if (allocated(error)) return
       if (scene%modes > 0 .and. scene%members > 1) then
@@ -320,6 +338,21 @@ contains
 
       !> &damping: the coefficients a and b, or the ratios (one value: both) at `modes`; not both.
       subroutine damping_forms()
+         if (modes(1) /= unset_node .or. modes(2) /= unset_node) then
+            if (modes(1) == unset_node .or. modes(2) == unset_node) then
+               call fatal_error(error, source//': &damping modes = '//itoa(maxval(modes))//' (one value) is out of '// &
+                  & 'range; allowed: modes = i, j, two distinct mode numbers (1 <= mode <= 2*elements)')
+               return
+            end if
+            if (ratio(1) == unset .and. ratio(2) == unset) then
+               call fatal_error(error, source//': &damping modes = '//itoa(modes(1))//', '//itoa(modes(2))// &
+                  & ' is given without ratio; allowed: modes only with ratio (the modes at which the damping '// &
+                  & 'ratios are given)')
+               return
+            end if
+         else
+            modes = scene%damping_modes
+         end if
          if (ratio(1) == unset) then
             if (ratio(2) /= unset) then
                call fatal_error(error, source//': &damping ratio(2) is given but ratio(1) is not; allowed: '// &

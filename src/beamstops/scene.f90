@@ -263,7 +263,8 @@ contains
          call list%add_real('damping', 'mass_coefficient', scene%damping_mass)
          call list%add_real('damping', 'stiffness_coefficient', scene%damping_stiffness)
       end if
-      call list%add_int('damping', 'modes', 0_ik, values=int(scene%damping_modes, ik), attribute=.false.)
+      if (scene%damping_by_ratio) call list%add_int('damping', 'modes', 0_ik, values=int(scene%damping_modes, ik), &
+         & attribute=.false.)
       call list%add_logical('statistics', 'enabled', scene%statistics)
       call list%add_real('statistics', 'transient', scene%transient)
       call list%add_int('statistics', 'batches', int(scene%batches, ik))

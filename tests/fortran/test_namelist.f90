@@ -41,7 +41,10 @@ contains
          & new_unittest('a malformed value names its key and kind', test_malformed_kind), &
          & new_unittest('canonical text reads back the same scene', test_canonical_round_trip), &
          & new_unittest('max_output_gb: 0 refused, the fixed part too big named, no snapshots suggested', &
-         & test_max_output_gb) &
+         & test_max_output_gb), &
+         & new_unittest('a spring with a law other than compliance is refused', test_spring_other_law), &
+         & new_unittest('&damping modes: one value, or without ratio, is refused', test_damping_modes), &
+         & new_unittest('an ensemble without statistics is refused', test_ensemble_without_statistics) &
          & ]
    end subroutine collect_namelist
 
@@ -410,8 +413,32 @@ contains
          & [character(len=48) :: 'snapshot_every = 0 and record_every >= 29'], error)
    end subroutine test_max_output_gb
 
+   !> A spring given with law 'signorini' or 'none' was dropped silently.
+   subroutine test_spring_other_law(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('spring.nml', [character(len=ll) :: '&stops stiffness = 1e5 /'], &
+         & [character(len=48) :: '&stops stiffness = 100000', 'law = ''signorini''', 'law = ''compliance'''], error)
+      if (allocated(error)) return
+      call expect_error('spring.nml', [character(len=ll) :: '&stops law = ''none'', stiffness_per_mass = 1e5 /'], &
+         & [character(len=48) :: '&stops stiffness_per_mass = 100000', 'law = ''none'''], error)
+   end subroutine test_spring_other_law
 
+   !> modes = 2 became (2, 2); modes without ratio did nothing.
+   subroutine test_damping_modes(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('modes.nml', [character(len=ll) :: '&damping ratio = 0.01, modes = 2 /'], &
+         & [character(len=48) :: '&damping modes = 2 (one value)', 'two distinct mode numbers'], error)
+      if (allocated(error)) return
+      call expect_error('modes.nml', [character(len=ll) :: '&damping modes = 2, 3 /'], &
+         & [character(len=48) :: '&damping modes = 2, 3 is given without ratio', 'modes only with ratio'], error)
+   end subroutine test_damping_modes
 
+   !> members = 3 with the statistics off ran three members and wrote no /ensemble.
+   subroutine test_ensemble_without_statistics(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('ensemble.nml', [character(len=ll) :: '&ensemble members = 3 /', '&statistics enabled = .false. /'], &
+         & [character(len=48) :: '&ensemble members = 3', 'enabled = .false.', 'members = 1'], error)
+   end subroutine test_ensemble_without_statistics
 
 
 

@@ -219,6 +219,12 @@ class Scene:
             for derived in ROUTES[route]:
                 values.pop(derived, None)
         values.update(changes)
+        # Keys the engine refuses where they would do nothing: a spring without the compliance
+        # law, &damping modes without ratio (unless the change gives them itself).
+        if values.get("law") != "compliance" and not {"stiffness", "stiffness_per_mass"} & set(changes):
+            values.pop("stiffness_per_mass", None)
+        if not values.get("ratio") and "damping_modes" not in changes:
+            values.pop("damping_modes", None)
         return Scene.from_text(_namelist(values), _source)
 
     # ------------------------------------------------------------------ output
