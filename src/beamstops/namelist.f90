@@ -426,25 +426,51 @@ contains
       subroutine malformed_key(g, stat, msg)
          integer, intent(in) :: g, stat
          character(len=*), intent(in) :: msg
-         character(len=:), allocatable :: body, key
+         character(len=:), allocatable :: body, key, value
          integer, allocatable :: starts(:)
-         integer :: i, one_stat, last
+         integer :: i, one_stat, last, capacity, count
          character(len=512) :: one_msg
          body = group_body(cleaned, trim(group_names(g)))
          starts = assignment_starts(body)
          do i = 1, size(starts)
             last = len(body)
             if (i < size(starts)) last = starts(i + 1) - 1
+            key = key_at(body, starts(i))
+            value = body(starts(i):last)
+            value = value(index(value, '=') + 1:)
+            ! More values than a list key holds: out of range, not malformed.
+            capacity = 0
+            if (g == 3 .and. (key == 'lower' .or. key == 'upper' .or. key == 'nodes' .or. key == 'x')) capacity = max_stops
+            if (g == 4 .and. (key == 'ratio' .or. key == 'modes')) capacity = 2
+            if (capacity > 0) then
+               count = value_count(value)
+               if (count > capacity) then
+                  if (capacity == max_stops) then
+                     call fatal_error(error, source//': &'//trim(group_names(g))//' '//key//' has '//itoa(count)// &
+                        & ' values, out of range; allowed: at most '//itoa(max_stops)//' stops (one value per stop)')
+                  else
+                     call fatal_error(error, source//': &'//trim(group_names(g))//' '//key//' has '//itoa(count)// &
+                        & ' values, out of range; allowed: at most two values')
+                  end if
+                  return
+               end if
+            end if
+            ! A logical is T or F, with an optional leading dot (gfortran reads `3,` alone without a word).
+            if (value_kind(key) == '.true. or .false.' .and. .not. logical_text(value)) then
+               call fatal_error(error, source//': &'//trim(group_names(g))//' '// &
+                  & assignment_text(body(starts(i):min(last, starts(i) + 120)))//' is malformed; allowed: '//key// &
+                  & ' = '//value_kind(key))
+               return
+            end if
             call read_group(g, '&'//trim(group_names(g))//' '//body(starts(i):last)//' /', one_stat, one_msg)
             ! (gfortran may read alone what it refuses in the group: then a lone assignment is the culprit)
             if (one_stat == 0 .and. size(starts) > 1) cycle
-            key = key_at(body, starts(i))
             if (index(one_msg, 'Cannot match namelist object name') > 0 .and. .not. known_key(g, key)) then
                call fatal_error(error, source//': &'//trim(group_names(g))//': unknown key '//key// &
                   & '; keys of &'//trim(group_names(g))//': '//trim(group_keys(g)))
             else
                call fatal_error(error, source//': &'//trim(group_names(g))//' '// &
-                  & trim(adjustl(body(starts(i):min(last, starts(i) + 120))))//' is malformed; allowed: '//key// &
+                  & assignment_text(body(starts(i):min(last, starts(i) + 120)))//' is malformed; allowed: '//key// &
                   & ' = '//value_kind(key))
             end if
             return
@@ -464,6 +490,59 @@ contains
          if (text(:len(bom)) == bom) rest = text(len(bom) + 1:)
       end if
    end function without_bom
+
+   !> An assignment of a group's body as shown in a message: without the blanks and the comma after it.
+   pure function assignment_text(text) result(shown)
+      character(len=*), intent(in) :: text
+      character(len=:), allocatable :: shown
+      shown = trim(adjustl(text))
+      do while (len(shown) > 0)
+         if (shown(len(shown):) /= ',') exit
+         shown = trim(shown(:len(shown) - 1))
+      end do
+   end function assignment_text
+
+   !> Number of values in the value text of a list key: items separated by commas or blanks,
+   !> `r*value` counting r.
+   function value_count(text) result(count)
+      character(len=*), intent(in) :: text
+      integer :: count
+      integer :: i, first, star, r, stat
+      character(len=:), allocatable :: item
+      count = 0
+      i = 1
+      do while (i <= len(text))
+         if (scan(text(i:i), ', ') > 0) then
+            i = i + 1
+            cycle
+         end if
+         first = i
+         do while (i <= len(text))
+            if (scan(text(i:i), ', ') > 0) exit
+            i = i + 1
+         end do
+         item = text(first:i - 1)
+         star = index(item, '*')
+         r = 1
+         if (star > 1) then
+            read (item(:star - 1), *, iostat=stat) r
+            if (stat /= 0 .or. r < 1) r = 1
+         end if
+         count = count + r
+      end do
+   end function value_count
+
+   !> Whether the value text of a logical key starts as a logical does: T or F, after an optional dot.
+   pure logical function logical_text(text)
+      character(len=*), intent(in) :: text
+      character(len=:), allocatable :: v
+      v = adjustl(text)
+      if (len_trim(v) > 0) then
+         if (v(1:1) == '.') v = v(2:)
+      end if
+      logical_text = .false.
+      if (len(v) > 0) logical_text = scan(v(1:1), 'tTfF') > 0
+   end function logical_text
 
    !> The key (lower case) that starts at position `start` of a group's body.
    function key_at(body, start) result(key)
@@ -613,7 +692,7 @@ contains
       integer, intent(in) :: nodes(:)
       type(scene_type), intent(inout) :: scene
       type(error_type), allocatable, intent(out) :: error
-      integer :: n_lower, n_upper, n_nodes, n_x, m, i, node
+      integer :: n_lower, n_upper, n_nodes, n_x, m, i, j, node
       real(wp) :: h, at
       n_lower = given(lower == unset, 'lower'); if (allocated(error)) return
       n_upper = given(upper == unset, 'upper'); if (allocated(error)) return
@@ -658,6 +737,13 @@ contains
                & 'allowed: x = i*length/elements to 1e-9*length (length = '//fmt_real(scene%length)// &
                & ', elements = '//itoa(scene%elements)//'); the nearest nodes are '//node_text(node)//' and '// &
                & node_text(node + 1))
+            return
+         end if
+         if (any(scene%stop_nodes(:i - 1) == node)) then
+            j = findloc(scene%stop_nodes(:i - 1), node, dim=1)
+            call fatal_error(error, path//': &stops x('//itoa(i)//') = '//fmt_real(x(i))//' is out of range; '// &
+               & 'allowed: each stop at its own node (x('//itoa(i)//') and x('//itoa(j)//') = '//fmt_real(x(j))// &
+               & ' are both node '//node_text(node)//')')
             return
          end if
          scene%stop_nodes(i) = node
@@ -847,6 +933,12 @@ contains
                   i = j
                   cycle
                end if
+               if (current > 0) then
+                  call fatal_error(error, source//': line '//itoa(line_no)//': group &'// &
+                     & trim(group_names(current))//' is not closed by / before &'//name// &
+                     & '; allowed: each group ends with / (e.g. `&time dt = 1e-5 /`)')
+                  return
+               end if
                g = group_index(name)
                if (g == 0) then
                   call fatal_error(error, source//': line '//itoa(line_no)//': unknown group &'//name// &
@@ -875,6 +967,11 @@ contains
          if (i > len_trim(line)) cleaned = cleaned//trim(line)//' '
          if (current > 0) call append_text(current, ' ')
       end do
+      if (current > 0) then
+         call fatal_error(error, source//': group &'//trim(group_names(current))//' is not closed by / '// &
+            & '(the text ends inside it); allowed: each group ends with / (e.g. `&time dt = 1e-5 /`)')
+         return
+      end if
       if (.not. any(present)) then
          call fatal_error(error, source//': no namelist group; allowed: groups '//all_groups()// &
             & ' (e.g. `&time dt = 1e-5 /`), each at most once, and comments after !')

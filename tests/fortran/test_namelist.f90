@@ -44,7 +44,11 @@ contains
          & test_max_output_gb), &
          & new_unittest('a spring with a law other than compliance is refused', test_spring_other_law), &
          & new_unittest('&damping modes: one value, or without ratio, is refused', test_damping_modes), &
-         & new_unittest('an ensemble without statistics is refused', test_ensemble_without_statistics) &
+         & new_unittest('an ensemble without statistics is refused', test_ensemble_without_statistics), &
+         & new_unittest('two x at one node are told in x', test_x_twice), &
+         & new_unittest('a bad logical followed by other keys names the key', test_bad_logical), &
+         & new_unittest('a group not closed by / is told so', test_unclosed_group), &
+         & new_unittest('more values than a list holds are out of range', test_too_many_values) &
          & ]
    end subroutine collect_namelist
 
@@ -440,7 +444,41 @@ contains
          & [character(len=48) :: '&ensemble members = 3', 'enabled = .false.', 'members = 1'], error)
    end subroutine test_ensemble_without_statistics
 
+   !> x = 0.079, 0.079 was told as nodes(2) = 1, a key the file does not hold.
+   subroutine test_x_twice(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('x.nml', [character(len=ll) :: '&stops x = 0.079, 0.079 /'], &
+         & [character(len=48) :: '&stops x(2) = 0.079 is out of range', 'each stop at its own node', 'node 1'], error)
+   end subroutine test_x_twice
 
+   !> allow_unstable = 3 followed by another key gave gfortran's 'Bad repeat count'.
+   subroutine test_bad_logical(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('logical.nml', [character(len=ll) :: '&time allow_unstable = 3, dt = 1e-5 /'], &
+         & [character(len=64) :: '&time allow_unstable = 3 is malformed', 'allowed: allow_unstable = .true. or .false.'], &
+         & error)
+      if (allocated(error)) return
+      call expect_error('logical.nml', [character(len=ll) :: '&statistics enabled = 2 bins = 3 /'], &
+         & [character(len=64) :: '&statistics enabled = 2 is malformed', 'allowed: enabled = .true. or .false.'], error)
+   end subroutine test_bad_logical
 
+   !> A group without its / at the end of the file was told as a malformed value.
+   subroutine test_unclosed_group(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('open.nml', [character(len=ll) :: '&time t_end=0.01'], &
+         & [character(len=48) :: 'group &time is not closed by /'], error)
+      if (allocated(error)) return
+      call expect_error('open.nml', [character(len=ll) :: '&time t_end=0.01', '&mesh elements = 3 /'], &
+         & [character(len=48) :: 'line 2', 'group &time is not closed by / before &mesh'], error)
+   end subroutine test_unclosed_group
 
+   !> 1001 stops were told as a malformed value.
+   subroutine test_too_many_values(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_error('many.nml', [character(len=ll) :: '&stops nodes = 1001*19, lower = -0.01, upper = 0.01 /'], &
+         & [character(len=64) :: '&stops nodes has 1001 values, out of range', 'at most 1000 stops'], error)
+      if (allocated(error)) return
+      call expect_error('many.nml', [character(len=ll) :: '&damping ratio = 0.1, 0.2, 0.3 /'], &
+         & [character(len=64) :: '&damping ratio has 3 values, out of range', 'at most two values'], error)
+   end subroutine test_too_many_values
 end module test_namelist
