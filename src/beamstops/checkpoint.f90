@@ -6,7 +6,7 @@ module beamstops_checkpoint
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
    use beamstops_scene, only: scene_type, scene_table, stop_count
-   use beamstops_attributes, only: attribute_list, kind_real, kind_text
+   use beamstops_attributes, only: attribute_list, kind_real, kind_text, namelist_text
    use beamstops_model, only: model_type
    use beamstops_state, only: state_type
    use beamstops_loop_scalars, only: n_loop_scalars, loop_scalars_vector, restore_loop_scalars
@@ -18,6 +18,7 @@ module beamstops_checkpoint
    public :: write_checkpoint, read_checkpoint, checkpoint_path, scene_signature, is_checkpoint
    ! (the reduced model's checkpoints, beamstops_reduced_checkpoint, share the file's frame)
    public :: create_checkpoint, commit_checkpoint, open_checkpoint, close_checkpoint, write_observer, read_observer
+   public :: write_scene_text, signature_text
 
 contains
 
@@ -53,6 +54,114 @@ contains
          end associate
       end do
    end function scene_signature
+
+   !> The keys of a scene that a restart must find unchanged (those of scene_signature), as
+   !> namelist text: one `key = value` a line under its `&group` line.
+   function signature_text(scene) result(text)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: text
+      type(attribute_list) :: table
+      integer :: i
+      table = scene_table(scene)
+      text = namelist_text(table, [(table%items(i)%signature, i=1, table%count)])
+   end function signature_text
+
+   !> Write the scene's signature_text to a checkpoint (datasets `scene_text_length` and
+   !> `scene_text`, its character codes), so that a restart of another scene names the keys changed.
+   subroutine write_scene_text(file, scene, ok)
+      !> The checkpoint's temporary file (create_checkpoint).
+      integer(hid_t), intent(in) :: file
+      !> Scene of the run.
+      type(scene_type), intent(in) :: scene
+      !> Whether the writes succeeded.
+      logical, intent(out) :: ok
+      character(len=:), allocatable :: text
+      integer :: j
+      text = signature_text(scene)
+      call write_vector(file, 'scene_text_length', [real(len(text), wp)], ok)
+      if (ok) call write_vector(file, 'scene_text', [(real(iachar(text(j:j)), wp), j=1, len(text))], ok)
+   end subroutine write_scene_text
+
+   !> The keys whose values differ between the scene text of a checkpoint (write_scene_text) and
+   !> `scene`, as `&group key = old in the checkpoint, new here; ...`; '' when the checkpoint has
+   !> no scene text (written by an earlier version) or the same one.
+   function changed_keys(file, scene) result(changed)
+      integer(hid_t), intent(in) :: file
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: changed
+      character(len=:), allocatable :: old, new
+      character(len=:), allocatable :: old_keys(:), old_values(:), new_keys(:), new_values(:)
+      real(wp) :: length(1)
+      real(wp), allocatable :: codes(:)
+      logical :: ok
+      integer :: i, j
+      changed = ''
+      call read_vector(file, 'scene_text_length', length, ok)
+      if (.not. ok) return
+      if (.not. (length(1) >= 0 .and. length(1) < 1.0e8_wp)) return
+      allocate (codes(nint(length(1))))
+      call read_vector(file, 'scene_text', codes, ok)
+      if (.not. ok) return
+      if (any(codes < 0 .or. codes > 127)) return
+      allocate (character(len=size(codes)) :: old)
+      do i = 1, size(codes)
+         old(i:i) = achar(nint(codes(i)))
+      end do
+      new = signature_text(scene)
+      if (old == new) return
+      call key_lines(old, old_keys, old_values)
+      call key_lines(new, new_keys, new_values)
+      do i = 1, size(new_keys)
+         j = findloc(old_keys, new_keys(i), dim=1)
+         if (j == 0) then
+            call add(trim(new_keys(i))//' = '//trim(new_values(i))//' here, not in the checkpoint')
+         else if (old_values(j) /= new_values(i)) then
+            call add(trim(new_keys(i))//' = '//trim(old_values(j))//' in the checkpoint, '//trim(new_values(i))// &
+               & ' here')
+         end if
+      end do
+      do j = 1, size(old_keys)
+         if (findloc(new_keys, old_keys(j), dim=1) == 0) &
+            & call add(trim(old_keys(j))//' = '//trim(old_values(j))//' in the checkpoint, not here')
+      end do
+
+   contains
+
+      subroutine add(piece)
+         character(len=*), intent(in) :: piece
+         if (len(changed) > 0) changed = changed//'; '
+         changed = changed//piece
+      end subroutine add
+   end function changed_keys
+
+   !> The `&group key` and value of each `key = value` line of a namelist_text.
+   subroutine key_lines(text, keys, values)
+      character(len=*), intent(in) :: text
+      character(len=:), allocatable, intent(out) :: keys(:), values(:)
+      character(len=:), allocatable :: line, group
+      integer :: first, last, n, eq, width
+      width = max(1, len(text))
+      allocate (character(len=width) :: keys(0), values(0))
+      group = ''
+      first = 1
+      n = 0
+      do while (first <= len(text))
+         last = index(text(first:), new_line('a'))
+         if (last == 0) last = len(text) - first + 2
+         line = text(first:first + last - 2)
+         first = first + last
+         if (len(line) == 0) cycle
+         if (line(1:1) == '&') then
+            group = trim(line)
+            cycle
+         end if
+         eq = index(line, ' = ')
+         if (eq == 0) cycle
+         keys = [character(len=width) :: keys, group//' '//trim(adjustl(line(:eq - 1)))]
+         values = [character(len=width) :: values, line(eq + 3:)]
+      end do
+   end subroutine key_lines
 
    !> Whether `path` is a checkpoint file (HDF5 holding a scene signature), so that it may be
    !> replaced or removed.
@@ -92,6 +201,7 @@ contains
       call create_checkpoint(path, file, error)
       if (allocated(error)) return
       call write_vector(file, 'signature', scene_signature(scene), ok(1))
+      if (ok(1)) call write_scene_text(file, scene, ok(1))
       call write_vector(file, 'scalars', loop_scalars_vector(state%loop_scalars_type, records, snapshots), ok(2))
       call write_vector(file, 'u', state%u, ok(3))
       call write_vector(file, 'd', state%d, ok(4))
@@ -210,7 +320,14 @@ contains
       !> Set when the checkpoint cannot be used.
       type(error_type), allocatable, intent(out) :: error
       integer :: hdferr
+      character(len=:), allocatable :: changed
+      changed = changed_keys(file, scene)
       call h5fclose_f(file, hdferr)
+      if (len(changed) > 0) then
+         call fatal_error(error, path//': the checkpoint belongs to another scene: '//changed//'; allowed: the '// &
+            & 'same namelist values as the interrupted run (or run without --restart)')
+         return
+      end if
       if (.not. ok) then
          call fatal_error(error, path//': the checkpoint is damaged or of another mesh')
          return

@@ -10,7 +10,7 @@ module beamstops_reduced_checkpoint
    use beamstops_error, only: error_type
    use beamstops_scene, only: scene_type, stop_count
    use beamstops_checkpoint, only: scene_signature, create_checkpoint, commit_checkpoint, open_checkpoint, &
-      & close_checkpoint, write_observer, read_observer
+      & close_checkpoint, write_observer, read_observer, write_scene_text
    use beamstops_loop_scalars, only: n_loop_scalars, loop_scalars_vector, restore_loop_scalars
    use beamstops_recorder_hdf5_vector, only: write_vector, read_vector
    use beamstops_reduced, only: reduced_model_type
@@ -41,6 +41,7 @@ contains
       call create_checkpoint(path, file, error)
       if (allocated(error)) return
       call write_vector(file, 'signature', scene_signature(scene), ok(1))
+      if (ok(1)) call write_scene_text(file, scene, ok(1))
       call write_vector(file, 'scalars', [loop_scalars_vector(state%loop_scalars_type, records, snapshots), &
          & state%damped], ok(2))
       call write_vector(file, 'q', state%q, ok(3))

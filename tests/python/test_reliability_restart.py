@@ -165,6 +165,8 @@ def test_restart_refuses_a_changed_scene(tmp_path: Path) -> None:
     done = run("run", scene, "--restart", cwd=tmp_path)
     assert done.returncode == 1
     assert "another scene" in done.stderr and done.stderr.count("\n") == 1
+    # the keys changed are named, with both values
+    assert "&time dt = 1e-06 in the checkpoint, 2e-06 here" in done.stderr, done.stderr
 
 
 def test_restart_without_checkpoint_starts_over(tmp_path: Path) -> None:
