@@ -455,6 +455,7 @@ contains
                   return
                end if
             end if
+            call read_group(g, '&'//trim(group_names(g))//' '//body(starts(i):last)//' /', one_stat, one_msg)
             ! A logical is T or F, with an optional leading dot (gfortran reads `3,` alone without a word).
             if (value_kind(key) == '.true. or .false.' .and. .not. logical_text(value)) then
                call fatal_error(error, source//': &'//trim(group_names(g))//' '// &
@@ -462,7 +463,6 @@ contains
                   & ' = '//value_kind(key))
                return
             end if
-            call read_group(g, '&'//trim(group_names(g))//' '//body(starts(i):last)//' /', one_stat, one_msg)
             ! (gfortran may read alone what it refuses in the group: then a lone assignment is the culprit)
             if (one_stat == 0 .and. size(starts) > 1) cycle
             if (index(one_msg, 'Cannot match namelist object name') > 0 .and. .not. known_key(g, key)) then

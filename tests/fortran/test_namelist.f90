@@ -48,7 +48,8 @@ contains
          & new_unittest('two x at one node are told in x', test_x_twice), &
          & new_unittest('a bad logical followed by other keys names the key', test_bad_logical), &
          & new_unittest('a group not closed by / is told so', test_unclosed_group), &
-         & new_unittest('more values than a list holds are out of range', test_too_many_values) &
+         & new_unittest('more values than a list holds are out of range', test_too_many_values), &
+         & new_unittest('a bad value leaves no state: the next text is read whole', test_reader_state_after_bad_logical) &
          & ]
    end subroutine collect_namelist
 
@@ -481,4 +482,30 @@ contains
       call expect_error('many.nml', [character(len=ll) :: '&damping ratio = 0.1, 0.2, 0.3 /'], &
          & [character(len=64) :: '&damping ratio has 3 values, out of range', 'at most two values'], error)
    end subroutine test_too_many_values
+
+   !> A malformed logical left gfortran's reader in a state where the next text's &stops was
+   !> not read: law = 'glue' was then accepted as 'signorini'.
+   subroutine test_reader_state_after_bad_logical(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: bad(4) = [character(len=40) :: '&time allow_unstable = 1 /', &
+         & '&time allow_unstable = 3, dt = 1e-5 /', '&statistics enabled = 2 /', '&mesh elements = 19.5 /']
+      type(scene_type) :: scene
+      type(error_type), allocatable :: failure
+      integer :: i
+      do i = 1, size(bad)
+         call scene_from_text(trim(bad(i)), 'first', scene, failure)
+         call check(error, allocated(failure), 'refused: '//trim(bad(i)))
+         if (allocated(error)) return
+         deallocate (failure)
+         call scene_from_text('&stops law = ''glue'' /', 'second', scene, failure)
+         call check(error, allocated(failure), 'law = ''glue'' refused after '//trim(bad(i)))
+         if (allocated(error)) return
+         deallocate (failure)
+         call scene_from_text('&mesh elements = 7 /', 'third', scene, failure)
+         call check(error, .not. allocated(failure), 'a good text read after '//trim(bad(i)))
+         if (allocated(error)) return
+         call check(error, scene%elements, 7, 'elements read after '//trim(bad(i)))
+         if (allocated(error)) return
+      end do
+   end subroutine test_reader_state_after_bad_logical
 end module test_namelist
