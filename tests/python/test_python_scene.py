@@ -106,7 +106,6 @@ ACCEPTED = [
     '&time load_rule="paper", start="euler" /',
     "&stops law='compliance', stiffness=1e7 /",
     "&stops law='compliance', stiffness_per_mass=1e8 /",
-    "&stops law='signorini', stiffness=1e7 /",
     "&beam youngs_modulus=2e11, density=8e3, outer_diameter=0.01, wall_thickness=5e-4 /\n"
     "&stops law='compliance', stiffness=1e8 /",
     "&beam length=2, k2=300 /",
@@ -141,6 +140,8 @@ REFUSED = [
     ("&stops law='glue' /", ["&stops law", "signorini"]),
     ("&stops law='compliance' /", ["&stops", "stiffness"]),
     ("&stops law='compliance', stiffness=-1 /", ["&stops stiffness", "> 0"]),
+    ("&stops law='signorini', stiffness=1e7 /", ["&stops stiffness = 1e+07", "law = 'compliance'"]),
+    ("&damping modes=1, 3 /", ["&damping modes = 1, 3", "without ratio"]),
     ("&time load_rule=' paper' /", ["&time load_rule"]),
     ("&beam youngs_modulus=2e11 /", ["&beam", "density"]),
     ("&beam k2=1, youngs_modulus=2e11, density=8e3, outer_diameter=0.01, wall_thickness=5e-4 /", ["&beam", "k2"]),
@@ -228,3 +229,17 @@ def test_none_empty_or_control_characters_are_refused(changes: dict, kind: type)
     with pytest.raises(kind, match="scene key"):
         Scene(**changes)
     assert Scene(file=None).file is None and Scene(nodes=()).nodes == ()
+
+
+def test_replace_leaves_out_a_spring_or_modes_the_change_makes_useless() -> None:
+    """The engine refuses a spring without law 'compliance' and &damping modes without ratio:
+    a change of law or of the damping's form must not carry them along."""
+    spring = Scene(law="compliance", stiffness_per_mass=1e8, beta=0.25, dt=5e-6)
+    plain = spring.replace(law="signorini")
+    assert plain.law == "signorini" and "stiffness" not in plain.to_text()
+    assert plain.replace(law="compliance", stiffness_per_mass=1e7).stiffness_per_mass == 1e7
+    ratio = Scene(ratio=(0.01, 0.02), damping_modes=(1, 3))
+    coefficients = ratio.replace(mass_coefficient=0.1)
+    assert coefficients.mass_coefficient == 0.1 and "modes" not in coefficients.groups()["damping"]
+    with pytest.raises(ValueError, match="without ratio"):
+        Scene().replace(damping_modes=(1, 3))
