@@ -113,7 +113,7 @@ contains
       call key_lines(old, old_keys, old_values)
       call key_lines(new, new_keys, new_values)
       do i = 1, size(new_keys)
-         j = findloc(old_keys, new_keys(i), dim=1)
+         j = position(old_keys, new_keys(i))
          if (j == 0) then
             call add(trim(new_keys(i))//' = '//trim(new_values(i))//' here, not in the checkpoint')
          else if (old_values(j) /= new_values(i)) then
@@ -122,7 +122,7 @@ contains
          end if
       end do
       do j = 1, size(old_keys)
-         if (findloc(new_keys, old_keys(j), dim=1) == 0) &
+         if (position(new_keys, old_keys(j)) == 0) &
             & call add(trim(old_keys(j))//' = '//trim(old_values(j))//' in the checkpoint, not here')
       end do
 
@@ -139,29 +139,49 @@ contains
    subroutine key_lines(text, keys, values)
       character(len=*), intent(in) :: text
       character(len=:), allocatable, intent(out) :: keys(:), values(:)
-      character(len=:), allocatable :: line, group
-      integer :: first, last, n, eq, width
-      width = max(1, len(text))
-      allocate (character(len=width) :: keys(0), values(0))
-      group = ''
-      first = 1
+      integer :: pass, n, first, last, eq, group_start, group_end
       n = 0
-      do while (first <= len(text))
-         last = index(text(first:), new_line('a'))
-         if (last == 0) last = len(text) - first + 2
-         line = text(first:first + last - 2)
-         first = first + last
-         if (len(line) == 0) cycle
-         if (line(1:1) == '&') then
-            group = trim(line)
-            cycle
-         end if
-         eq = index(line, ' = ')
-         if (eq == 0) cycle
-         keys = [character(len=width) :: keys, group//' '//trim(adjustl(line(:eq - 1)))]
-         values = [character(len=width) :: values, line(eq + 3:)]
+      do pass = 1, 2
+         if (pass == 2) allocate (character(len=max(1, len(text))) :: keys(n), values(n))
+         n = 0
+         group_start = 1
+         group_end = 0
+         first = 1
+         do while (first <= len(text))
+            last = index(text(first:), new_line('a'))
+            if (last == 0) then
+               last = len(text)
+            else
+               last = first + last - 2
+            end if
+            if (last >= first) then
+               if (text(first:first) == '&') then
+                  group_start = first
+                  group_end = last
+               else
+                  eq = index(text(first:last), ' = ')
+                  if (eq > 0) then
+                     n = n + 1
+                     if (pass == 2) then
+                        keys(n) = text(group_start:group_end)//' '//adjustl(text(first:first + eq - 2))
+                        values(n) = text(first + eq + 2:last)
+                     end if
+                  end if
+               end if
+            end if
+            first = last + 2
+         end do
       end do
    end subroutine key_lines
+
+   !> Index of `item` in `list` (0 when absent).
+   pure integer function position(list, item)
+      character(len=*), intent(in) :: list(:), item
+      do position = 1, size(list)
+         if (list(position) == item) return
+      end do
+      position = 0
+   end function position
 
    !> Whether `path` is a checkpoint file (HDF5 holding a scene signature), so that it may be
    !> replaced or removed.
