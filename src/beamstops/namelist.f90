@@ -397,12 +397,14 @@ contains
       end subroutine read_group
 
       !> A key given twice in group g (`key = ...` both times; the elements of an array, `key(i) =`,
-      !> may each be given once): refused, where gfortran would let the last one win unsaid.
+      !> may each be given once): refused, where gfortran would let the last one win unsaid. And a
+      !> key given no value (`dt = /`, `dt = , beta = 0.5`): refused, where gfortran would keep the
+      !> default unsaid.
       subroutine repeated_key(g)
          integer, intent(in) :: g
          character(len=:), allocatable :: body, key, seen
          integer, allocatable :: starts(:)
-         integer :: i, j
+         integer :: i, j, last
          body = group_body(cleaned, trim(group_names(g)))
          starts = assignment_starts(body)
          seen = ' '
@@ -411,6 +413,13 @@ contains
             j = starts(i) + len(key)
             j = j - 1 + verify(body(j:)//'=', ' ')
             if (body(j:j) /= '=') cycle
+            last = len(body)
+            if (i < size(starts)) last = starts(i + 1) - 1
+            if (verify(body(j + 1:last), ' ,'//new_line('a')//achar(9)) == 0) then
+               call fatal_error(error, source//': &'//trim(group_names(g))//' '//key//' has no value; allowed: '// &
+                  & key//' = '//value_kind(key))
+               return
+            end if
             if (index(seen, ' '//key//' ') > 0) then
                call fatal_error(error, source//': &'//trim(group_names(g))//' '//key// &
                   & ' is given twice; allowed: each key once in a group')

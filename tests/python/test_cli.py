@@ -88,6 +88,8 @@ BAD = [
     ("unknown group", "&beams length=1 /\n", ["&beams", "unknown group"]),
     ("unknown key", "&time dtt=1e-5 /\n", ["&time", "dtt"]),
     ("malformed value", "&time dt=abc /\n", ["&time", "dt=abc"]),
+    ("key without a value", "&time dt= , beta=0.25 /\n", ["&time dt has no value", "allowed: dt = a real number"]),
+    ("key without a value at the end", "&stops upper= /\n", ["&stops upper has no value"]),
     ("repeated group", "&time dt=1e-5 /\n&time dt=2e-5 /\n", ["&time", "twice"]),
     ("negative dt", "&time dt=-1e-5 /\n", ["&time", "dt", "allowed"]),
     ("nan dt", "&time dt=nan /\n", ["&time", "dt", "allowed"]),

@@ -86,7 +86,6 @@ def test_shipped_inputs_read_as_the_program_reads_them(name: str, tmp_path: Path
 ACCEPTED = [
     "&time dt=1e-5 /",
     "&TIME DT=1E-5, T_END=1 /",
-    "&time dt= /",
     "&time dt=1d-5 /",
     "&time dt=.5e-4, beta=.25 /",
     "&time t_end=1 dt=1e-5 /",
@@ -127,6 +126,7 @@ REFUSED = [
     ("&beams length=1 /", ["&beams", "unknown group"]),
     ("&time dtt=1e-5 /", ["&time", "dtt"]),
     ("&time dt=abc /", ["&time", "abc"]),
+    ("&time dt= /", ["&time dt has no value", "allowed: dt = a real number"]),
     ("&time dt=1.0_8 /", ["&time", "_8"]),
     ("&time dt=1e-5, 2e-5 /", ["&time", "2e-5"]),
     ("&time dt=1e-5 /\n&time dt=2e-5 /", ["&time", "twice"]),
