@@ -27,7 +27,7 @@ module beamstops_band_solve_lockstep
    implicit none
    private
    public :: lockstep_forward, lockstep_energy_dots, lockstep_back, lockstep_matvec, lockstep_dot
-   public :: lockstep_rhs, lockstep_update, lockstep_matvec_rhs, lockstep_periodic_rows
+   public :: lockstep_rhs, lockstep_update, lockstep_matvec_rhs, lockstep_periodic_rows, matvec_rhs_periodic_rows
    public :: lockstep_back_edge, lockstep_back_update
    public :: lockstep_min_unknowns, lockstep_work_columns, lockstep_lanes
 
@@ -436,10 +436,16 @@ contains
       call matvec_rhs_last_rows(stiffness, u, a, g, b, spring, su, rhs)
    end subroutine lockstep_matvec_rhs
 
-   !> The interior rows of lockstep_matvec_rhs with period-2 coefficients `rows`.
+   !> The interior rows kd+1 .. n-kd of lockstep_matvec_rhs with period-2 coefficients `rows`:
+   !> y = S x and rhs = a g - b y there.
    pure subroutine matvec_rhs_periodic_rows(n, rows, x, a, g, b, y, rhs)
+      !> Unknowns.
       integer, intent(in) :: n
-      real(wp), intent(in) :: rows(2*kd + 1, 2), x(lockstep_lanes, n), a(lockstep_lanes), g(lockstep_lanes, n), b
+      !> The coefficients of interior rows kd+1 and kd+2 (lockstep_periodic_rows).
+      real(wp), intent(in) :: rows(2*kd + 1, 2)
+      !> x (lanes, n), dt^2 times the load weights (lanes), the load vectors (lanes, n), dt^2.
+      real(wp), intent(in) :: x(lockstep_lanes, n), a(lockstep_lanes), g(lockstep_lanes, n), b
+      !> S x and the right-hand sides (lanes, n), their interior rows set.
       real(wp), intent(inout) :: y(lockstep_lanes, n), rhs(lockstep_lanes, n)
       real(wp) :: p1, p2, p3, p4, p5, p6, p7, q1, q2, q3, q4, q5, q6, q7
       integer :: j, k

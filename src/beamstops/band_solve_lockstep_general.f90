@@ -12,7 +12,7 @@ module beamstops_band_solve_lockstep_general
    use beamstops_kinds, only: wp
    use beamstops_band, only: kd
    use beamstops_band_solve, only: band_diagonals
-   use beamstops_band_solve_lockstep, only: lockstep_lanes
+   use beamstops_band_solve_lockstep, only: lockstep_lanes, matvec_rhs_periodic_rows
    implicit none
    private
    public :: lockstep_matvec_rhs_damped, lockstep_row
@@ -22,7 +22,7 @@ contains
    !> S u and the right-hand sides rhs = a g - b S u - c_scale C d plus `spring` in the tip row n-1
    !> of every lane in one pass (beamstops_band_solve_lockstep's lockstep_matvec_rhs with the
    !> damping term of beamstops_scheme's forward_pass).
-   pure subroutine lockstep_matvec_rhs_damped(stiffness, u, a, g, b, spring, cd, c_scale, su, rhs)
+   pure subroutine lockstep_matvec_rhs_damped(stiffness, u, a, g, b, spring, cd, c_scale, su, rhs, rows)
       !> S by diagonals.
       type(band_diagonals), intent(in) :: stiffness
       !> u of every lane (lanes, n).
@@ -43,6 +43,9 @@ contains
       real(wp), intent(out) :: su(lockstep_lanes, stiffness%n)
       !> Right-hand sides (lanes, n).
       real(wp), intent(out) :: rhs(lockstep_lanes, stiffness%n)
+      !> The coefficients of interior rows kd+1 and kd+2 of a periodic S (lockstep_periodic_rows):
+      !> the interior's a g - b S u by matvec_rhs_periodic_rows, then - c_scale cd.
+      real(wp), intent(in), optional :: rows(2*kd + 1, 2)
       integer :: j, k, n
       n = stiffness%n
       associate (s => stiffness%a, x => u, y => su)
@@ -57,15 +60,26 @@ contains
             rhs(k, 2) = a(k)*g(k, 2) - b*y(k, 2) - c_scale*cd(k, 2)
             rhs(k, 3) = a(k)*g(k, 3) - b*y(k, 3) - c_scale*cd(k, 3)
          end do
-         do j = kd + 1, n - kd
+         if (present(rows)) then
+            call matvec_rhs_periodic_rows(n, rows, x, a, g, b, y, rhs)
+            do j = kd + 1, n - kd
 !GCC$ ivdep
 !GCC$ vector
-            do k = 1, lockstep_lanes
-               y(k, j) = s(j, 3)*x(k, j - 3) + s(j, 2)*x(k, j - 2) + s(j, 1)*x(k, j - 1) + s(j, 0)*x(k, j) &
-                  & + s(j + 1, 1)*x(k, j + 1) + s(j + 2, 2)*x(k, j + 2) + s(j + 3, 3)*x(k, j + 3)
-               rhs(k, j) = a(k)*g(k, j) - b*y(k, j) - c_scale*cd(k, j)
+               do k = 1, lockstep_lanes
+                  rhs(k, j) = rhs(k, j) - c_scale*cd(k, j)
+               end do
             end do
-         end do
+         else
+            do j = kd + 1, n - kd
+!GCC$ ivdep
+!GCC$ vector
+               do k = 1, lockstep_lanes
+                  y(k, j) = s(j, 3)*x(k, j - 3) + s(j, 2)*x(k, j - 2) + s(j, 1)*x(k, j - 1) + s(j, 0)*x(k, j) &
+                     & + s(j + 1, 1)*x(k, j + 1) + s(j + 2, 2)*x(k, j + 2) + s(j + 3, 3)*x(k, j + 3)
+                  rhs(k, j) = a(k)*g(k, j) - b*y(k, j) - c_scale*cd(k, j)
+               end do
+            end do
+         end if
 !GCC$ ivdep
 !GCC$ vector
          do k = 1, lockstep_lanes

@@ -89,9 +89,16 @@ contains
          do c = 1, ms%chunks
             lo = (c - 1)*lockstep_lanes + 1
             hi = c*lockstep_lanes
-            if (damped) then
+            if (damped .and. ops%periodic) then
+               call lockstep_matvec_rhs_damped(ops%stiffness, ms%u(:, :, c), ms%coef(lo:hi), ms%g(:, :, c), &
+                  & model%dt2, ms%spring(lo:hi), ms%cd(:, :, c), model%dt, ms%su(:, :, c), ms%rhs(:, :, c), &
+                  & ops%stiffness_rows)
+            else if (damped) then
                call lockstep_matvec_rhs_damped(ops%stiffness, ms%u(:, :, c), ms%coef(lo:hi), ms%g(:, :, c), &
                   & model%dt2, ms%spring(lo:hi), ms%cd(:, :, c), model%dt, ms%su(:, :, c), ms%rhs(:, :, c))
+            else if (ops%periodic) then
+               call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), ms%coef(lo:hi), ms%g(:, :, c), model%dt2, &
+                  & ms%spring(lo:hi), ms%su(:, :, c), ms%rhs(:, :, c), ops%stiffness_rows)
             else
                call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), ms%coef(lo:hi), ms%g(:, :, c), model%dt2, &
                   & ms%spring(lo:hi), ms%su(:, :, c), ms%rhs(:, :, c))
