@@ -27,7 +27,7 @@ module beamstops_band_solve_lockstep
    implicit none
    private
    public :: lockstep_forward, lockstep_energy_dots, lockstep_back, lockstep_matvec, lockstep_dot
-   public :: lockstep_rhs, lockstep_update, lockstep_matvec_rhs, lockstep_periodic_rows, matvec_rhs_periodic_rows
+   public :: lockstep_rhs, lockstep_update, lockstep_matvec_rhs, lockstep_periodic_rows
    public :: lockstep_back_edge, lockstep_back_update
    public :: lockstep_min_unknowns, lockstep_work_columns, lockstep_lanes
 

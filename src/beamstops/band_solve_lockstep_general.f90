@@ -12,7 +12,7 @@ module beamstops_band_solve_lockstep_general
    use beamstops_kinds, only: wp
    use beamstops_band, only: kd
    use beamstops_band_solve, only: band_diagonals
-   use beamstops_band_solve_lockstep, only: lockstep_lanes, matvec_rhs_periodic_rows
+   use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_matvec_rhs
    implicit none
    private
    public :: lockstep_matvec_rhs_damped, lockstep_row
@@ -20,8 +20,10 @@ module beamstops_band_solve_lockstep_general
 contains
 
    !> S u and the right-hand sides rhs = a g - b S u - c_scale C d plus `spring` in the tip row n-1
-   !> of every lane in one pass (beamstops_band_solve_lockstep's lockstep_matvec_rhs with the
-   !> damping term of beamstops_scheme's forward_pass).
+   !> of every lane (beamstops_scheme's forward_pass with damping): lockstep_matvec_rhs without the
+   !> spring, then the damping term, then the spring, which rounds as the one expression
+   !> a g - b S u - c_scale C d does (test_lockstep_general compares damped members with the
+   !> same scenes run alone, bit for bit).
    pure subroutine lockstep_matvec_rhs_damped(stiffness, u, a, g, b, spring, cd, c_scale, su, rhs, rows)
       !> S by diagonals.
       type(band_diagonals), intent(in) :: stiffness
@@ -43,57 +45,24 @@ contains
       real(wp), intent(out) :: su(lockstep_lanes, stiffness%n)
       !> Right-hand sides (lanes, n).
       real(wp), intent(out) :: rhs(lockstep_lanes, stiffness%n)
-      !> The coefficients of interior rows kd+1 and kd+2 of a periodic S (lockstep_periodic_rows):
-      !> the interior's a g - b S u by matvec_rhs_periodic_rows, then - c_scale cd.
+      !> The coefficients of interior rows kd+1 and kd+2 of a periodic S (lockstep_periodic_rows).
       real(wp), intent(in), optional :: rows(2*kd + 1, 2)
+      real(wp), parameter :: no_spring(lockstep_lanes) = 0
       integer :: j, k, n
       n = stiffness%n
-      associate (s => stiffness%a, x => u, y => su)
+      call lockstep_matvec_rhs(stiffness, u, a, g, b, no_spring, su, rhs, rows)
+      do j = 1, n
 !GCC$ ivdep
 !GCC$ vector
          do k = 1, lockstep_lanes
-            y(k, 1) = s(1, 0)*x(k, 1) + s(2, 1)*x(k, 2) + s(3, 2)*x(k, 3) + s(4, 3)*x(k, 4)
-            y(k, 2) = s(2, 1)*x(k, 1) + s(2, 0)*x(k, 2) + s(3, 1)*x(k, 3) + s(4, 2)*x(k, 4) + s(5, 3)*x(k, 5)
-            y(k, 3) = s(3, 2)*x(k, 1) + s(3, 1)*x(k, 2) + s(3, 0)*x(k, 3) + s(4, 1)*x(k, 4) + s(5, 2)*x(k, 5) &
-               & + s(6, 3)*x(k, 6)
-            rhs(k, 1) = a(k)*g(k, 1) - b*y(k, 1) - c_scale*cd(k, 1)
-            rhs(k, 2) = a(k)*g(k, 2) - b*y(k, 2) - c_scale*cd(k, 2)
-            rhs(k, 3) = a(k)*g(k, 3) - b*y(k, 3) - c_scale*cd(k, 3)
+            rhs(k, j) = rhs(k, j) - c_scale*cd(k, j)
          end do
-         if (present(rows)) then
-            call matvec_rhs_periodic_rows(n, rows, x, a, g, b, y, rhs)
-            do j = kd + 1, n - kd
+      end do
 !GCC$ ivdep
 !GCC$ vector
-               do k = 1, lockstep_lanes
-                  rhs(k, j) = rhs(k, j) - c_scale*cd(k, j)
-               end do
-            end do
-         else
-            do j = kd + 1, n - kd
-!GCC$ ivdep
-!GCC$ vector
-               do k = 1, lockstep_lanes
-                  y(k, j) = s(j, 3)*x(k, j - 3) + s(j, 2)*x(k, j - 2) + s(j, 1)*x(k, j - 1) + s(j, 0)*x(k, j) &
-                     & + s(j + 1, 1)*x(k, j + 1) + s(j + 2, 2)*x(k, j + 2) + s(j + 3, 3)*x(k, j + 3)
-                  rhs(k, j) = a(k)*g(k, j) - b*y(k, j) - c_scale*cd(k, j)
-               end do
-            end do
-         end if
-!GCC$ ivdep
-!GCC$ vector
-         do k = 1, lockstep_lanes
-            y(k, n - 2) = s(n - 2, 3)*x(k, n - 5) + s(n - 2, 2)*x(k, n - 4) + s(n - 2, 1)*x(k, n - 3) &
-               & + s(n - 2, 0)*x(k, n - 2) + s(n - 1, 1)*x(k, n - 1) + s(n, 2)*x(k, n)
-            y(k, n - 1) = s(n - 1, 3)*x(k, n - 4) + s(n - 1, 2)*x(k, n - 3) + s(n - 1, 1)*x(k, n - 2) &
-               & + s(n - 1, 0)*x(k, n - 1) + s(n, 1)*x(k, n)
-            y(k, n) = s(n, 3)*x(k, n - 3) + s(n, 2)*x(k, n - 2) + s(n, 1)*x(k, n - 1) + s(n, 0)*x(k, n)
-            rhs(k, n - 2) = a(k)*g(k, n - 2) - b*y(k, n - 2) - c_scale*cd(k, n - 2)
-            rhs(k, n - 1) = a(k)*g(k, n - 1) - b*y(k, n - 1) - c_scale*cd(k, n - 1)
-            rhs(k, n) = a(k)*g(k, n) - b*y(k, n) - c_scale*cd(k, n)
-            rhs(k, n - 1) = rhs(k, n - 1) + spring(k)
-         end do
-      end associate
+      do k = 1, lockstep_lanes
+         rhs(k, n - 1) = rhs(k, n - 1) + spring(k)
+      end do
    end subroutine lockstep_matvec_rhs_damped
 
    !> Row `row` of A x of every lane, A symmetric by diagonals (beamstops_band_solve's
