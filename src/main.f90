@@ -11,7 +11,7 @@ program beamstops_main
       & c_null_char, c_ptr, c_null_ptr, c_loc
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use beamstops
-   use beamstops_checkpoint, only: checkpoint_path, read_checkpoint, is_checkpoint
+   use beamstops_checkpoint, only: checkpoint_path, temporary_path, read_checkpoint, is_checkpoint
    use beamstops_files, only: file_exists, remove_file, same_file, same_path
    use beamstops_recorder_hdf5, only: partial_path, check_output_path
    use beamstops_run, only: continue_run, continue_reduced
@@ -587,7 +587,7 @@ contains
       case (3)
          path = checkpoint_path(output)
       case default
-         path = checkpoint_path(output)//'.tmp'
+         path = temporary_path(checkpoint_path(output))
       end select
    end function written_file
 

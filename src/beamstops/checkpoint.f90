@@ -15,7 +15,7 @@ module beamstops_checkpoint
    use beamstops_recorder_hdf5_vector, only: write_vector, read_vector
    implicit none
    private
-   public :: write_checkpoint, read_checkpoint, checkpoint_path, scene_signature, is_checkpoint
+   public :: write_checkpoint, read_checkpoint, checkpoint_path, temporary_path, scene_signature, is_checkpoint
    ! (the reduced model's checkpoints, beamstops_reduced_checkpoint, share the file's frame)
    public :: create_checkpoint, commit_checkpoint, open_checkpoint, close_checkpoint, write_observer, read_observer
    public :: write_scene_text, signature_text
@@ -29,6 +29,14 @@ contains
       character(len=:), allocatable :: path
       path = output//'.checkpoint'
    end function checkpoint_path
+
+   !> The temporary file a checkpoint is written to before it is moved onto `path`.
+   pure function temporary_path(path) result(temporary)
+      !> Checkpoint file.
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: temporary
+      temporary = path//'.tmp'
+   end function temporary_path
 
    !> Every value of a scene that a restart must find unchanged, as numbers: the items of the
    !> scene table marked `signature` (texts as their character codes), in the table's order.
@@ -270,7 +278,7 @@ contains
       ok = .not. allocated(failure)
    end subroutine read_observer
 
-   !> Create the temporary file of the checkpoint `path` (path.tmp), to be written and then
+   !> Create the temporary file of the checkpoint `path` (temporary_path), to be written and then
    !> moved in place by commit_checkpoint.
    subroutine create_checkpoint(path, file, error)
       !> Checkpoint file.
@@ -282,7 +290,7 @@ contains
       integer :: hdferr
       call h5open_f(hdferr)
       call h5eset_auto_f(0, hdferr)
-      call h5fcreate_f(path//'.tmp', H5F_ACC_TRUNC_F, file, hdferr)
+      call h5fcreate_f(temporary_path(path), H5F_ACC_TRUNC_F, file, hdferr)
       if (hdferr /= 0) call fatal_error(error, path//': cannot create the checkpoint')
    end subroutine create_checkpoint
 
@@ -301,11 +309,11 @@ contains
       logical :: moved
       call h5fclose_f(file, hdferr)
       if (.not. ok .or. hdferr /= 0) then
-         call remove_file(path//'.tmp')
+         call remove_file(temporary_path(path))
          call fatal_error(error, path//': cannot write the checkpoint (disk full, or beyond the file-size limit?)')
          return
       end if
-      call rename_file(path//'.tmp', path, moved)
+      call rename_file(temporary_path(path), path, moved)
       if (.not. moved) call fatal_error(error, path//': cannot move the new checkpoint in place')
    end subroutine commit_checkpoint
 

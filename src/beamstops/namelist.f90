@@ -144,7 +144,7 @@ contains
       character(len=text_len) :: groups_text(size(group_names))
       logical :: has_group(size(group_names))
       character(len=512) :: msg
-      character(len=:), allocatable :: cleaned
+      character(len=:), allocatable :: cleaned, spring_key
       character(len=*), parameter :: no_file = achar(1)
       integer :: stat, g
 
@@ -170,7 +170,7 @@ contains
 
       do g = 1, size(group_names)
          if (.not. has_group(g)) cycle
-         call repeated_key(g)
+         call check_assignments(g)
          if (allocated(error)) return
       end do
       do g = 1, size(group_names)
@@ -194,15 +194,11 @@ contains
          return
       end if
       if (scene%law /= law_compliance .and. (stiffness /= unset .or. stiffness_per_mass /= unset)) then
-         if (stiffness /= unset) then
-            call fatal_error(error, source//': &stops stiffness = '//fmt_real(stiffness)//' is out of range for '// &
-               & "law = '"//trim(law)//"'; allowed: stiffness only with law = 'compliance' (the spring of the "// &
-               & 'compliance law; other laws have none)')
-         else
-            call fatal_error(error, source//': &stops stiffness_per_mass = '//fmt_real(stiffness_per_mass)// &
-               & " is out of range for law = '"//trim(law)//"'; allowed: stiffness_per_mass only with law = "// &
-               & "'compliance' (the spring of the compliance law; other laws have none)")
-         end if
+         spring_key = trim(merge('stiffness         ', 'stiffness_per_mass', stiffness /= unset))
+         call fatal_error(error, source//': &stops '//spring_key//' = '// &
+            & fmt_real(merge(stiffness, stiffness_per_mass, stiffness /= unset))//" is out of range for law = '"// &
+            & trim(law)//"'; allowed: "//spring_key//" only with law = 'compliance' (the spring of the compliance "// &
+            & 'law; other laws have none)')
          return
       end if
       if (scene%law == law_compliance) then
@@ -396,11 +392,11 @@ contains
          end select
       end subroutine read_group
 
-      !> A key given twice in group g (`key = ...` both times; the elements of an array, `key(i) =`,
-      !> may each be given once): refused, where gfortran would let the last one win unsaid. And a
-      !> key given no value (`dt = /`, `dt = , beta = 0.5`): refused, where gfortran would keep the
-      !> default unsaid.
-      subroutine repeated_key(g)
+      !> The assignments of group g, before gfortran reads it: a key given twice (`key = ...` both
+      !> times; the elements of an array, `key(i) =`, may each be given once), where gfortran would
+      !> let the last one win unsaid, and a key given no value (`dt = /`, `dt = , beta = 0.5`), where
+      !> gfortran would keep the default unsaid, are refused.
+      subroutine check_assignments(g)
          integer, intent(in) :: g
          character(len=:), allocatable :: body, key, seen
          integer, allocatable :: starts(:)
@@ -427,7 +423,7 @@ contains
             end if
             seen = seen//key//' '
          end do
-      end subroutine repeated_key
+      end subroutine check_assignments
 
       !> The message of a group gfortran could not read: each `key = value` of the group is read
       !> alone to find the first one that fails, and the message names it with the kind of value

@@ -162,9 +162,23 @@ contains
       !> Scene.
       type(scene_type), intent(in) :: scene
       real(wp) :: bytes
-      bytes = 8*(9 + 2*stop_count(scene))*real(record_count(scene), wp) &
-         & + 8*real(snapshot_count(scene), wp)*(scene%elements + 2)
+      bytes = row_bytes(scene)*real(record_count(scene), wp) + shape_bytes(scene)*real(snapshot_count(scene), wp)
    end function output_bytes
+
+   !> Bytes of one record: its 9 series (tip and energy) and, with stops along the span, each
+   !> stop's displacement and reaction.
+   pure real(wp) function row_bytes(scene)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      row_bytes = 8*real(9 + 2*stop_count(scene), wp)
+   end function row_bytes
+
+   !> Bytes of one snapshot: the time and the J + 1 nodal displacements.
+   pure real(wp) function shape_bytes(scene)
+      !> Scene.
+      type(scene_type), intent(in) :: scene
+      shape_bytes = 8*real(scene%elements + 2, wp)
+   end function shape_bytes
 
    !> Cross-section area and second moment of a tube.
    pure subroutine tube_section(outer_diameter, wall_thickness, area, inertia)
@@ -437,8 +451,8 @@ contains
          limit = scene%max_output_gb*1.0e9_wp
          if (output_bytes(scene) <= limit) return
          steps = steps_of(scene)
-         row = 8*real(9 + 2*stop_count(scene), wp)
-         snapshot = 8*real(scene%elements + 2, wp)
+         row = row_bytes(scene)
+         snapshot = shape_bytes(scene)
          records = row*real(record_count(scene), wp)
          snaps = snapshot*real(snapshot_count(scene), wp)
          ! The least any record_every (at most huge(1)) gives, without snapshots.

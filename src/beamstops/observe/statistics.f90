@@ -81,8 +81,8 @@ module beamstops_observe_statistics
       real(wp) :: next_edge = 0, lower = 0, scale = 0, top = 0
       !> The current batch's tip sum, sum of squares and extremes (m, m^2).
       real(wp) :: su = 0, suu = 0, umin = 0, umax = 0
-      !> Bin of the current run of samples, and bins.
-      integer :: run_bin = 0, bins = 0
+      !> Bin of the current run of samples.
+      integer :: run_bin = 0
       !> Samples of the current batch.
       integer(ik) :: n = 0
    end type quiet_tip_stats
@@ -376,7 +376,6 @@ contains
       q%umin = self%umin
       q%umax = self%umax
       q%run_bin = self%run_bin
-      q%bins = self%bins
       q%n = self%n
    end function quiet_tip
 
