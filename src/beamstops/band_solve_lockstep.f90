@@ -28,7 +28,7 @@ module beamstops_band_solve_lockstep
    private
    public :: lockstep_forward, lockstep_energy_dots, lockstep_back, lockstep_matvec, lockstep_dot
    public :: lockstep_rhs, lockstep_update, lockstep_matvec_rhs, lockstep_periodic_rows
-   public :: lockstep_back_edge, lockstep_back_update
+   public :: lockstep_back_edge, lockstep_back_update, lockstep_matvec_rhs_forward
    public :: lockstep_min_unknowns, lockstep_work_columns, lockstep_lanes
 
    !> Fewest unknowns these routines handle (J >= 4).
@@ -467,6 +467,93 @@ contains
          end do
       end do
    end subroutine matvec_rhs_periodic_rows
+
+   !> lockstep_matvec_rhs with `rows` (a periodic S) then lockstep_forward, in one pass: the
+   !> forward substitution follows the product six rows at a time, so that its chain (one
+   !> multiply-add a row) runs while the product of the next six rows is computed instead of
+   !> after the whole product. Each row's expressions are those of the two routines (the same
+   !> bits); rhs is returned as lockstep_forward leaves it (D^{-2} w).
+   pure subroutine lockstep_matvec_rhs_forward(stiffness, solver, rows, u, a, g, b, spring, su, rhs)
+      !> S by diagonals and the factor of A.
+      type(band_diagonals), intent(in) :: stiffness
+      type(band_solver), intent(in) :: solver
+      !> The coefficients of interior rows kd+1 and kd+2 of S (lockstep_periodic_rows).
+      real(wp), intent(in) :: rows(2*kd + 1, 2)
+      !> u of every lane (lanes, n), dt^2 times the load weights (lanes), the load vectors
+      !> (lanes, n), dt^2 and the force term of the tip row (lanes).
+      real(wp), intent(in) :: u(lockstep_lanes, stiffness%n), a(lockstep_lanes), g(lockstep_lanes, stiffness%n), &
+         & b, spring(lockstep_lanes)
+      !> S u (lanes, n).
+      real(wp), intent(out) :: su(lockstep_lanes, stiffness%n)
+      !> D^{-2} w, w the forward substitution of rhs = a g - b S u + spring e_{n-1} (lanes, n).
+      real(wp), intent(out) :: rhs(lockstep_lanes, stiffness%n)
+      real(wp) :: p1, p2, p3, p4, p5, p6, p7, q1, q2, q3, q4, q5, q6, q7
+      real(wp) :: xa(lockstep_lanes), xb(lockstep_lanes), xc(lockstep_lanes)
+      integer :: i, j, k, n
+      n = stiffness%n
+      p1 = rows(1, 1); p2 = rows(2, 1); p3 = rows(3, 1); p4 = rows(4, 1); p5 = rows(5, 1); p6 = rows(6, 1)
+      p7 = rows(7, 1)
+      q1 = rows(1, 2); q2 = rows(2, 2); q3 = rows(3, 2); q4 = rows(4, 2); q5 = rows(5, 2); q6 = rows(6, 2)
+      q7 = rows(7, 2)
+      call matvec_rhs_first_rows(stiffness, u, a, g, b, su, rhs)
+      associate (off => solver%off, inv_d2 => solver%inv_d2, x => u, y => su)
+         call forward_first_rows(off, inv_d2, n, rhs, xa, xb, xc)
+         j = kd + 1
+         do while (j + 5 <= n - kd)
+            do i = j, j + 4, 2
+!GCC$ ivdep
+!GCC$ vector
+               do k = 1, lockstep_lanes
+                  y(k, i) = p1*x(k, i - 3) + p2*x(k, i - 2) + p3*x(k, i - 1) + p4*x(k, i) + p5*x(k, i + 1) &
+                     & + p6*x(k, i + 2) + p7*x(k, i + 3)
+                  rhs(k, i) = a(k)*g(k, i) - b*y(k, i)
+                  y(k, i + 1) = q1*x(k, i - 2) + q2*x(k, i - 1) + q3*x(k, i) + q4*x(k, i + 1) + q5*x(k, i + 2) &
+                     & + q6*x(k, i + 3) + q7*x(k, i + 4)
+                  rhs(k, i + 1) = a(k)*g(k, i + 1) - b*y(k, i + 1)
+               end do
+            end do
+            do i = j, j + 3, 3
+!GCC$ ivdep
+!GCC$ vector
+               do k = 1, lockstep_lanes
+                  xa(k) = rhs(k, i) - off(1, i)*xa(k) - off(2, i)*xb(k) - off(3, i)*xc(k)
+                  rhs(k, i) = xa(k)*inv_d2(i)
+                  xb(k) = rhs(k, i + 1) - off(1, i + 1)*xb(k) - off(2, i + 1)*xc(k) - off(3, i + 1)*xa(k)
+                  rhs(k, i + 1) = xb(k)*inv_d2(i + 1)
+                  xc(k) = rhs(k, i + 2) - off(1, i + 2)*xc(k) - off(2, i + 2)*xa(k) - off(3, i + 2)*xb(k)
+                  rhs(k, i + 2) = xc(k)*inv_d2(i + 2)
+               end do
+            end do
+            j = j + 6
+         end do
+         do i = j, n - kd - 1, 2
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               y(k, i) = p1*x(k, i - 3) + p2*x(k, i - 2) + p3*x(k, i - 1) + p4*x(k, i) + p5*x(k, i + 1) &
+                  & + p6*x(k, i + 2) + p7*x(k, i + 3)
+               rhs(k, i) = a(k)*g(k, i) - b*y(k, i)
+               y(k, i + 1) = q1*x(k, i - 2) + q2*x(k, i - 1) + q3*x(k, i) + q4*x(k, i + 1) + q5*x(k, i + 2) &
+                  & + q6*x(k, i + 3) + q7*x(k, i + 4)
+               rhs(k, i + 1) = a(k)*g(k, i + 1) - b*y(k, i + 1)
+            end do
+         end do
+         call matvec_rhs_last_rows(stiffness, u, a, g, b, spring, su, rhs)
+         do j = j, n - 2, 3
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               xa(k) = rhs(k, j) - off(1, j)*xa(k) - off(2, j)*xb(k) - off(3, j)*xc(k)
+               rhs(k, j) = xa(k)*inv_d2(j)
+               xb(k) = rhs(k, j + 1) - off(1, j + 1)*xb(k) - off(2, j + 1)*xc(k) - off(3, j + 1)*xa(k)
+               rhs(k, j + 1) = xb(k)*inv_d2(j + 1)
+               xc(k) = rhs(k, j + 2) - off(1, j + 2)*xc(k) - off(2, j + 2)*xa(k) - off(3, j + 2)*xb(k)
+               rhs(k, j + 2) = xc(k)*inv_d2(j + 2)
+            end do
+         end do
+         call forward_last_rows(off, inv_d2, j, n, rhs, xa, xb, xc)
+      end associate
+   end subroutine lockstep_matvec_rhs_forward
 
    !> Whether the interior rows kd+1 .. n-kd of a band matrix repeat with period 2, and the
    !> coefficients of the first two in the order of a row's products (A(j, j-3), A(j, j-2),

@@ -42,7 +42,7 @@ module beamstops_lockstep
    use beamstops_band_solve, only: prepare_solver, prepare_diagonals, energy_dots
    use beamstops_band_solve_lockstep, only: lockstep_forward, lockstep_energy_dots, lockstep_back_edge, &
       & lockstep_back_update, lockstep_matvec, lockstep_dot, lockstep_min_unknowns, lockstep_work_columns, &
-      & lockstep_lanes, lockstep_matvec_rhs, lockstep_periodic_rows
+      & lockstep_lanes, lockstep_matvec_rhs, lockstep_periodic_rows, lockstep_matvec_rhs_forward
    use beamstops_lockstep_lanes, only: lanes_type, lanes_restart_loads, lanes_next_loads, lanes_begin_step, &
       & lanes_contact, lanes_close
    use beamstops_state, only: state_type
@@ -594,17 +594,17 @@ contains
          do c = 1, ms%chunks
             call lanes_begin_step(lanes(c), law, model%beta, model%dt2, restart, load_k + 1, model%dt)
             if (ops%periodic) then
-               call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), lanes(c)%coef, ms%g(:, :, c), model%dt2, &
-                  & lanes(c)%spring, ms%su(:, :, c), ms%rhs(:, :, c), ops%stiffness_rows)
+               call lockstep_matvec_rhs_forward(ops%stiffness, ops%solver, ops%stiffness_rows, ms%u(:, :, c), &
+                  & lanes(c)%coef, ms%g(:, :, c), model%dt2, lanes(c)%spring, ms%su(:, :, c), ms%rhs(:, :, c))
             else
                call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), lanes(c)%coef, ms%g(:, :, c), model%dt2, &
                   & lanes(c)%spring, ms%su(:, :, c), ms%rhs(:, :, c))
+               call lockstep_forward(ops%solver, ms%rhs(:, :, c))
             end if
             if (energy_wanted) then
                call lockstep_energy_dots(ops%mass, ms%u(:, :, c), ms%d(:, :, c), ms%su(:, :, c), lanes(c)%usu, &
                   & lanes(c)%dsu, lanes(c)%dmd)
             end if
-            call lockstep_forward(ops%solver, ms%rhs(:, :, c))
          end do
          load_k = load_k + 1
          if (pending) then

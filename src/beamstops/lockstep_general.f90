@@ -27,7 +27,7 @@ module beamstops_lockstep_general
    use beamstops_observe_lanes, only: observer_lanes, gather_observers, scatter_observers, observe_lanes
    use beamstops_band_solve, only: energy_dots
    use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_matvec_rhs, lockstep_forward, &
-      & lockstep_energy_dots, lockstep_back, lockstep_update, lockstep_dot, lockstep_matvec
+      & lockstep_matvec_rhs_forward, lockstep_energy_dots, lockstep_back, lockstep_update, lockstep_dot, lockstep_matvec
    use beamstops_band_solve_lockstep_general, only: lockstep_matvec_rhs_damped, lockstep_row
    use beamstops_contact_mass_redistribution, only: massless_reaction, equilibrium_rows
    use beamstops_lockstep_members, only: operators_type, members_type, lane, chunk, contact_law, close_steps, &
@@ -96,6 +96,10 @@ contains
             else if (damped) then
                call lockstep_matvec_rhs_damped(ops%stiffness, ms%u(:, :, c), ms%coef(lo:hi), ms%g(:, :, c), &
                   & model%dt2, ms%spring(lo:hi), ms%cd(:, :, c), model%dt, ms%su(:, :, c), ms%rhs(:, :, c))
+            else if (ops%periodic .and. .not. massless) then
+               ! the product and the forward substitution in one pass
+               call lockstep_matvec_rhs_forward(ops%stiffness, ops%solver, ops%stiffness_rows, ms%u(:, :, c), &
+                  & ms%coef(lo:hi), ms%g(:, :, c), model%dt2, ms%spring(lo:hi), ms%su(:, :, c), ms%rhs(:, :, c))
             else if (ops%periodic) then
                call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), ms%coef(lo:hi), ms%g(:, :, c), model%dt2, &
                   & ms%spring(lo:hi), ms%su(:, :, c), ms%rhs(:, :, c), ops%stiffness_rows)
@@ -113,7 +117,7 @@ contains
                call lockstep_energy_dots(ops%mass, ms%u(:, :, c), ms%d(:, :, c), ms%su(:, :, c), ms%usu(lo:hi), &
                   & ms%dsu(lo:hi), ms%dmd(lo:hi))
             end if
-            call lockstep_forward(ops%solver, ms%rhs(:, :, c))
+            if (damped .or. massless .or. .not. ops%periodic) call lockstep_forward(ops%solver, ms%rhs(:, :, c))
          end do
          if (pending) then
             do k = 1, ms%k

@@ -24,7 +24,7 @@ module test_lockstep
       & back_substitution_edge, back_substitution_update
    use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_work_columns, lockstep_matvec, &
       & lockstep_forward, lockstep_energy_dots, lockstep_back, lockstep_dot, lockstep_update, lockstep_back_edge, &
-      & lockstep_back_update, lockstep_matvec_rhs, lockstep_periodic_rows
+      & lockstep_back_update, lockstep_matvec_rhs, lockstep_periodic_rows, lockstep_matvec_rhs_forward
    use beamstops_contact_tip_contact, only: update
    use test_support, only: base_scene
    implicit none
@@ -334,6 +334,11 @@ contains
             call lockstep_matvec_rhs(s, x, c, u, 1.0e-10_wp, d(:, 1), ub, w2, rows)
             if (.not. (all(same_bits(y, ub)) .and. all(same_bits(b, w2)))) &
                & call test_failed(error, where//'S x and the right-hand side with period-2 rows')
+            ! the product and the forward substitution in one pass: the two kernels' bits
+            call lockstep_forward(solver, b)
+            call lockstep_matvec_rhs_forward(s, solver, rows, x, c, u, 1.0e-10_wp, d(:, 1), ub, w2)
+            if (.not. (all(same_bits(y, ub)) .and. all(same_bits(b, w2)))) &
+               & call test_failed(error, where//'S x and the forward substitution in one pass')
             b = x
             call lockstep_forward(solver, b)
             do k = 1, lanes
