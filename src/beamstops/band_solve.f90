@@ -20,7 +20,7 @@ module beamstops_band_solve
    implicit none
    private
    public :: band_solver, prepare_solver, fused_solve, forward_substitution, back_substitution
-   public :: back_substitution_edge, back_substitution_update
+   public :: back_substitution_edge, back_substitution_update, load_work_product
    public :: energy_dots
    public :: band_diagonals, prepare_diagonals, diagonal_matvec, diagonal_matvec_rhs, diagonal_row, dot
 
@@ -297,71 +297,115 @@ contains
    end subroutine back_substitution_edge
 
    !> The rest of back_substitution after back_substitution_edge, each row of x followed at
-   !> once by its row of the update d^n = d^{n-1} + x + c z, u^{n+1} = u^n + d^n: the update
-   !> rides in the shadow of the substitution's chain instead of two passes of its own, and the
-   !> next forward pass, which starts from the first rows, finds them updated last. Per row the
-   !> same operations as back_substitution then beamstops_contact_tip_contact's update; x itself
-   !> is not stored (b keeps D^{-2} w below the edge rows).
-   pure subroutine back_substitution_update(solver, b, c, z, d, u)
+   !> once by its row of the update d^n = d^{n-1} + x + c z, u^{n+1} = u^n + d^n and its term of
+   !> g.d^n: the update and the product ride in the shadow of the substitution's chain instead
+   !> of passes of their own, and the next forward pass, which starts from the first rows, finds
+   !> them updated last. Per row the same operations as back_substitution then
+   !> beamstops_contact_tip_contact's update; gd is load_work_product(g, d^n), its sums taken
+   !> in the same order; x itself is not stored (b keeps D^{-2} w below the edge rows).
+   pure subroutine back_substitution_update(solver, b, c, z, g, d, u, gd)
       !> Solver from prepare_solver.
       type(band_solver), intent(in) :: solver
       !> D^{-2} w (n) with its last kd rows from back_substitution_edge (all of x when n <= kd).
       real(wp), intent(in), contiguous :: b(:)
       !> Multiple of z.
       real(wp), intent(in) :: c
-      !> z = A^{-1} e_tip (n).
-      real(wp), intent(in), contiguous :: z(:)
+      !> z = A^{-1} e_tip and the load vector g (n).
+      real(wp), intent(in), contiguous :: z(:), g(:)
       !> d^{n-1} and u^n on entry, d^n and u^{n+1} on return (n).
       real(wp), intent(inout), contiguous :: d(:), u(:)
+      !> g.d^n (load_work_product).
+      real(wp), intent(out) :: gd
       integer :: n
       n = solver%n
       if (n <= kd) then
          d = d + b + c*z
          u = u + d
+         gd = load_work_product(g, d)
          return
       end if
-      call back_update_rows(n, solver%off, b, c, z, d, u)
+      call back_update_rows(n, solver%off, b, c, z, g, d, u, gd)
    end subroutine back_substitution_update
 
    !> The rows of back_substitution_update in one routine of explicit-shape arrays (as back_rows).
-   pure subroutine back_update_rows(n, off, b, c, z, d, u)
+   pure subroutine back_update_rows(n, off, b, c, z, g, d, u, gd)
       integer, intent(in) :: n
-      real(wp), intent(in) :: off(kd, n), b(n), c, z(n)
+      real(wp), intent(in) :: off(kd, n), b(n), c, z(n), g(n)
       real(wp), intent(inout) :: d(n), u(n)
-      real(wp) :: xa, xb, xc
+      real(wp), intent(out) :: gd
+      real(wp) :: xa, xb, xc, ga, gb, gc
       integer :: i
       xa = b(n)
       xb = b(n - 1)
       xc = b(n - 2)
       d(n) = d(n) + xa + c*z(n)
       u(n) = u(n) + d(n)
+      ga = g(n)*d(n)
       d(n - 1) = d(n - 1) + xb + c*z(n - 1)
       u(n - 1) = u(n - 1) + d(n - 1)
+      gb = g(n - 1)*d(n - 1)
       d(n - 2) = d(n - 2) + xc + c*z(n - 2)
       u(n - 2) = u(n - 2) + d(n - 2)
+      gc = g(n - 2)*d(n - 2)
       do i = n - kd, 3, -3
          xa = row(b(i), off(1, i + 3), off(2, i + 2), off(3, i + 1), xa, xb, xc)
          d(i) = d(i) + xa + c*z(i)
          u(i) = u(i) + d(i)
+         ga = ga + g(i)*d(i)
          xb = row(b(i - 1), off(1, i + 2), off(2, i + 1), off(3, i), xb, xc, xa)
          d(i - 1) = d(i - 1) + xb + c*z(i - 1)
          u(i - 1) = u(i - 1) + d(i - 1)
+         gb = gb + g(i - 1)*d(i - 1)
          xc = row(b(i - 2), off(1, i + 1), off(2, i), off(3, i - 1), xc, xa, xb)
          d(i - 2) = d(i - 2) + xc + c*z(i - 2)
          u(i - 2) = u(i - 2) + d(i - 2)
+         gc = gc + g(i - 2)*d(i - 2)
       end do
       ! The first rows (fewer than three): xa, xb, xc hold x_{i+3}, x_{i+2}, x_{i+1}.
       if (i >= 1) then
          xa = row(b(i), off(1, i + 3), off(2, i + 2), off(3, i + 1), xa, xb, xc)
          d(i) = d(i) + xa + c*z(i)
          u(i) = u(i) + d(i)
+         ga = ga + g(i)*d(i)
       end if
       if (i - 1 >= 1) then
          xb = row(b(i - 1), off(1, i + 2), off(2, i + 1), off(3, i), xb, xc, xa)
          d(i - 1) = d(i - 1) + xb + c*z(i - 1)
          u(i - 1) = u(i - 1) + d(i - 1)
+         gb = gb + g(i - 1)*d(i - 1)
       end if
+      gd = (ga + gb) + gc
    end subroutine back_update_rows
+
+   !> g.d, the product of the load's work (SPEC 3's G^n.(u^{n+1} - u^n)), summed in the order of
+   !> the back substitution, from the last row down, so that back_substitution_update can take it
+   !> in the substitution's shadow: row j in sum mod(n - j, 3) + 1, each sum starting with the
+   !> product of its top row, then (s1 + s2) + s3. Every path of the engine takes g.d with this
+   !> order (the lockstep lanes too), so that their work is the same to the bit.
+   pure function load_work_product(g, d) result(gd)
+      !> The load vector and d (n >= 1).
+      real(wp), intent(in), contiguous :: g(:), d(:)
+      real(wp) :: gd
+      gd = work_rows(size(g), g, d)
+   end function load_work_product
+
+   !> load_work_product in explicit-shape arrays.
+   pure function work_rows(n, g, d) result(gd)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: g(n), d(n)
+      real(wp) :: gd
+      real(wp) :: s(3)
+      integer :: j, p
+      s = 0
+      do j = n, max(1, n - 2), -1
+         s(n - j + 1) = g(j)*d(j)
+      end do
+      do j = n - 3, 1, -1
+         p = mod(n - j, 3) + 1
+         s(p) = s(p) + g(j)*d(j)
+      end do
+      gd = (s(1) + s(2)) + s(3)
+   end function work_rows
 
    !> One row of a substitution, b - o3 x3 - o2 x2 - o1 x1, with x1 the nearest value:
    !> subtracted last, it is the only input the row waits for.

@@ -28,7 +28,7 @@ module beamstops_band_solve_lockstep
    private
    public :: lockstep_forward, lockstep_energy_dots, lockstep_back, lockstep_matvec, lockstep_dot
    public :: lockstep_rhs, lockstep_update, lockstep_matvec_rhs, lockstep_periodic_rows
-   public :: lockstep_back_edge, lockstep_back_update, lockstep_matvec_rhs_forward
+   public :: lockstep_back_edge, lockstep_back_update, lockstep_matvec_rhs_forward, lockstep_load_work
    public :: lockstep_min_unknowns, lockstep_work_columns, lockstep_lanes
 
    !> Fewest unknowns these routines handle (J >= 4).
@@ -237,7 +237,7 @@ contains
    !> the shadow of the substitution's chain instead of a pass of its own, and x itself is not
    !> stored (the update is its only use). Per lane the same operations as lockstep_back then
    !> lockstep_update (the update of a row needs only that row).
-   pure subroutine lockstep_back_update(solver, b, c, z, d, u)
+   pure subroutine lockstep_back_update(solver, b, c, z, g, d, u, gd)
       !> Solver from prepare_solver.
       type(band_solver), intent(in) :: solver
       !> D^{-2} w (lanes, n) with its last kd rows from lockstep_back_edge (left as it is).
@@ -246,9 +246,14 @@ contains
       real(wp), intent(in) :: c(lockstep_lanes)
       !> z = A^{-1} e_tip (n).
       real(wp), intent(in) :: z(solver%n)
+      !> Load vectors (lanes, n).
+      real(wp), intent(in) :: g(lockstep_lanes, solver%n)
       !> d^{n-1} and u^n on entry, d^n and u^{n+1} on return (lanes, n).
       real(wp), intent(inout) :: d(lockstep_lanes, solver%n), u(lockstep_lanes, solver%n)
+      !> g.d^n of every lane (lanes; beamstops_band_solve's load_work_product).
+      real(wp), intent(out) :: gd(lockstep_lanes)
       real(wp) :: xa(lockstep_lanes), xb(lockstep_lanes), xc(lockstep_lanes)
+      real(wp) :: ga(lockstep_lanes), gb(lockstep_lanes), gc(lockstep_lanes)
       integer :: i, k, n
       n = solver%n
       associate (off => solver%off)
@@ -260,10 +265,13 @@ contains
             xc(k) = b(k, n - 2)
             d(k, n) = d(k, n) + xa(k) + c(k)*z(n)
             u(k, n) = u(k, n) + d(k, n)
+            ga(k) = g(k, n)*d(k, n)
             d(k, n - 1) = d(k, n - 1) + xb(k) + c(k)*z(n - 1)
             u(k, n - 1) = u(k, n - 1) + d(k, n - 1)
+            gb(k) = g(k, n - 1)*d(k, n - 1)
             d(k, n - 2) = d(k, n - 2) + xc(k) + c(k)*z(n - 2)
             u(k, n - 2) = u(k, n - 2) + d(k, n - 2)
+            gc(k) = g(k, n - 2)*d(k, n - 2)
          end do
          do i = n - kd, 3, -3
 !GCC$ ivdep
@@ -272,12 +280,15 @@ contains
                xa(k) = b(k, i) - off(1, i + 3)*xa(k) - off(2, i + 2)*xb(k) - off(3, i + 1)*xc(k)
                d(k, i) = d(k, i) + xa(k) + c(k)*z(i)
                u(k, i) = u(k, i) + d(k, i)
+               ga(k) = ga(k) + g(k, i)*d(k, i)
                xb(k) = b(k, i - 1) - off(1, i + 2)*xb(k) - off(2, i + 1)*xc(k) - off(3, i)*xa(k)
                d(k, i - 1) = d(k, i - 1) + xb(k) + c(k)*z(i - 1)
                u(k, i - 1) = u(k, i - 1) + d(k, i - 1)
+               gb(k) = gb(k) + g(k, i - 1)*d(k, i - 1)
                xc(k) = b(k, i - 2) - off(1, i + 1)*xc(k) - off(2, i)*xa(k) - off(3, i - 1)*xb(k)
                d(k, i - 2) = d(k, i - 2) + xc(k) + c(k)*z(i - 2)
                u(k, i - 2) = u(k, i - 2) + d(k, i - 2)
+               gc(k) = gc(k) + g(k, i - 2)*d(k, i - 2)
             end do
          end do
          if (i >= 1) then
@@ -287,6 +298,7 @@ contains
                xa(k) = b(k, i) - off(1, i + 3)*xa(k) - off(2, i + 2)*xb(k) - off(3, i + 1)*xc(k)
                d(k, i) = d(k, i) + xa(k) + c(k)*z(i)
                u(k, i) = u(k, i) + d(k, i)
+               ga(k) = ga(k) + g(k, i)*d(k, i)
             end do
          end if
          if (i - 1 >= 1) then
@@ -296,10 +308,65 @@ contains
                xb(k) = b(k, i - 1) - off(1, i + 2)*xb(k) - off(2, i + 1)*xc(k) - off(3, i)*xa(k)
                d(k, i - 1) = d(k, i - 1) + xb(k) + c(k)*z(i - 1)
                u(k, i - 1) = u(k, i - 1) + d(k, i - 1)
+               gb(k) = gb(k) + g(k, i - 1)*d(k, i - 1)
             end do
          end if
       end associate
+!GCC$ ivdep
+!GCC$ vector
+      do k = 1, lockstep_lanes
+         gd(k) = (ga(k) + gb(k)) + gc(k)
+      end do
    end subroutine lockstep_back_update
+
+   !> g.d of every lane in the order of beamstops_band_solve's load_work_product (row j in sum
+   !> mod(n - j, 3) + 1 from the last row down, then (s1 + s2) + s3), n >= kd: for the loops whose
+   !> update does not ride on the back substitution (lockstep_back_update takes it there).
+   pure subroutine lockstep_load_work(n, g, d, gd)
+      !> Unknowns.
+      integer, intent(in) :: n
+      !> Load vectors and d (lanes, n).
+      real(wp), intent(in) :: g(lockstep_lanes, n), d(lockstep_lanes, n)
+      !> The products (lanes).
+      real(wp), intent(out) :: gd(lockstep_lanes)
+      real(wp) :: ga(lockstep_lanes), gb(lockstep_lanes), gc(lockstep_lanes)
+      integer :: i, k
+!GCC$ ivdep
+!GCC$ vector
+      do k = 1, lockstep_lanes
+         ga(k) = g(k, n)*d(k, n)
+         gb(k) = g(k, n - 1)*d(k, n - 1)
+         gc(k) = g(k, n - 2)*d(k, n - 2)
+      end do
+      do i = n - kd, 3, -3
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            ga(k) = ga(k) + g(k, i)*d(k, i)
+            gb(k) = gb(k) + g(k, i - 1)*d(k, i - 1)
+            gc(k) = gc(k) + g(k, i - 2)*d(k, i - 2)
+         end do
+      end do
+      if (i >= 1) then
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            ga(k) = ga(k) + g(k, i)*d(k, i)
+         end do
+      end if
+      if (i - 1 >= 1) then
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            gb(k) = gb(k) + g(k, i - 1)*d(k, i - 1)
+         end do
+      end if
+!GCC$ ivdep
+!GCC$ vector
+      do k = 1, lockstep_lanes
+         gd(k) = (ga(k) + gb(k)) + gc(k)
+      end do
+   end subroutine lockstep_load_work
 
    !> y = A x of every lane for a symmetric band matrix by diagonals (beamstops_band_solve's
    !> diagonal_matvec, n >= 2 kd + 1).

@@ -630,8 +630,8 @@ contains
             call lockstep_back_edge(ops%solver, ms%rhs(:, :, c))
             call lanes_contact(lanes(c), law, ms%u(:, tip, c), ms%d(:, tip, c), ms%rhs(:, tip, c), z_tip, model%dt2, &
                & model%beta)
-            call lockstep_back_update(ops%solver, ms%rhs(:, :, c), lanes(c)%c, model%z, ms%d(:, :, c), ms%u(:, :, c))
-            call lockstep_dot(n, ms%g(:, :, c), ms%d(:, :, c), ms%partial, lanes(c)%gd, model%dt2)
+            call lockstep_back_update(ops%solver, ms%rhs(:, :, c), lanes(c)%c, model%z, ms%g(:, :, c), ms%d(:, :, c), &
+               & ms%u(:, :, c), lanes(c)%gd)
             call lanes_close(lanes(c), law, ms%u(:, tip, c), ms%d(:, tip, c))
          end do
          ! the shock log and statistics of each member that keeps them (its quiet samples lane by

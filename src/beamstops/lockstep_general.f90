@@ -27,7 +27,8 @@ module beamstops_lockstep_general
    use beamstops_observe_lanes, only: observer_lanes, gather_observers, scatter_observers, observe_lanes
    use beamstops_band_solve, only: energy_dots
    use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_matvec_rhs, lockstep_forward, &
-      & lockstep_matvec_rhs_forward, lockstep_energy_dots, lockstep_back, lockstep_update, lockstep_dot, lockstep_matvec
+      & lockstep_matvec_rhs_forward, lockstep_energy_dots, lockstep_back, lockstep_update, lockstep_dot, lockstep_matvec, &
+      & lockstep_load_work
    use beamstops_band_solve_lockstep_general, only: lockstep_matvec_rhs_damped, lockstep_row
    use beamstops_contact_mass_redistribution, only: massless_reaction, equilibrium_rows
    use beamstops_lockstep_members, only: operators_type, members_type, lane, chunk, contact_law, close_steps, &
@@ -163,7 +164,7 @@ contains
             lo = (c - 1)*lockstep_lanes + 1
             hi = c*lockstep_lanes
             call lockstep_update(n, ms%rhs(:, :, c), ms%c(lo:hi), model%z, ms%d(:, :, c), ms%u(:, :, c))
-            call lockstep_dot(n, ms%g(:, :, c), ms%d(:, :, c), ms%partial, ms%gd(lo:hi), model%dt2)
+            call lockstep_load_work(n, ms%g(:, :, c), ms%d(:, :, c), ms%gd(lo:hi))
             ms%u_tip(lo:hi) = ms%u(:, tip, c)
             ms%d_tip(lo:hi) = ms%d(:, tip, c)
             if (massless) then

@@ -228,7 +228,7 @@ contains
       class(recorder_type), intent(inout) :: recorder
       integer(ik), intent(in) :: last
       integer(ik) :: step, next_record, next_snapshot
-      real(wp) :: sigma_next, weight, held_weight, d_tip_free, c
+      real(wp) :: sigma_next, weight, held_weight, gd, c
       real(wp) :: sums(4)
       logical :: held
       type(tip_outcome) :: outcome
@@ -237,7 +237,7 @@ contains
       call first_events(scene, state%step, next_record, next_snapshot)
       held = .false.
       held_weight = 0
-      d_tip_free = 0
+      gd = 0
       ! sums: u.S u, d.S u and d.M d of this step's forward pass, and u.S u of the one before
       sums = 0
       call start_loads(loads, state%step + 1, model%dt, scene%omega, scene%centered_load)
@@ -249,13 +249,12 @@ contains
             & state%u, state%d, model%dt2*weight, model%dt2, spring_term(scene, model, state), &
             & (held .and. step - 1 == next_record) .or. step == next_record, &
             & state%su, state%rhs, sums(1), sums(2), sums(3))
-         if (held) call settle_held(scene, model, state, recorder, step - 1, outcome, d_tip_free, held_weight, sums, &
+         if (held) call settle_held(scene, model, state, recorder, step - 1, outcome, gd, held_weight, sums, &
             & next_record, next_snapshot)
          sums(4) = sums(1)
          call back_substitution_edge(model%solver, state%rhs)
          call tip_law(scene, model, state, outcome, c)
-         call back_substitution_update(model%solver, state%rhs, c, model%z, state%d, state%u)
-         d_tip_free = state%d(model%tip)
+         call back_substitution_update(model%solver, state%rhs, c, model%z, model%load, state%d, state%u, gd)
          call fix_tip(scene, model, state, outcome%contact, outcome%tip_value, outcome%u_tip_prev, .true.)
          call shift_loads(state, sigma_next)
          held = .true.
@@ -266,16 +265,16 @@ contains
       if (held) then
          if (last == next_record) call energy_dots(model%mass_diagonals, state%u, state%d, state%su, sums(1), sums(2), &
             & sums(3))
-         call settle_held(scene, model, state, recorder, last, outcome, d_tip_free, held_weight, sums, &
+         call settle_held(scene, model, state, recorder, last, outcome, gd, held_weight, sums, &
             & next_record, next_snapshot)
       end if
    end subroutine advance_fused
 
    !> The books of step n of advance_fused, done while the forward pass of step n+1 runs (it
-   !> leaves u^{n+1} and d^n alone): g.d^n with d^n_tip as the update left it (before fix_tip,
-   !> as in tip_step), settle_tip, the observer, the record row (its energy from `sums`) and the
+   !> leaves u^{n+1} and d^n alone): settle_tip with g.d^n (taken by the back substitution's
+   !> update, d^n_tip as the update left it, before fix_tip, as in tip_step), the observer, the record row (its energy from `sums`) and the
    !> snapshot.
-   subroutine settle_held(scene, model, state, recorder, step, outcome, d_tip_free, weight, sums, next_record, &
+   subroutine settle_held(scene, model, state, recorder, step, outcome, gd, weight, sums, next_record, &
       & next_snapshot)
       !> Scene.
       type(scene_type), intent(in) :: scene
@@ -289,17 +288,13 @@ contains
       integer(ik), intent(in) :: step
       !> The step's contact, reaction and tip values (tip_update).
       type(tip_outcome), intent(in) :: outcome
-      !> d^n_tip before fix_tip and the load average weight of the step.
-      real(wp), intent(in) :: d_tip_free, weight
+      !> g.d^n (back_substitution_update) and the load average weight of the step.
+      real(wp), intent(in) :: gd, weight
       !> u^{n+1}.S u^{n+1}, d^n.S u^{n+1}, d^n.M d^n and u^n.S u^n (when step n is recorded).
       real(wp), intent(in) :: sums(4)
       !> The next step recorded and the next snapshot, moved on past step n.
       integer(ik), intent(inout) :: next_record, next_snapshot
-      real(wp) :: gd, d_tip, r_prev, row(n_columns)
-      d_tip = state%d(model%tip)
-      state%d(model%tip) = d_tip_free
-      gd = dot(model%load, state%d)
-      state%d(model%tip) = d_tip
+      real(wp) :: r_prev, row(n_columns)
       r_prev = state%reaction
       call settle_tip(scene, model, state, outcome, gd, weight)
       if (state%observer%takes(real(step + 1, wp)*model%dt)) call state%observer%tip(real(step + 1, wp)*model%dt, &

@@ -8,7 +8,7 @@ module beamstops_span_step
    use beamstops_scene, only: scene_type, law_signorini
    use beamstops_model, only: model_type
    use beamstops_state, only: state_type
-   use beamstops_band_solve, only: diagonal_matvec, diagonal_row, dot, energy_dots
+   use beamstops_band_solve, only: diagonal_matvec, diagonal_row, load_work_product, energy_dots
    use beamstops_contact_mass_redistribution, only: massless_reaction
    use beamstops_contact_tip_contact, only: update
    use beamstops_contact_span_stops, only: span_contact, span_correction, span_settle, span_energy, &
@@ -130,7 +130,7 @@ contains
       else
          call update(state%rhs, 0.0_wp, model%z, state%d, state%u)
       end if
-      gd = dot(model%load, state%d)
+      gd = load_work_product(model%load, state%d)
       contact = state%span%contact
       if (enforce) call span_settle(model%stops, state%span, state%u, state%d, state%max_violation, &
          & .not. model%redistributed)

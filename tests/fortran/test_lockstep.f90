@@ -21,10 +21,10 @@ module test_lockstep
    use beamstops_band, only: band_matvec
    use beamstops_band_solve, only: band_solver, band_diagonals, prepare_solver, prepare_diagonals, diagonal_matvec, &
       & forward_substitution, energy_dots, back_substitution, dot, &
-      & back_substitution_edge, back_substitution_update
+      & back_substitution_edge, back_substitution_update, load_work_product
    use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_work_columns, lockstep_matvec, &
       & lockstep_forward, lockstep_energy_dots, lockstep_back, lockstep_dot, lockstep_update, lockstep_back_edge, &
-      & lockstep_back_update, lockstep_matvec_rhs, lockstep_periodic_rows, lockstep_matvec_rhs_forward
+      & lockstep_back_update, lockstep_matvec_rhs, lockstep_periodic_rows, lockstep_matvec_rhs_forward, lockstep_load_work
    use beamstops_contact_tip_contact, only: update
    use test_support, only: base_scene
    implicit none
@@ -386,7 +386,9 @@ contains
             call lockstep_back_edge(solver, b)
             y = d
             ub = u
-            call lockstep_back_update(solver, b, c, model%z, y, ub)
+            ! (with g.d^n taken on the way: w2 stands for the load vectors)
+            call random_number(w2)
+            call lockstep_back_update(solver, b, c, model%z, w2, y, ub, dd)
             do k = 1, lanes
                v = x(k, :)
                call back_substitution(solver, v)
@@ -395,8 +397,19 @@ contains
                call update(v, c(k), model%z, w, uk)
                if (.not. (all(same_bits(w, y(k, :))) .and. all(same_bits(uk, ub(k, :))))) &
                   & call test_failed(error, where//'back substitution with the update, d and u, lane '//int_text(k))
+               if (.not. same_bits(load_work_product(w2(k, :), w), dd(k))) &
+                  & call test_failed(error, where//'g.d taken by the back substitution, lane '//int_text(k))
                ! and the one-member version of it (advance_fused's)
-               call same_back_update(solver, model%z, x(k, :), c(k), d(k, :), u(k, :), where, error)
+               call same_back_update(solver, model%z, x(k, :), c(k), w2(k, :), d(k, :), u(k, :), where, error)
+            end do
+            ! g.d in the back substitution's order on its own (the general loop's), and that order
+            ! against the sum itself, to round-off (n eps times the sum of |terms|)
+            call lockstep_load_work(n, w2, y, dd)
+            do k = 1, lanes
+               if (.not. same_bits(load_work_product(w2(k, :), y(k, :)), dd(k))) &
+                  & call test_failed(error, where//'g.d in the order of the back substitution, lane '//int_text(k))
+               if (abs(dd(k) - sum(w2(k, :)*y(k, :))) > n*epsilon(1.0_wp)*sum(abs(w2(k, :)*y(k, :)))) &
+                  & call test_failed(error, where//'g.d against the sum of its terms, lane '//int_text(k))
             end do
             if (allocated(error)) return
          end do
@@ -413,19 +426,20 @@ contains
          call random_number(v)
          call random_number(w)
          call random_number(uk)
-         call same_back_update(solver, model%z, v - 0.5_wp, 0.3_wp, w, uk, 'J = '//int_text(a)//': ', error)
+         call same_back_update(solver, model%z, v - 0.5_wp, 0.3_wp, w + 1, w, uk, 'J = '//int_text(a)//': ', error)
          if (allocated(error)) return
       end do
    end subroutine test_kernels
 
    !> back_substitution_edge then back_substitution_update (x not stored, the update riding on
-   !> the substitution) against back_substitution then update: d and u to the bit.
-   subroutine same_back_update(solver, z, b, c, d, u, where, error)
+   !> the substitution) against back_substitution then update: d and u to the bit, and g.d^n
+   !> as load_work_product takes it.
+   subroutine same_back_update(solver, z, b, c, g, d, u, where, error)
       type(band_solver), intent(in) :: solver
-      real(wp), intent(in) :: z(:), b(:), c, d(:), u(:)
+      real(wp), intent(in) :: z(:), b(:), c, g(:), d(:), u(:)
       character(len=*), intent(in) :: where
       type(error_type), allocatable, intent(inout) :: error
-      real(wp) :: x(size(b)), d1(size(b)), u1(size(b)), d2(size(b)), u2(size(b))
+      real(wp) :: x(size(b)), d1(size(b)), u1(size(b)), d2(size(b)), u2(size(b)), gd
       x = b
       call back_substitution(solver, x)
       d1 = d
@@ -435,9 +449,11 @@ contains
       d2 = d
       u2 = u
       call back_substitution_edge(solver, x)
-      call back_substitution_update(solver, x, c, z, d2, u2)
+      call back_substitution_update(solver, x, c, z, g, d2, u2, gd)
       if (.not. (all(same_bits(d1, d2)) .and. all(same_bits(u1, u2)))) &
          & call test_failed(error, where//'one-member back substitution with the update, d and u')
+      if (.not. same_bits(load_work_product(g, d1), gd)) &
+         & call test_failed(error, where//'one-member back substitution with the update, g.d')
    end subroutine same_back_update
 
    subroutine test_one(error)

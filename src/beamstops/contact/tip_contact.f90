@@ -10,7 +10,7 @@ module beamstops_contact_tip_contact
    use beamstops_scene, only: scene_type, law_none, law_signorini, law_compliance
    use beamstops_model, only: model_type
    use beamstops_state, only: state_type
-   use beamstops_band_solve, only: dot, diagonal_row
+   use beamstops_band_solve, only: load_work_product, diagonal_row
    use beamstops_contact_mass_redistribution, only: massless_reaction
    use beamstops_contact_tip_projection, only: project_tip
    use beamstops_contact_compliance, only: compliance_step
@@ -119,7 +119,7 @@ contains
       call tip_law(scene, model, state, outcome, c)
       call update(state%rhs, c, model%z, state%d, state%u)
       r_prev = state%reaction
-      gd = dot(model%load, state%d)
+      gd = load_work_product(model%load, state%d)
       call fix_tip(scene, model, state, outcome%contact, outcome%tip_value, outcome%u_tip_prev, .true.)
       call settle_tip(scene, model, state, outcome, gd, weight)
       call shift_loads(state, sigma_next)
@@ -179,7 +179,7 @@ contains
       r_step = massless_reaction(model%beta, weight, model%load(model%tip), s_u, s_d_prev, &
          & diagonal_row(model%stiffness_diagonals, state%d, model%tip))
       r_prev = state%reaction
-      call close_step(scene, model, state, contact, tip_value, dot(model%load, state%d), weight, r_step, &
+      call close_step(scene, model, state, contact, tip_value, load_work_product(model%load, state%d), weight, r_step, &
          & d_tip_prev, u_tip_prev, sigma_next, .false.)
       if (.not. contact) state%reaction = 0
    end subroutine tip_step_massless
