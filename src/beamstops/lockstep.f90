@@ -41,7 +41,7 @@ module beamstops_lockstep
    use beamstops_band, only: band_matvec
    use beamstops_band_solve, only: prepare_solver, prepare_diagonals, energy_dots
    use beamstops_band_solve_lockstep, only: lockstep_forward, lockstep_energy_dots, lockstep_back_edge, &
-      & lockstep_back_update, lockstep_matvec, lockstep_dot, lockstep_min_unknowns, lockstep_work_columns, &
+      & lockstep_back_update, lockstep_matvec, lockstep_min_unknowns, lockstep_work_columns, &
       & lockstep_lanes, lockstep_matvec_rhs, lockstep_periodic_rows, lockstep_matvec_rhs_forward
    use beamstops_lockstep_lanes, only: lanes_type, lanes_restart_loads, lanes_next_loads, lanes_begin_step, &
       & lanes_contact, lanes_close
@@ -567,11 +567,10 @@ contains
       type(lanes_type), allocatable :: lanes(:)
       type(observer_lanes), allocatable :: watch(:)
       integer(ik) :: step, next_record, next_snapshot, load_k
-      integer :: k, c, n, tip, law
+      integer :: k, c, tip, law
       logical :: energy_wanted, pending, observing, restart
       real(wp) :: z_tip, sums(3)
 
-      n = ms%n
       tip = model%tip
       z_tip = model%z(tip)
       law = scenes(1)%law
