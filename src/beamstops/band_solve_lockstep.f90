@@ -539,7 +539,10 @@ contains
    !> forward substitution follows the product six rows at a time, so that its chain (one
    !> multiply-add a row) runs while the product of the next six rows is computed instead of
    !> after the whole product. Each row's expressions are those of the two routines (the same
-   !> bits); rhs is returned as lockstep_forward leaves it (D^{-2} w).
+   !> bits); rhs is returned as lockstep_forward leaves it (D^{-2} w). The rows are written out
+   !> here rather than taken from helpers shared with those routines: gfortran 12 does not inline
+   !> such helpers, and calls per block of six rows made the pass about 30 % slower at J = 100
+   !> (bench_lockstep, measured against this version).
    pure subroutine lockstep_matvec_rhs_forward(stiffness, solver, rows, u, a, g, b, spring, su, rhs)
       !> S by diagonals and the factor of A.
       type(band_diagonals), intent(in) :: stiffness
