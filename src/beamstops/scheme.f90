@@ -214,10 +214,10 @@ contains
    !> products and dot products vectorized over S and M by diagonals; the load averages by
    !> rotation (load_rotation) instead of a sine a step. S u^{n+1} is computed once, by the next
    !> forward pass (plain_forward_pass). The contact law runs as soon as the back substitution's
-   !> edge rows give the tip value; the update then rides on the rest of the substitution
-   !> (back_substitution_update), so that the next forward pass finds its first rows updated
-   !> last and waits only for the tip set on the stop and the load averages moved on. The books
-   !> of the step (g.d^n, the ledger, the observer, the record and the snapshot: settle_held)
+   !> edge rows give the tip value; the update and the terms of g.d^n then ride on the rest of
+   !> the substitution (back_substitution_update), so that the next forward pass finds its first
+   !> rows updated last and waits only for the tip set on the stop and the load averages moved
+   !> on. The books of the step (the ledger, the observer, the record and the snapshot: settle_held)
    !> wait until the next forward pass is under way, where they run in the shadow of its chain;
    !> the record's energy comes from that pass's dot products. Same operations on the same values
    !> as tip_step then close_step: the same bits.
