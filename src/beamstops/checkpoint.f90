@@ -18,7 +18,7 @@ module beamstops_checkpoint
    public :: write_checkpoint, read_checkpoint, checkpoint_path, temporary_path, scene_signature, is_checkpoint
    ! (the reduced model's checkpoints, beamstops_reduced_checkpoint, share the file's frame)
    public :: create_checkpoint, commit_checkpoint, open_checkpoint, close_checkpoint, write_observer, read_observer
-   public :: write_scene_text, signature_text
+   public :: write_scene_text
 
 contains
 

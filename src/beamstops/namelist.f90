@@ -445,8 +445,12 @@ contains
             value = value(index(value, '=') + 1:)
             ! More values than a list key holds: out of range, not malformed.
             capacity = 0
-            if (g == 3 .and. (key == 'lower' .or. key == 'upper' .or. key == 'nodes' .or. key == 'x')) capacity = max_stops
-            if (g == 4 .and. (key == 'ratio' .or. key == 'modes')) capacity = 2
+            select case (trim(group_names(g)))
+            case ('stops')
+               if (key == 'lower' .or. key == 'upper' .or. key == 'nodes' .or. key == 'x') capacity = max_stops
+            case ('damping')
+               if (key == 'ratio' .or. key == 'modes') capacity = 2
+            end select
             if (capacity > 0) then
                count = value_count(value)
                if (count > capacity) then

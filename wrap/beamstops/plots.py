@@ -329,7 +329,8 @@ def save(result: Result, path: str | os.PathLike[str], kind: str = "tip", dpi: i
     The format follows the file's extension; a name without one gets matplotlib's default
     format's (``savefig.format``, .png), and the path given back has it. A folder is refused
     (IsADirectoryError). ``kind='animation'`` writes the beam moving between its stops to a .gif
-    (or .mp4 with ffmpeg; a name without extension gets .gif); its options are ``frames`` (at most this many, default 200) and ``fps``.
+    (or .mp4 with ffmpeg; a name without extension gets .gif); its options are ``frames`` (at
+    most this many, default 200) and ``fps``.
     """
     if names_folder(path):
         raise IsADirectoryError(f"{os.fspath(path)}: is a folder; name the image file to write, e.g. "
