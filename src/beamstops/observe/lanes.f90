@@ -98,32 +98,24 @@ contains
       real(wp), intent(in) :: t
       !> Tip displacement (m), reaction and energy taken so far per unit mass, of every lane.
       real(wp), intent(in) :: u_tip(lockstep_lanes), reaction(lockstep_lanes), dissipated(lockstep_lanes)
-      logical :: quiet(lockstep_lanes), other(lockstep_lanes), test(lockstep_lanes, 8)
-      real(wp) :: x
+      logical :: quiet(lockstep_lanes), other(lockstep_lanes)
+      real(wp) :: x, pass(lockstep_lanes)
       integer :: i
       ! quiet: taken, no reaction, no energy, before the deadline and the batch's end, in the run's
-      ! bin (tip_sample's bin is int(x), x clamped to [0, bins - 1/2]), finite. Each compare is
-      ! stored on its own, then the masks combined: compares joined by .and. become branches (a
-      ! compare may trap, so the compiler keeps them in order), which do not vectorize.
+      ! bin (tip_sample's bin is int(x), x clamped to [0, bins - 1/2]), finite. Each test gives 1
+      ! or 0 by merge and the tests are multiplied: whole-register compares and selects, where
+      ! tests joined by .and. become a branch per lane and test (a compare may trap, so the
+      ! compiler keeps them in order).
 !GCC$ ivdep
 !GCC$ vector
       do i = 1, lockstep_lanes
          x = min(max((u_tip(i) - lanes%lower(i))*lanes%scale(i), 0.0_wp), lanes%top(i))
-         test(i, 1) = t <= lanes%t_stop(i)
-         test(i, 2) = reaction(i) == 0
-         test(i, 3) = dissipated(i) == lanes%seen(i)
-         test(i, 4) = lanes%left(i) > 0
-         test(i, 5) = t < lanes%next_edge(i)
-         test(i, 6) = x >= lanes%bin_low(i)
-         test(i, 7) = x < lanes%bin_low(i) + 1
-         test(i, 8) = abs(u_tip(i)) <= huge(1.0_wp)
-      end do
-!GCC$ ivdep
-!GCC$ vector
-      do i = 1, lockstep_lanes
-         quiet(i) = test(i, 1) .and. test(i, 2) .and. test(i, 3) .and. test(i, 4) .and. test(i, 5) .and. test(i, 6) &
-            & .and. test(i, 7) .and. test(i, 8)
-         other(i) = test(i, 1) .and. .not. quiet(i)
+         pass(i) = merge(1.0_wp, 0.0_wp, reaction(i) == 0)*merge(1.0_wp, 0.0_wp, dissipated(i) == lanes%seen(i)) &
+            & *merge(1.0_wp, 0.0_wp, lanes%left(i) > 0)*merge(1.0_wp, 0.0_wp, t < lanes%next_edge(i)) &
+            & *merge(1.0_wp, 0.0_wp, x >= lanes%bin_low(i))*merge(1.0_wp, 0.0_wp, x < lanes%bin_low(i) + 1) &
+            & *merge(1.0_wp, 0.0_wp, abs(u_tip(i)) <= huge(1.0_wp))*merge(1.0_wp, 0.0_wp, t <= lanes%t_stop(i))
+         quiet(i) = pass(i) > 0
+         other(i) = t <= lanes%t_stop(i) .neqv. quiet(i)
       end do
 !GCC$ ivdep
 !GCC$ vector
