@@ -484,7 +484,7 @@ contains
       real(wp), intent(in), optional :: rows(2*kd + 1, 2)
       integer :: j, k, n
       n = stiffness%n
-      call matvec_rhs_first_rows(stiffness, u, a, g, b, su, rhs)
+      call matvec_rhs_first_rows(n, stiffness%a, u, a, g, b, su, rhs)
       if (present(rows)) then
          call matvec_rhs_periodic_rows(n, rows, u, a, g, b, su, rhs)
       else
@@ -500,7 +500,7 @@ contains
             end do
          end associate
       end if
-      call matvec_rhs_last_rows(stiffness, u, a, g, b, spring, su, rhs)
+      call matvec_rhs_last_rows(n, stiffness%a, u, a, g, b, spring, su, rhs)
    end subroutine lockstep_matvec_rhs
 
    !> The interior rows kd+1 .. n-kd of lockstep_matvec_rhs with period-2 coefficients `rows`:
@@ -539,10 +539,7 @@ contains
    !> forward substitution follows the product six rows at a time, so that its chain (one
    !> multiply-add a row) runs while the product of the next six rows is computed instead of
    !> after the whole product. Each row's expressions are those of the two routines (the same
-   !> bits); rhs is returned as lockstep_forward leaves it (D^{-2} w). The rows are written out
-   !> here rather than taken from helpers shared with those routines: gfortran 12 does not inline
-   !> such helpers, and calls per block of six rows made the pass about 30 % slower at J = 100
-   !> (bench_lockstep, measured against this version).
+   !> bits); rhs is returned as lockstep_forward leaves it (D^{-2} w).
    pure subroutine lockstep_matvec_rhs_forward(stiffness, solver, rows, u, a, g, b, spring, su, rhs)
       !> S by diagonals and the factor of A.
       type(band_diagonals), intent(in) :: stiffness
@@ -557,46 +554,31 @@ contains
       real(wp), intent(out) :: su(lockstep_lanes, stiffness%n)
       !> D^{-2} w, w the forward substitution of rhs = a g - b S u + spring e_{n-1} (lanes, n).
       real(wp), intent(out) :: rhs(lockstep_lanes, stiffness%n)
+      call matvec_rhs_forward_rows(stiffness%n, stiffness%a, solver%off, solver%inv_d2, rows, u, a, g, b, spring, su, rhs)
+   end subroutine lockstep_matvec_rhs_forward
+
+   !> The rows of lockstep_matvec_rhs_forward, all in one routine of explicit-shape arrays (as
+   !> beamstops_band_solve's forward_rows): every array at a fixed stride, so that the rows of a
+   !> block address the factor from one register (through the descriptors of solver%off and
+   !> stiffness%a, gfortran 12 kept an address per row and coefficient, 24 a block, and spilled
+   !> them: about 20 % slower, bench_lockstep), and the edge routines inlined.
+   pure subroutine matvec_rhs_forward_rows(n, s, off, inv_d2, rows, x, a, g, b, spring, y, rhs)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: s(n, 0:kd), off(kd, n), inv_d2(n), rows(2*kd + 1, 2)
+      real(wp), intent(in) :: x(lockstep_lanes, n), a(lockstep_lanes), g(lockstep_lanes, n), b, spring(lockstep_lanes)
+      real(wp), intent(out) :: y(lockstep_lanes, n), rhs(lockstep_lanes, n)
       real(wp) :: p1, p2, p3, p4, p5, p6, p7, q1, q2, q3, q4, q5, q6, q7
       real(wp) :: xa(lockstep_lanes), xb(lockstep_lanes), xc(lockstep_lanes)
-      integer :: i, j, k, n
-      n = stiffness%n
+      integer :: i, j, k
       p1 = rows(1, 1); p2 = rows(2, 1); p3 = rows(3, 1); p4 = rows(4, 1); p5 = rows(5, 1); p6 = rows(6, 1)
       p7 = rows(7, 1)
       q1 = rows(1, 2); q2 = rows(2, 2); q3 = rows(3, 2); q4 = rows(4, 2); q5 = rows(5, 2); q6 = rows(6, 2)
       q7 = rows(7, 2)
-      call matvec_rhs_first_rows(stiffness, u, a, g, b, su, rhs)
-      associate (off => solver%off, inv_d2 => solver%inv_d2, x => u, y => su)
-         call forward_first_rows(off, inv_d2, n, rhs, xa, xb, xc)
-         j = kd + 1
-         do while (j + 5 <= n - kd)
-            do i = j, j + 4, 2
-!GCC$ ivdep
-!GCC$ vector
-               do k = 1, lockstep_lanes
-                  y(k, i) = p1*x(k, i - 3) + p2*x(k, i - 2) + p3*x(k, i - 1) + p4*x(k, i) + p5*x(k, i + 1) &
-                     & + p6*x(k, i + 2) + p7*x(k, i + 3)
-                  rhs(k, i) = a(k)*g(k, i) - b*y(k, i)
-                  y(k, i + 1) = q1*x(k, i - 2) + q2*x(k, i - 1) + q3*x(k, i) + q4*x(k, i + 1) + q5*x(k, i + 2) &
-                     & + q6*x(k, i + 3) + q7*x(k, i + 4)
-                  rhs(k, i + 1) = a(k)*g(k, i + 1) - b*y(k, i + 1)
-               end do
-            end do
-            do i = j, j + 3, 3
-!GCC$ ivdep
-!GCC$ vector
-               do k = 1, lockstep_lanes
-                  xa(k) = rhs(k, i) - off(1, i)*xa(k) - off(2, i)*xb(k) - off(3, i)*xc(k)
-                  rhs(k, i) = xa(k)*inv_d2(i)
-                  xb(k) = rhs(k, i + 1) - off(1, i + 1)*xb(k) - off(2, i + 1)*xc(k) - off(3, i + 1)*xa(k)
-                  rhs(k, i + 1) = xb(k)*inv_d2(i + 1)
-                  xc(k) = rhs(k, i + 2) - off(1, i + 2)*xc(k) - off(2, i + 2)*xa(k) - off(3, i + 2)*xb(k)
-                  rhs(k, i + 2) = xc(k)*inv_d2(i + 2)
-               end do
-            end do
-            j = j + 6
-         end do
-         do i = j, n - kd - 1, 2
+      call matvec_rhs_first_rows(n, s, x, a, g, b, y, rhs)
+      call forward_first_rows(off, inv_d2, n, rhs, xa, xb, xc)
+      j = kd + 1
+      do while (j + 5 <= n - kd)
+         do i = j, j + 4, 2
 !GCC$ ivdep
 !GCC$ vector
             do k = 1, lockstep_lanes
@@ -608,22 +590,47 @@ contains
                rhs(k, i + 1) = a(k)*g(k, i + 1) - b*y(k, i + 1)
             end do
          end do
-         call matvec_rhs_last_rows(stiffness, u, a, g, b, spring, su, rhs)
-         do j = j, n - 2, 3
+         do i = j, j + 3, 3
 !GCC$ ivdep
 !GCC$ vector
             do k = 1, lockstep_lanes
-               xa(k) = rhs(k, j) - off(1, j)*xa(k) - off(2, j)*xb(k) - off(3, j)*xc(k)
-               rhs(k, j) = xa(k)*inv_d2(j)
-               xb(k) = rhs(k, j + 1) - off(1, j + 1)*xb(k) - off(2, j + 1)*xc(k) - off(3, j + 1)*xa(k)
-               rhs(k, j + 1) = xb(k)*inv_d2(j + 1)
-               xc(k) = rhs(k, j + 2) - off(1, j + 2)*xc(k) - off(2, j + 2)*xa(k) - off(3, j + 2)*xb(k)
-               rhs(k, j + 2) = xc(k)*inv_d2(j + 2)
+               xa(k) = rhs(k, i) - off(1, i)*xa(k) - off(2, i)*xb(k) - off(3, i)*xc(k)
+               rhs(k, i) = xa(k)*inv_d2(i)
+               xb(k) = rhs(k, i + 1) - off(1, i + 1)*xb(k) - off(2, i + 1)*xc(k) - off(3, i + 1)*xa(k)
+               rhs(k, i + 1) = xb(k)*inv_d2(i + 1)
+               xc(k) = rhs(k, i + 2) - off(1, i + 2)*xc(k) - off(2, i + 2)*xa(k) - off(3, i + 2)*xb(k)
+               rhs(k, i + 2) = xc(k)*inv_d2(i + 2)
             end do
          end do
-         call forward_last_rows(off, inv_d2, j, n, rhs, xa, xb, xc)
-      end associate
-   end subroutine lockstep_matvec_rhs_forward
+         j = j + 6
+      end do
+      do i = j, n - kd - 1, 2
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            y(k, i) = p1*x(k, i - 3) + p2*x(k, i - 2) + p3*x(k, i - 1) + p4*x(k, i) + p5*x(k, i + 1) &
+               & + p6*x(k, i + 2) + p7*x(k, i + 3)
+            rhs(k, i) = a(k)*g(k, i) - b*y(k, i)
+            y(k, i + 1) = q1*x(k, i - 2) + q2*x(k, i - 1) + q3*x(k, i) + q4*x(k, i + 1) + q5*x(k, i + 2) &
+               & + q6*x(k, i + 3) + q7*x(k, i + 4)
+            rhs(k, i + 1) = a(k)*g(k, i + 1) - b*y(k, i + 1)
+         end do
+      end do
+      call matvec_rhs_last_rows(n, s, x, a, g, b, spring, y, rhs)
+      do j = j, n - 2, 3
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            xa(k) = rhs(k, j) - off(1, j)*xa(k) - off(2, j)*xb(k) - off(3, j)*xc(k)
+            rhs(k, j) = xa(k)*inv_d2(j)
+            xb(k) = rhs(k, j + 1) - off(1, j + 1)*xb(k) - off(2, j + 1)*xc(k) - off(3, j + 1)*xa(k)
+            rhs(k, j + 1) = xb(k)*inv_d2(j + 1)
+            xc(k) = rhs(k, j + 2) - off(1, j + 2)*xc(k) - off(2, j + 2)*xa(k) - off(3, j + 2)*xb(k)
+            rhs(k, j + 2) = xc(k)*inv_d2(j + 2)
+         end do
+      end do
+      call forward_last_rows(off, inv_d2, j, n, rhs, xa, xb, xc)
+   end subroutine matvec_rhs_forward_rows
 
    !> Whether the interior rows kd+1 .. n-kd of a band matrix repeat with period 2, and the
    !> coefficients of the first two in the order of a row's products (A(j, j-3), A(j, j-2),
@@ -656,12 +663,11 @@ contains
    end function row_coefficients
 
    !> The first kd rows of lockstep_matvec_rhs.
-   pure subroutine matvec_rhs_first_rows(stiffness, x, a, g, b, y, rhs)
-      type(band_diagonals), intent(in) :: stiffness
-      real(wp), intent(in) :: x(lockstep_lanes, stiffness%n), a(lockstep_lanes), g(lockstep_lanes, stiffness%n), b
-      real(wp), intent(inout) :: y(lockstep_lanes, stiffness%n), rhs(lockstep_lanes, stiffness%n)
+   pure subroutine matvec_rhs_first_rows(n, s, x, a, g, b, y, rhs)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: s(n, 0:kd), x(lockstep_lanes, n), a(lockstep_lanes), g(lockstep_lanes, n), b
+      real(wp), intent(inout) :: y(lockstep_lanes, n), rhs(lockstep_lanes, n)
       integer :: k
-      associate (s => stiffness%a)
 !GCC$ ivdep
 !GCC$ vector
          do k = 1, lockstep_lanes
@@ -673,18 +679,15 @@ contains
             rhs(k, 2) = a(k)*g(k, 2) - b*y(k, 2)
             rhs(k, 3) = a(k)*g(k, 3) - b*y(k, 3)
          end do
-      end associate
    end subroutine matvec_rhs_first_rows
 
    !> The last kd rows of lockstep_matvec_rhs, and the spring term of the tip row n-1.
-   pure subroutine matvec_rhs_last_rows(stiffness, x, a, g, b, spring, y, rhs)
-      type(band_diagonals), intent(in) :: stiffness
-      real(wp), intent(in) :: x(lockstep_lanes, stiffness%n), a(lockstep_lanes), g(lockstep_lanes, stiffness%n), b, &
+   pure subroutine matvec_rhs_last_rows(n, s, x, a, g, b, spring, y, rhs)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: s(n, 0:kd), x(lockstep_lanes, n), a(lockstep_lanes), g(lockstep_lanes, n), b, &
          & spring(lockstep_lanes)
-      real(wp), intent(inout) :: y(lockstep_lanes, stiffness%n), rhs(lockstep_lanes, stiffness%n)
-      integer :: k, n
-      n = stiffness%n
-      associate (s => stiffness%a)
+      real(wp), intent(inout) :: y(lockstep_lanes, n), rhs(lockstep_lanes, n)
+      integer :: k
 !GCC$ ivdep
 !GCC$ vector
          do k = 1, lockstep_lanes
@@ -698,7 +701,6 @@ contains
             rhs(k, n) = a(k)*g(k, n) - b*y(k, n)
             rhs(k, n - 1) = rhs(k, n - 1) + spring(k)
          end do
-      end associate
    end subroutine matvec_rhs_last_rows
 
    !> The end of a dot product from the eight partial sums and the rows j..n after them
