@@ -252,72 +252,78 @@ contains
       real(wp), intent(inout) :: d(lockstep_lanes, solver%n), u(lockstep_lanes, solver%n)
       !> g.d^n of every lane (lanes; beamstops_band_solve's load_work_product).
       real(wp), intent(out) :: gd(lockstep_lanes)
+      call back_update_rows(solver%n, solver%off, b, c, z, g, d, u, gd)
+   end subroutine lockstep_back_update
+
+   !> The rows of lockstep_back_update in explicit-shape arrays (as matvec_rhs_forward_rows).
+   pure subroutine back_update_rows(n, off, b, c, z, g, d, u, gd)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: off(kd, n), b(lockstep_lanes, n), c(lockstep_lanes), z(n), g(lockstep_lanes, n)
+      real(wp), intent(inout) :: d(lockstep_lanes, n), u(lockstep_lanes, n)
+      real(wp), intent(out) :: gd(lockstep_lanes)
       real(wp) :: xa(lockstep_lanes), xb(lockstep_lanes), xc(lockstep_lanes)
       real(wp) :: ga(lockstep_lanes), gb(lockstep_lanes), gc(lockstep_lanes)
-      integer :: i, k, n
-      n = solver%n
-      associate (off => solver%off)
+      integer :: i, k
+!GCC$ ivdep
+!GCC$ vector
+      do k = 1, lockstep_lanes
+         xa(k) = b(k, n)
+         xb(k) = b(k, n - 1)
+         xc(k) = b(k, n - 2)
+         d(k, n) = d(k, n) + xa(k) + c(k)*z(n)
+         u(k, n) = u(k, n) + d(k, n)
+         ga(k) = g(k, n)*d(k, n)
+         d(k, n - 1) = d(k, n - 1) + xb(k) + c(k)*z(n - 1)
+         u(k, n - 1) = u(k, n - 1) + d(k, n - 1)
+         gb(k) = g(k, n - 1)*d(k, n - 1)
+         d(k, n - 2) = d(k, n - 2) + xc(k) + c(k)*z(n - 2)
+         u(k, n - 2) = u(k, n - 2) + d(k, n - 2)
+         gc(k) = g(k, n - 2)*d(k, n - 2)
+      end do
+      do i = n - kd, 3, -3
 !GCC$ ivdep
 !GCC$ vector
          do k = 1, lockstep_lanes
-            xa(k) = b(k, n)
-            xb(k) = b(k, n - 1)
-            xc(k) = b(k, n - 2)
-            d(k, n) = d(k, n) + xa(k) + c(k)*z(n)
-            u(k, n) = u(k, n) + d(k, n)
-            ga(k) = g(k, n)*d(k, n)
-            d(k, n - 1) = d(k, n - 1) + xb(k) + c(k)*z(n - 1)
-            u(k, n - 1) = u(k, n - 1) + d(k, n - 1)
-            gb(k) = g(k, n - 1)*d(k, n - 1)
-            d(k, n - 2) = d(k, n - 2) + xc(k) + c(k)*z(n - 2)
-            u(k, n - 2) = u(k, n - 2) + d(k, n - 2)
-            gc(k) = g(k, n - 2)*d(k, n - 2)
+            xa(k) = b(k, i) - off(1, i + 3)*xa(k) - off(2, i + 2)*xb(k) - off(3, i + 1)*xc(k)
+            d(k, i) = d(k, i) + xa(k) + c(k)*z(i)
+            u(k, i) = u(k, i) + d(k, i)
+            ga(k) = ga(k) + g(k, i)*d(k, i)
+            xb(k) = b(k, i - 1) - off(1, i + 2)*xb(k) - off(2, i + 1)*xc(k) - off(3, i)*xa(k)
+            d(k, i - 1) = d(k, i - 1) + xb(k) + c(k)*z(i - 1)
+            u(k, i - 1) = u(k, i - 1) + d(k, i - 1)
+            gb(k) = gb(k) + g(k, i - 1)*d(k, i - 1)
+            xc(k) = b(k, i - 2) - off(1, i + 1)*xc(k) - off(2, i)*xa(k) - off(3, i - 1)*xb(k)
+            d(k, i - 2) = d(k, i - 2) + xc(k) + c(k)*z(i - 2)
+            u(k, i - 2) = u(k, i - 2) + d(k, i - 2)
+            gc(k) = gc(k) + g(k, i - 2)*d(k, i - 2)
          end do
-         do i = n - kd, 3, -3
+      end do
+      if (i >= 1) then
 !GCC$ ivdep
 !GCC$ vector
-            do k = 1, lockstep_lanes
-               xa(k) = b(k, i) - off(1, i + 3)*xa(k) - off(2, i + 2)*xb(k) - off(3, i + 1)*xc(k)
-               d(k, i) = d(k, i) + xa(k) + c(k)*z(i)
-               u(k, i) = u(k, i) + d(k, i)
-               ga(k) = ga(k) + g(k, i)*d(k, i)
-               xb(k) = b(k, i - 1) - off(1, i + 2)*xb(k) - off(2, i + 1)*xc(k) - off(3, i)*xa(k)
-               d(k, i - 1) = d(k, i - 1) + xb(k) + c(k)*z(i - 1)
-               u(k, i - 1) = u(k, i - 1) + d(k, i - 1)
-               gb(k) = gb(k) + g(k, i - 1)*d(k, i - 1)
-               xc(k) = b(k, i - 2) - off(1, i + 1)*xc(k) - off(2, i)*xa(k) - off(3, i - 1)*xb(k)
-               d(k, i - 2) = d(k, i - 2) + xc(k) + c(k)*z(i - 2)
-               u(k, i - 2) = u(k, i - 2) + d(k, i - 2)
-               gc(k) = gc(k) + g(k, i - 2)*d(k, i - 2)
-            end do
+         do k = 1, lockstep_lanes
+            xa(k) = b(k, i) - off(1, i + 3)*xa(k) - off(2, i + 2)*xb(k) - off(3, i + 1)*xc(k)
+            d(k, i) = d(k, i) + xa(k) + c(k)*z(i)
+            u(k, i) = u(k, i) + d(k, i)
+            ga(k) = ga(k) + g(k, i)*d(k, i)
          end do
-         if (i >= 1) then
+      end if
+      if (i - 1 >= 1) then
 !GCC$ ivdep
 !GCC$ vector
-            do k = 1, lockstep_lanes
-               xa(k) = b(k, i) - off(1, i + 3)*xa(k) - off(2, i + 2)*xb(k) - off(3, i + 1)*xc(k)
-               d(k, i) = d(k, i) + xa(k) + c(k)*z(i)
-               u(k, i) = u(k, i) + d(k, i)
-               ga(k) = ga(k) + g(k, i)*d(k, i)
-            end do
-         end if
-         if (i - 1 >= 1) then
-!GCC$ ivdep
-!GCC$ vector
-            do k = 1, lockstep_lanes
-               xb(k) = b(k, i - 1) - off(1, i + 2)*xb(k) - off(2, i + 1)*xc(k) - off(3, i)*xa(k)
-               d(k, i - 1) = d(k, i - 1) + xb(k) + c(k)*z(i - 1)
-               u(k, i - 1) = u(k, i - 1) + d(k, i - 1)
-               gb(k) = gb(k) + g(k, i - 1)*d(k, i - 1)
-            end do
-         end if
-      end associate
+         do k = 1, lockstep_lanes
+            xb(k) = b(k, i - 1) - off(1, i + 2)*xb(k) - off(2, i + 1)*xc(k) - off(3, i)*xa(k)
+            d(k, i - 1) = d(k, i - 1) + xb(k) + c(k)*z(i - 1)
+            u(k, i - 1) = u(k, i - 1) + d(k, i - 1)
+            gb(k) = gb(k) + g(k, i - 1)*d(k, i - 1)
+         end do
+      end if
 !GCC$ ivdep
 !GCC$ vector
       do k = 1, lockstep_lanes
          gd(k) = (ga(k) + gb(k)) + gc(k)
       end do
-   end subroutine lockstep_back_update
+   end subroutine back_update_rows
 
    !> g.d of every lane in the order of beamstops_band_solve's load_work_product (row j in sum
    !> mod(n - j, 3) + 1 from the last row down, then (s1 + s2) + s3), n >= kd: for the loops whose
