@@ -50,6 +50,8 @@ module beamstops_lockstep
    use beamstops_clock, only: thread_cpu_seconds
    use beamstops_forcing, only: lift_shape, lift_slope, restart_every
    use beamstops_lockstep_physics, only: check_shared_physics
+   use beamstops_lockstep_store, only: chunk_store, fill_store, give_back, put_lane, part_u, part_d, part_su, &
+      & part_rhs, part_g
    use beamstops_lockstep_members, only: operators_type, members_type, lane, chunk, take_snapshot, first_events, &
       & energy
    use beamstops_lockstep_general, only: advance_members_general
@@ -566,6 +568,7 @@ contains
       integer(ik), intent(in) :: last
       type(lanes_type), allocatable :: lanes(:)
       type(observer_lanes), allocatable :: watch(:)
+      type(chunk_store) :: w
       integer(ik) :: step, next_record, next_snapshot, load_k
       integer :: k, c, tip, law
       logical :: energy_wanted, pending, observing, restart
@@ -584,6 +587,7 @@ contains
       pending = .false.
       allocate (lanes(ms%chunks))
       call gather_lanes(scenes, ms, lanes)
+      call fill_store(w, ms%u, ms%d, ms%su, ms%g)
       if (observing) call gather_observers(watch, ms%observers, ms%active(:ms%k))
       load_k = start_lanes_loads(lanes, ms%step + 1, model%dt)
       do step = ms%step, last
@@ -593,16 +597,17 @@ contains
          do c = 1, ms%chunks
             call lanes_begin_step(lanes(c), law, model%beta, model%dt2, restart, load_k + 1, model%dt)
             if (ops%periodic) then
-               call lockstep_matvec_rhs_forward(ops%stiffness, ops%solver, ops%stiffness_rows, ms%u(:, :, c), &
-                  & lanes(c)%coef, ms%g(:, :, c), model%dt2, lanes(c)%spring, ms%su(:, :, c), ms%rhs(:, :, c))
+               call lockstep_matvec_rhs_forward(ops%stiffness, ops%solver, ops%stiffness_rows, w%store(w%at(part_u, c)), &
+                  & lanes(c)%coef, w%store(w%at(part_g, c)), model%dt2, lanes(c)%spring, w%store(w%at(part_su, c)), &
+                  & w%store(w%at(part_rhs, c)))
             else
-               call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), lanes(c)%coef, ms%g(:, :, c), model%dt2, &
-                  & lanes(c)%spring, ms%su(:, :, c), ms%rhs(:, :, c))
-               call lockstep_forward(ops%solver, ms%rhs(:, :, c))
+               call lockstep_matvec_rhs(ops%stiffness, w%store(w%at(part_u, c)), lanes(c)%coef, w%store(w%at(part_g, c)), &
+                  & model%dt2, lanes(c)%spring, w%store(w%at(part_su, c)), w%store(w%at(part_rhs, c)))
+               call lockstep_forward(ops%solver, w%store(w%at(part_rhs, c)))
             end if
             if (energy_wanted) then
-               call lockstep_energy_dots(ops%mass, ms%u(:, :, c), ms%d(:, :, c), ms%su(:, :, c), lanes(c)%usu, &
-                  & lanes(c)%dsu, lanes(c)%dmd)
+               call lockstep_energy_dots(ops%mass, w%store(w%at(part_u, c)), w%store(w%at(part_d, c)), &
+                  & w%store(w%at(part_su, c)), lanes(c)%usu, lanes(c)%dsu, lanes(c)%dmd)
             end if
          end do
          load_k = load_k + 1
@@ -626,12 +631,12 @@ contains
             else
                lanes(c)%u_old_su = 0
             end if
-            call lockstep_back_edge(ops%solver, ms%rhs(:, :, c))
-            call lanes_contact(lanes(c), law, ms%u(:, tip, c), ms%d(:, tip, c), ms%rhs(:, tip, c), z_tip, model%dt2, &
-               & model%beta)
-            call lockstep_back_update(ops%solver, ms%rhs(:, :, c), lanes(c)%c, model%z, ms%g(:, :, c), ms%d(:, :, c), &
-               & ms%u(:, :, c), lanes(c)%gd)
-            call lanes_close(lanes(c), law, ms%u(:, tip, c), ms%d(:, tip, c))
+            call lockstep_back_edge(ops%solver, w%store(w%at(part_rhs, c)))
+            call lanes_contact(lanes(c), law, w%store(w%row(part_u, c, tip)), w%store(w%row(part_d, c, tip)), &
+               & w%store(w%row(part_rhs, c, tip)), z_tip, model%dt2, model%beta)
+            call lockstep_back_update(ops%solver, w%store(w%at(part_rhs, c)), lanes(c)%c, model%z, &
+               & w%store(w%at(part_g, c)), w%store(w%at(part_d, c)), w%store(w%at(part_u, c)), lanes(c)%gd)
+            call lanes_close(lanes(c), law, w%store(w%row(part_u, c, tip)), w%store(w%row(part_d, c, tip)))
          end do
          ! the shock log and statistics of each member that keeps them (its quiet samples lane by
          ! lane, beamstops_observe_lanes)
@@ -646,13 +651,18 @@ contains
             do k = 1, ms%k
                if (step == ms%next_record(k)) then
                   ms%next_record(k) = ms%next_record(k) + scenes(k)%record_every
-                  call fill_row_lanes(scenes(k), model, ms, lanes(chunk(k)), k, step, ms%rows(:, k))
+                  call fill_row_lanes(scenes(k), model, w%store(w%row(part_d, chunk(k), tip) + lane(k) - 1), &
+                     & lanes(chunk(k)), k, step, ms%rows(:, k))
                   ms%pending(k) = .true.
                   pending = .true.
                end if
                if (step == ms%next_snapshot(k)) then
                   ms%next_snapshot(k) = ms%next_snapshot(k) + scenes(k)%snapshot_every
-                  if (ms%active(k)) call take_snapshot(scenes(k), model, ms, k, step, recorders(k))
+                  if (ms%active(k)) then
+                     call put_lane(w, part_u, chunk(k), lane(k), ms%u)
+                     call put_lane(w, part_d, chunk(k), lane(k), ms%d)
+                     call take_snapshot(scenes(k), model, ms, k, step, recorders(k))
+                  end if
                end if
             end do
             next_record = minval(ms%next_record)
@@ -660,6 +670,7 @@ contains
          end if
       end do
       call scatter_lanes(lanes, ms)
+      call give_back(w, ms%u, ms%d, ms%su)
       if (observing) call scatter_observers(watch, ms%observers)
       ! S u^{last+1}; it also completes the waiting records, as advance_fused does (one member
       ! at a time, with the one-member products and dot products).
@@ -755,10 +766,11 @@ contains
    !> Member k's record row of step n from its chunk's lanes, the energy column left for later
    !> (beamstops_ledger's fill_row; the general loop's, on the members' arrays, is
    !> beamstops_lockstep_members' fill_row_members).
-   subroutine fill_row_lanes(scene, model, ms, lanes, k, step, row)
+   subroutine fill_row_lanes(scene, model, d_tip, lanes, k, step, row)
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
-      type(members_type), intent(in) :: ms
+      !> Member k's d^n at the tip.
+      real(wp), intent(in) :: d_tip
       !> Member k's chunk.
       type(lanes_type), intent(in) :: lanes
       integer, intent(in) :: k
@@ -768,7 +780,7 @@ contains
       i = lane(k)
       row(col_t) = real(step, wp)*model%dt
       row(col_u) = lanes%u_tip_prev(i)
-      row(col_v) = (ms%d(i, model%tip, chunk(k)) + lanes%d_tip_prev(i))/(2*model%dt)
+      row(col_v) = (d_tip + lanes%d_tip_prev(i))/(2*model%dt)
       row(col_reaction) = scene%mass_per_length*lanes%r_prev(i)
       row(col_energy) = 0
       row(col_work) = scene%mass_per_length*lanes%work(i)
