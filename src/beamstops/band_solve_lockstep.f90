@@ -567,7 +567,10 @@ contains
    !> beamstops_band_solve's forward_rows): every array at a fixed stride, so that the rows of a
    !> block address the factor from one register (through the descriptors of solver%off and
    !> stiffness%a, gfortran 12 kept an address per row and coefficient, 24 a block, and spilled
-   !> them: about 20 % slower, bench_lockstep), and the edge routines inlined.
+   !> them: about 20 % slower, bench_lockstep), and the edge routines inlined. The forward rows
+   !> are written out here as in lockstep_forward: taken from a helper shared by the two (three
+   !> rows a turn while j <= last), the pass was 12 % slower at J = 19 and 15 % at J = 100
+   !> (bench_lockstep, A/B).
    pure subroutine matvec_rhs_forward_rows(n, s, off, inv_d2, rows, x, a, g, b, spring, y, rhs)
       integer, intent(in) :: n
       real(wp), intent(in) :: s(n, 0:kd), off(kd, n), inv_d2(n), rows(2*kd + 1, 2)
