@@ -31,6 +31,8 @@ module beamstops_lockstep_general
       & lockstep_load_work
    use beamstops_band_solve_lockstep_general, only: lockstep_matvec_rhs_damped, lockstep_row
    use beamstops_contact_mass_redistribution, only: massless_reaction, equilibrium_rows
+   use beamstops_lockstep_store, only: chunk_store, fill_store, give_back, put_lane, part_u, part_d, part_su, &
+      & part_rhs, part_g, part_cd
    use beamstops_lockstep_members, only: operators_type, members_type, lane, chunk, contact_law, close_steps, &
       & project_lanes, fill_row_members, take_snapshot, start_loads, next_loads, first_events, energy
    use beamstops_recorder, only: recorder_type, col_energy
@@ -61,6 +63,7 @@ contains
       logical :: energy_wanted, pending, observing, damped, massless
       real(wp) :: sums(3), reaction(lockstep_lanes)
       type(observer_lanes), allocatable :: watch(:)
+      type(chunk_store) :: w
 
       n = ms%n
       tip = model%tip
@@ -79,6 +82,11 @@ contains
       ms%u_old_su = 0
       ms%dmd = 0
       call start_loads(ms, ms%step + 1, scenes, model)
+      if (damped) then
+         call fill_store(w, ms%u, ms%d, ms%su, ms%g, ms%cd)
+      else
+         call fill_store(w, ms%u, ms%d, ms%su, ms%g)
+      end if
       do step = ms%step, last
          ms%sigma_next = ms%sigma
          call next_loads(ms, scenes, model)
@@ -91,34 +99,34 @@ contains
             lo = (c - 1)*lockstep_lanes + 1
             hi = c*lockstep_lanes
             if (damped .and. ops%periodic) then
-               call lockstep_matvec_rhs_damped(ops%stiffness, ms%u(:, :, c), ms%coef(lo:hi), ms%g(:, :, c), &
-                  & model%dt2, ms%spring(lo:hi), ms%cd(:, :, c), model%dt, ms%su(:, :, c), ms%rhs(:, :, c), &
+               call lockstep_matvec_rhs_damped(ops%stiffness, w%store(w%at(part_u, c)), ms%coef(lo:hi), w%store(w%at(part_g, c)), &
+                  & model%dt2, ms%spring(lo:hi), w%store(w%at(part_cd, c)), model%dt, w%store(w%at(part_su, c)), w%store(w%at(part_rhs, c)), &
                   & ops%stiffness_rows)
             else if (damped) then
-               call lockstep_matvec_rhs_damped(ops%stiffness, ms%u(:, :, c), ms%coef(lo:hi), ms%g(:, :, c), &
-                  & model%dt2, ms%spring(lo:hi), ms%cd(:, :, c), model%dt, ms%su(:, :, c), ms%rhs(:, :, c))
+               call lockstep_matvec_rhs_damped(ops%stiffness, w%store(w%at(part_u, c)), ms%coef(lo:hi), w%store(w%at(part_g, c)), &
+                  & model%dt2, ms%spring(lo:hi), w%store(w%at(part_cd, c)), model%dt, w%store(w%at(part_su, c)), w%store(w%at(part_rhs, c)))
             else if (ops%periodic .and. .not. massless) then
                ! the product and the forward substitution in one pass
-               call lockstep_matvec_rhs_forward(ops%stiffness, ops%solver, ops%stiffness_rows, ms%u(:, :, c), &
-                  & ms%coef(lo:hi), ms%g(:, :, c), model%dt2, ms%spring(lo:hi), ms%su(:, :, c), ms%rhs(:, :, c))
+               call lockstep_matvec_rhs_forward(ops%stiffness, ops%solver, ops%stiffness_rows, w%store(w%at(part_u, c)), &
+                  & ms%coef(lo:hi), w%store(w%at(part_g, c)), model%dt2, ms%spring(lo:hi), w%store(w%at(part_su, c)), w%store(w%at(part_rhs, c)))
             else if (ops%periodic) then
-               call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), ms%coef(lo:hi), ms%g(:, :, c), model%dt2, &
-                  & ms%spring(lo:hi), ms%su(:, :, c), ms%rhs(:, :, c), ops%stiffness_rows)
+               call lockstep_matvec_rhs(ops%stiffness, w%store(w%at(part_u, c)), ms%coef(lo:hi), w%store(w%at(part_g, c)), model%dt2, &
+                  & ms%spring(lo:hi), w%store(w%at(part_su, c)), w%store(w%at(part_rhs, c)), ops%stiffness_rows)
             else
-               call lockstep_matvec_rhs(ops%stiffness, ms%u(:, :, c), ms%coef(lo:hi), ms%g(:, :, c), model%dt2, &
-                  & ms%spring(lo:hi), ms%su(:, :, c), ms%rhs(:, :, c))
+               call lockstep_matvec_rhs(ops%stiffness, w%store(w%at(part_u, c)), ms%coef(lo:hi), w%store(w%at(part_g, c)), model%dt2, &
+                  & ms%spring(lo:hi), w%store(w%at(part_su, c)), w%store(w%at(part_rhs, c)))
             end if
             if (massless) then
                do k = lo, hi
-                  call equilibrium_rows(model%massless, model%row_scale, ms%sigma_next(k), ms%g(lane(k), :, c), &
-                     & ms%su(lane(k), :, c), ops%stiffness, ms%d(lane(k), :, c), ms%rhs(lane(k), :, c))
+                  call equilibrium_rows(model%massless, model%row_scale, ms%sigma_next(k), w%store(w%row(part_g, c, 1) + lane(k) - 1:w%vector_end(part_g, c):lockstep_lanes), &
+                     & w%store(w%row(part_su, c, 1) + lane(k) - 1:w%vector_end(part_su, c):lockstep_lanes), ops%stiffness, w%store(w%row(part_d, c, 1) + lane(k) - 1:w%vector_end(part_d, c):lockstep_lanes), w%store(w%row(part_rhs, c, 1) + lane(k) - 1:w%vector_end(part_rhs, c):lockstep_lanes))
                end do
             end if
             if (energy_wanted) then
-               call lockstep_energy_dots(ops%mass, ms%u(:, :, c), ms%d(:, :, c), ms%su(:, :, c), ms%usu(lo:hi), &
+               call lockstep_energy_dots(ops%mass, w%store(w%at(part_u, c)), w%store(w%at(part_d, c)), w%store(w%at(part_su, c)), ms%usu(lo:hi), &
                   & ms%dsu(lo:hi), ms%dmd(lo:hi))
             end if
-            if (damped .or. massless .or. .not. ops%periodic) call lockstep_forward(ops%solver, ms%rhs(:, :, c))
+            if (damped .or. massless .or. .not. ops%periodic) call lockstep_forward(ops%solver, w%store(w%at(part_rhs, c)))
          end do
          if (pending) then
             do k = 1, ms%k
@@ -139,14 +147,14 @@ contains
          do c = 1, ms%chunks
             lo = (c - 1)*lockstep_lanes + 1
             hi = c*lockstep_lanes
-            call lockstep_back(ops%solver, ms%rhs(:, :, c))
-            ms%d_tip_prev(lo:hi) = ms%d(:, tip, c)
-            ms%u_tip_prev(lo:hi) = ms%u(:, tip, c)
+            call lockstep_back(ops%solver, w%store(w%at(part_rhs, c)))
+            ms%d_tip_prev(lo:hi) = w%store(w%row(part_d, c, tip):w%row_end(part_d, c, tip))
+            ms%u_tip_prev(lo:hi) = w%store(w%row(part_u, c, tip):w%row_end(part_u, c, tip))
             if (massless) then
-               call lockstep_row(ops%stiffness, ms%u(:, :, c), tip, ms%s_u_tip(lo:hi))
-               call lockstep_row(ops%stiffness, ms%d(:, :, c), tip, ms%s_d_prev_tip(lo:hi))
+               call lockstep_row(ops%stiffness, w%store(w%at(part_u, c)), tip, ms%s_u_tip(lo:hi))
+               call lockstep_row(ops%stiffness, w%store(w%at(part_d, c)), tip, ms%s_d_prev_tip(lo:hi))
             end if
-            ms%trial(lo:hi) = ms%u_tip_prev(lo:hi) + (ms%d_tip_prev(lo:hi) + ms%rhs(:, tip, c))
+            ms%trial(lo:hi) = ms%u_tip_prev(lo:hi) + (ms%d_tip_prev(lo:hi) + w%store(w%row(part_rhs, c, tip):w%row_end(part_rhs, c, tip)))
          end do
          if (law == law_signorini) then
             do c = 1, ms%chunks
@@ -163,15 +171,15 @@ contains
          do c = 1, ms%chunks
             lo = (c - 1)*lockstep_lanes + 1
             hi = c*lockstep_lanes
-            call lockstep_update(n, ms%rhs(:, :, c), ms%c(lo:hi), model%z, ms%d(:, :, c), ms%u(:, :, c))
-            call lockstep_load_work(n, ms%g(:, :, c), ms%d(:, :, c), ms%gd(lo:hi))
-            ms%u_tip(lo:hi) = ms%u(:, tip, c)
-            ms%d_tip(lo:hi) = ms%d(:, tip, c)
+            call lockstep_update(n, w%store(w%at(part_rhs, c)), ms%c(lo:hi), model%z, w%store(w%at(part_d, c)), w%store(w%at(part_u, c)))
+            call lockstep_load_work(n, w%store(w%at(part_g, c)), w%store(w%at(part_d, c)), ms%gd(lo:hi))
+            ms%u_tip(lo:hi) = w%store(w%row(part_u, c, tip):w%row_end(part_u, c, tip))
+            ms%d_tip(lo:hi) = w%store(w%row(part_d, c, tip):w%row_end(part_d, c, tip))
             if (massless) then
                ! the reaction of the step: the residual of the tip's Newmark row (massless_reaction)
-               call lockstep_row(ops%stiffness, ms%d(:, :, c), tip, ms%cross(lo:hi))
+               call lockstep_row(ops%stiffness, w%store(w%at(part_d, c)), tip, ms%cross(lo:hi))
                do k = lo, hi
-                  ms%r_step(k) = massless_reaction(model%beta, ms%weight(k), ms%g(lane(k), tip, c), ms%s_u_tip(k), &
+                  ms%r_step(k) = massless_reaction(model%beta, ms%weight(k), w%store(w%row(part_g, c, tip) + lane(k) - 1), ms%s_u_tip(k), &
                      & ms%s_d_prev_tip(k), ms%cross(k))
                end do
             end if
@@ -185,8 +193,8 @@ contains
                do c = 1, ms%chunks
                   lo = (c - 1)*lockstep_lanes + 1
                   hi = c*lockstep_lanes
-                  ms%u(:, tip, c) = ms%u_tip(lo:hi)
-                  ms%d(:, tip, c) = ms%d_tip(lo:hi)
+                  w%store(w%row(part_u, c, tip):w%row_end(part_u, c, tip)) = ms%u_tip(lo:hi)
+                  w%store(w%row(part_d, c, tip):w%row_end(part_d, c, tip)) = ms%d_tip(lo:hi)
                end do
             end if
          end if
@@ -205,9 +213,9 @@ contains
             do c = 1, ms%chunks
                lo = (c - 1)*lockstep_lanes + 1
                hi = c*lockstep_lanes
-               call lockstep_dot(n, ms%d(:, :, c), ms%cd(:, :, c), ms%partial, ms%cross(lo:hi), model%dt2)
-               call lockstep_matvec(ops%damping, ms%d(:, :, c), ms%cd(:, :, c))
-               call lockstep_dot(n, ms%d(:, :, c), ms%cd(:, :, c), ms%partial, ms%dcd(lo:hi), model%dt2)
+               call lockstep_dot(n, w%store(w%at(part_d, c)), w%store(w%at(part_cd, c)), ms%partial, ms%cross(lo:hi), model%dt2)
+               call lockstep_matvec(ops%damping, w%store(w%at(part_d, c)), w%store(w%at(part_cd, c)))
+               call lockstep_dot(n, w%store(w%at(part_d, c)), w%store(w%at(part_cd, c)), ms%partial, ms%dcd(lo:hi), model%dt2)
             end do
             call damping_lanes(model%dt, ms%cross, ms%dcd, ms%dcd_prev, ms%damped)
          end if
@@ -216,19 +224,29 @@ contains
             do k = 1, ms%k
                if (step == ms%next_record(k)) then
                   ms%next_record(k) = ms%next_record(k) + scenes(k)%record_every
+                  call put_lane(w, part_d, chunk(k), lane(k), ms%d)
                   call fill_row_members(scenes(k), model, ms, k, step, ms%rows(:, k))
                   ms%pending(k) = .true.
                   pending = .true.
                end if
                if (step == ms%next_snapshot(k)) then
                   ms%next_snapshot(k) = ms%next_snapshot(k) + scenes(k)%snapshot_every
-                  if (ms%active(k)) call take_snapshot(scenes(k), model, ms, k, step, recorders(k))
+                  if (ms%active(k)) then
+                     call put_lane(w, part_u, chunk(k), lane(k), ms%u)
+                     call put_lane(w, part_d, chunk(k), lane(k), ms%d)
+                     call take_snapshot(scenes(k), model, ms, k, step, recorders(k))
+                  end if
                end if
             end do
             next_record = minval(ms%next_record)
             next_snapshot = minval(ms%next_snapshot)
          end if
       end do
+      if (damped) then
+         call give_back(w, ms%u, ms%d, ms%su, ms%cd)
+      else
+         call give_back(w, ms%u, ms%d, ms%su)
+      end if
       if (observing) call scatter_observers(watch, ms%observers)
       ! S u^{last+1}; it also completes the waiting records (advance_members)
       do c = 1, ms%chunks

@@ -1,4 +1,4 @@
-!> The chunks' vectors of a lockstep block (u, d, S u, rhs and g of each chunk, (lanes, n) each)
+!> The chunks' vectors of a lockstep block (u, d, S u, rhs, g and C d of each chunk, (lanes, n) each)
 !> in one allocation whose vectors start on a 64-byte boundary: a row of a chunk (lockstep_lanes
 !> = 8 doubles) is then one cache line, so that each whole-register load and store of the
 !> kernels touches one line instead of two. ALLOCATE gives the alignment of malloc (16 bytes),
@@ -14,10 +14,10 @@ module beamstops_lockstep_store
    use beamstops_band_solve_lockstep, only: lockstep_lanes
    implicit none
    private
-   public :: chunk_store, fill_store, give_back, put_lane, part_u, part_d, part_su, part_rhs, part_g
+   public :: chunk_store, fill_store, give_back, put_lane, part_u, part_d, part_su, part_rhs, part_g, part_cd
 
    !> The vectors of a chunk, in the order they are stored.
-   integer, parameter :: part_u = 0, part_d = 1, part_su = 2, part_rhs = 3, part_g = 4, parts = 5
+   integer, parameter :: part_u = 0, part_d = 1, part_su = 2, part_rhs = 3, part_g = 4, part_cd = 5, parts = 6
    !> Alignment of each vector (bytes) and its value in doubles.
    integer, parameter :: line_bytes = 64, line_values = line_bytes/8
 
@@ -32,17 +32,23 @@ module beamstops_lockstep_store
       procedure :: at
       !> Index of a chunk's vector's row j (its lockstep_lanes values).
       procedure :: row
+      !> Index of its last value in row j.
+      procedure :: row_end
+      !> Index of the last value of a chunk's vector.
+      procedure :: vector_end
    end type chunk_store
 
 
 contains
 
-   !> The store of u, d, S u and g (lanes, n, chunks), rhs zero.
-   subroutine fill_store(w, u, d, su, g)
+   !> The store of u, d, S u, g and C d (lanes, n, chunks; C d zero when absent), rhs zero.
+   subroutine fill_store(w, u, d, su, g, cd)
       !> The store, allocated and filled.
       type(chunk_store), intent(out), target :: w
       !> The members' vectors (lanes, n, chunks).
       real(wp), intent(in), contiguous :: u(:, :, :), d(:, :, :), su(:, :, :), g(:, :, :)
+      !> C d^{n-1} (damping), when the loop carries it.
+      real(wp), intent(in), contiguous, optional :: cd(:, :, :)
       integer(c_intptr_t) :: address
       integer :: c, size_of
       w%n = size(u, 2)
@@ -57,21 +63,25 @@ contains
          call copy(size_of, d(:, :, c), w%store(w%at(part_d, c)))
          call copy(size_of, su(:, :, c), w%store(w%at(part_su, c)))
          call copy(size_of, g(:, :, c), w%store(w%at(part_g, c)))
+         if (present(cd)) call copy(size_of, cd(:, :, c), w%store(w%at(part_cd, c)))
       end do
    end subroutine fill_store
 
-   !> u, d and S u back into the members' arrays (lanes, n, chunks).
-   subroutine give_back(w, u, d, su)
+   !> u, d, S u (and C d) back into the members' arrays (lanes, n, chunks).
+   subroutine give_back(w, u, d, su, cd)
       !> The store.
       type(chunk_store), intent(in) :: w
       !> The members' vectors.
       real(wp), intent(inout), contiguous :: u(:, :, :), d(:, :, :), su(:, :, :)
+      !> C d^{n-1} (damping), when the loop carries it.
+      real(wp), intent(inout), contiguous, optional :: cd(:, :, :)
       integer :: c, size_of
       size_of = lockstep_lanes*w%n
       do c = 1, w%chunks
          call copy(size_of, w%store(w%at(part_u, c)), u(:, :, c))
          call copy(size_of, w%store(w%at(part_d, c)), d(:, :, c))
          call copy(size_of, w%store(w%at(part_su, c)), su(:, :, c))
+         if (present(cd)) call copy(size_of, w%store(w%at(part_cd, c)), cd(:, :, c))
       end do
    end subroutine give_back
 
@@ -106,6 +116,24 @@ contains
       integer, intent(in) :: part, c, j
       row = w%at(part, c) + (j - 1)*lockstep_lanes
    end function row
+
+   !> Index of the last value of row j of vector `part` of chunk c.
+   pure integer function row_end(w, part, c, j)
+      !> The store.
+      class(chunk_store), intent(in) :: w
+      !> The vector, chunk and unknown.
+      integer, intent(in) :: part, c, j
+      row_end = w%row(part, c, j) + lockstep_lanes - 1
+   end function row_end
+
+   !> Index of the last value of vector `part` of chunk c.
+   pure integer function vector_end(w, part, c)
+      !> The store.
+      class(chunk_store), intent(in) :: w
+      !> The vector and chunk.
+      integer, intent(in) :: part, c
+      vector_end = w%at(part, c) + lockstep_lanes*w%n - 1
+   end function vector_end
 
    !> y = x, m values (explicit shape: sections and elements by sequence association).
    pure subroutine copy(m, x, y)
