@@ -59,7 +59,7 @@ contains
       !> Last step to do.
       integer(ik), intent(in) :: last
       integer(ik) :: step, next_record, next_snapshot
-      integer :: k, c, lo, hi, n, tip, law
+      integer :: k, c, lo, hi, n, tip, law, i
       logical :: energy_wanted, pending, observing, damped, massless
       real(wp) :: sums(3), reaction(lockstep_lanes)
       type(observer_lanes), allocatable :: watch(:)
@@ -99,34 +99,45 @@ contains
             lo = (c - 1)*lockstep_lanes + 1
             hi = c*lockstep_lanes
             if (damped .and. ops%periodic) then
-               call lockstep_matvec_rhs_damped(ops%stiffness, w%store(w%at(part_u, c)), ms%coef(lo:hi), w%store(w%at(part_g, c)), &
-                  & model%dt2, ms%spring(lo:hi), w%store(w%at(part_cd, c)), model%dt, w%store(w%at(part_su, c)), w%store(w%at(part_rhs, c)), &
-                  & ops%stiffness_rows)
+               call lockstep_matvec_rhs_damped(ops%stiffness, w%store(w%at(part_u, c)), ms%coef(lo:hi), &
+                  & w%store(w%at(part_g, c)), model%dt2, ms%spring(lo:hi), w%store(w%at(part_cd, c)), model%dt, &
+                  & w%store(w%at(part_su, c)), w%store(w%at(part_rhs, c)), ops%stiffness_rows)
             else if (damped) then
-               call lockstep_matvec_rhs_damped(ops%stiffness, w%store(w%at(part_u, c)), ms%coef(lo:hi), w%store(w%at(part_g, c)), &
-                  & model%dt2, ms%spring(lo:hi), w%store(w%at(part_cd, c)), model%dt, w%store(w%at(part_su, c)), w%store(w%at(part_rhs, c)))
+               call lockstep_matvec_rhs_damped(ops%stiffness, w%store(w%at(part_u, c)), ms%coef(lo:hi), &
+                  & w%store(w%at(part_g, c)), model%dt2, ms%spring(lo:hi), w%store(w%at(part_cd, c)), model%dt, &
+                  & w%store(w%at(part_su, c)), w%store(w%at(part_rhs, c)))
             else if (ops%periodic .and. .not. massless) then
                ! the product and the forward substitution in one pass
-               call lockstep_matvec_rhs_forward(ops%stiffness, ops%solver, ops%stiffness_rows, w%store(w%at(part_u, c)), &
-                  & ms%coef(lo:hi), w%store(w%at(part_g, c)), model%dt2, ms%spring(lo:hi), w%store(w%at(part_su, c)), w%store(w%at(part_rhs, c)))
+               call lockstep_matvec_rhs_forward(ops%stiffness, ops%solver, ops%stiffness_rows, &
+                  & w%store(w%at(part_u, c)), ms%coef(lo:hi), w%store(w%at(part_g, c)), model%dt2, ms%spring(lo:hi), &
+                  & w%store(w%at(part_su, c)), w%store(w%at(part_rhs, c)))
             else if (ops%periodic) then
-               call lockstep_matvec_rhs(ops%stiffness, w%store(w%at(part_u, c)), ms%coef(lo:hi), w%store(w%at(part_g, c)), model%dt2, &
-                  & ms%spring(lo:hi), w%store(w%at(part_su, c)), w%store(w%at(part_rhs, c)), ops%stiffness_rows)
+               call lockstep_matvec_rhs(ops%stiffness, w%store(w%at(part_u, c)), ms%coef(lo:hi), &
+                  & w%store(w%at(part_g, c)), model%dt2, ms%spring(lo:hi), w%store(w%at(part_su, c)), &
+                  & w%store(w%at(part_rhs, c)), ops%stiffness_rows)
             else
-               call lockstep_matvec_rhs(ops%stiffness, w%store(w%at(part_u, c)), ms%coef(lo:hi), w%store(w%at(part_g, c)), model%dt2, &
-                  & ms%spring(lo:hi), w%store(w%at(part_su, c)), w%store(w%at(part_rhs, c)))
+               call lockstep_matvec_rhs(ops%stiffness, w%store(w%at(part_u, c)), ms%coef(lo:hi), &
+                  & w%store(w%at(part_g, c)), model%dt2, ms%spring(lo:hi), w%store(w%at(part_su, c)), &
+                  & w%store(w%at(part_rhs, c)))
             end if
             if (massless) then
                do k = lo, hi
-                  call equilibrium_rows(model%massless, model%row_scale, ms%sigma_next(k), w%store(w%row(part_g, c, 1) + lane(k) - 1:w%vector_end(part_g, c):lockstep_lanes), &
-                     & w%store(w%row(part_su, c, 1) + lane(k) - 1:w%vector_end(part_su, c):lockstep_lanes), ops%stiffness, w%store(w%row(part_d, c, 1) + lane(k) - 1:w%vector_end(part_d, c):lockstep_lanes), w%store(w%row(part_rhs, c, 1) + lane(k) - 1:w%vector_end(part_rhs, c):lockstep_lanes))
+                  ! member k's lane of each vector: every lockstep_lanes-th value of the chunk's
+                  i = lane(k) - 1
+                  call equilibrium_rows(model%massless, model%row_scale, ms%sigma_next(k), &
+                     & w%store(w%at(part_g, c) + i:w%row_end(part_g, c, n):lockstep_lanes), &
+                     & w%store(w%at(part_su, c) + i:w%row_end(part_su, c, n):lockstep_lanes), ops%stiffness, &
+                     & w%store(w%at(part_d, c) + i:w%row_end(part_d, c, n):lockstep_lanes), &
+                     & w%store(w%at(part_rhs, c) + i:w%row_end(part_rhs, c, n):lockstep_lanes))
                end do
             end if
             if (energy_wanted) then
-               call lockstep_energy_dots(ops%mass, w%store(w%at(part_u, c)), w%store(w%at(part_d, c)), w%store(w%at(part_su, c)), ms%usu(lo:hi), &
-                  & ms%dsu(lo:hi), ms%dmd(lo:hi))
+               call lockstep_energy_dots(ops%mass, w%store(w%at(part_u, c)), w%store(w%at(part_d, c)), &
+                  & w%store(w%at(part_su, c)), ms%usu(lo:hi), ms%dsu(lo:hi), ms%dmd(lo:hi))
             end if
-            if (damped .or. massless .or. .not. ops%periodic) call lockstep_forward(ops%solver, w%store(w%at(part_rhs, c)))
+            if (damped .or. massless .or. .not. ops%periodic) then
+               call lockstep_forward(ops%solver, w%store(w%at(part_rhs, c)))
+            end if
          end do
          if (pending) then
             do k = 1, ms%k
@@ -154,7 +165,8 @@ contains
                call lockstep_row(ops%stiffness, w%store(w%at(part_u, c)), tip, ms%s_u_tip(lo:hi))
                call lockstep_row(ops%stiffness, w%store(w%at(part_d, c)), tip, ms%s_d_prev_tip(lo:hi))
             end if
-            ms%trial(lo:hi) = ms%u_tip_prev(lo:hi) + (ms%d_tip_prev(lo:hi) + w%store(w%row(part_rhs, c, tip):w%row_end(part_rhs, c, tip)))
+            ms%trial(lo:hi) = ms%u_tip_prev(lo:hi) + (ms%d_tip_prev(lo:hi) &
+               & + w%store(w%row(part_rhs, c, tip):w%row_end(part_rhs, c, tip)))
          end do
          if (law == law_signorini) then
             do c = 1, ms%chunks
@@ -171,7 +183,8 @@ contains
          do c = 1, ms%chunks
             lo = (c - 1)*lockstep_lanes + 1
             hi = c*lockstep_lanes
-            call lockstep_update(n, w%store(w%at(part_rhs, c)), ms%c(lo:hi), model%z, w%store(w%at(part_d, c)), w%store(w%at(part_u, c)))
+            call lockstep_update(n, w%store(w%at(part_rhs, c)), ms%c(lo:hi), model%z, w%store(w%at(part_d, c)), &
+               & w%store(w%at(part_u, c)))
             call lockstep_load_work(n, w%store(w%at(part_g, c)), w%store(w%at(part_d, c)), ms%gd(lo:hi))
             ms%u_tip(lo:hi) = w%store(w%row(part_u, c, tip):w%row_end(part_u, c, tip))
             ms%d_tip(lo:hi) = w%store(w%row(part_d, c, tip):w%row_end(part_d, c, tip))
@@ -179,7 +192,8 @@ contains
                ! the reaction of the step: the residual of the tip's Newmark row (massless_reaction)
                call lockstep_row(ops%stiffness, w%store(w%at(part_d, c)), tip, ms%cross(lo:hi))
                do k = lo, hi
-                  ms%r_step(k) = massless_reaction(model%beta, ms%weight(k), w%store(w%row(part_g, c, tip) + lane(k) - 1), ms%s_u_tip(k), &
+                  ms%r_step(k) = massless_reaction(model%beta, ms%weight(k), &
+                     & w%store(w%row(part_g, c, tip) + lane(k) - 1), ms%s_u_tip(k), &
                      & ms%s_d_prev_tip(k), ms%cross(k))
                end do
             end if
@@ -213,9 +227,11 @@ contains
             do c = 1, ms%chunks
                lo = (c - 1)*lockstep_lanes + 1
                hi = c*lockstep_lanes
-               call lockstep_dot(n, w%store(w%at(part_d, c)), w%store(w%at(part_cd, c)), ms%partial, ms%cross(lo:hi), model%dt2)
+               call lockstep_dot(n, w%store(w%at(part_d, c)), w%store(w%at(part_cd, c)), ms%partial, ms%cross(lo:hi), &
+                  & model%dt2)
                call lockstep_matvec(ops%damping, w%store(w%at(part_d, c)), w%store(w%at(part_cd, c)))
-               call lockstep_dot(n, w%store(w%at(part_d, c)), w%store(w%at(part_cd, c)), ms%partial, ms%dcd(lo:hi), model%dt2)
+               call lockstep_dot(n, w%store(w%at(part_d, c)), w%store(w%at(part_cd, c)), ms%partial, ms%dcd(lo:hi), &
+                  & model%dt2)
             end do
             call damping_lanes(model%dt, ms%cross, ms%dcd, ms%dcd_prev, ms%damped)
          end if

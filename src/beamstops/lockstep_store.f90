@@ -14,7 +14,8 @@ module beamstops_lockstep_store
    use beamstops_band_solve_lockstep, only: lockstep_lanes
    implicit none
    private
-   public :: chunk_store, fill_store, give_back, put_lane, part_u, part_d, part_su, part_rhs, part_g, part_cd
+   public :: chunk_store, fill_store, give_back, put_lane
+   public :: part_u, part_d, part_su, part_rhs, part_g, part_cd
 
    !> The vectors of a chunk, in the order they are stored.
    integer, parameter :: part_u = 0, part_d = 1, part_su = 2, part_rhs = 3, part_g = 4, part_cd = 5, parts = 6
@@ -34,8 +35,6 @@ module beamstops_lockstep_store
       procedure :: row
       !> Index of its last value in row j.
       procedure :: row_end
-      !> Index of the last value of a chunk's vector.
-      procedure :: vector_end
    end type chunk_store
 
 
@@ -125,15 +124,6 @@ contains
       integer, intent(in) :: part, c, j
       row_end = w%row(part, c, j) + lockstep_lanes - 1
    end function row_end
-
-   !> Index of the last value of vector `part` of chunk c.
-   pure integer function vector_end(w, part, c)
-      !> The store.
-      class(chunk_store), intent(in) :: w
-      !> The vector and chunk.
-      integer, intent(in) :: part, c
-      vector_end = w%at(part, c) + lockstep_lanes*w%n - 1
-   end function vector_end
 
    !> y = x, m values (explicit shape: sections and elements by sequence association).
    pure subroutine copy(m, x, y)
