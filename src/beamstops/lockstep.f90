@@ -375,12 +375,11 @@ contains
       ms%chunks = (nk + lockstep_lanes - 1)/lockstep_lanes
       ms%p = ms%chunks*lockstep_lanes
       allocate (ms%u(lockstep_lanes, n, ms%chunks), ms%d(lockstep_lanes, n, ms%chunks), &
-         & ms%su(lockstep_lanes, n, ms%chunks), ms%rhs(lockstep_lanes, n, ms%chunks), &
+         & ms%su(lockstep_lanes, n, ms%chunks), &
          & ms%g(lockstep_lanes, n, ms%chunks), ms%partial(lockstep_lanes, lockstep_work_columns))
       ms%u = 0
       ms%d = 0
       ms%su = 0
-      ms%rhs = 0
       ms%g = 0
       nk = ms%p
       allocate (ms%sigma_prev(nk), ms%sigma_now(nk), ms%gd_prev(nk), ms%p_prev(nk), ms%p_now(nk), ms%work(nk), &

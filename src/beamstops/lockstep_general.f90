@@ -240,8 +240,8 @@ contains
             do k = 1, ms%k
                if (step == ms%next_record(k)) then
                   ms%next_record(k) = ms%next_record(k) + scenes(k)%record_every
-                  call put_lane(w, part_d, chunk(k), lane(k), ms%d)
-                  call fill_row_members(scenes(k), model, ms, k, step, ms%rows(:, k))
+                  call fill_row_members(scenes(k), model, ms, w%store(w%row(part_d, chunk(k), tip) + lane(k) - 1), k, &
+                     & step, ms%rows(:, k))
                   ms%pending(k) = .true.
                   pending = .true.
                end if

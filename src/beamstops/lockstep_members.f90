@@ -52,9 +52,11 @@ module beamstops_lockstep_members
       !> of the next step (shared).
       integer :: k = 0, n = 0, chunks = 0, p = 0
       integer(ik) :: step = 1
-      !> u^n, d^{n-1}, S u^n, right-hand side / solution, load vector g of each member (lanes, n,
-      !> chunks): member k is lane lane(k) of chunk chunk(k); the padding lanes stay zero.
-      real(wp), allocatable :: u(:, :, :), d(:, :, :), su(:, :, :), rhs(:, :, :), g(:, :, :)
+      !> u^n, d^{n-1}, S u^n, load vector g of each member (lanes, n, chunks): member k is lane
+      !> lane(k) of chunk chunk(k); the padding lanes stay zero. During a block of the plain or the
+      !> general loop they are in the loop's aligned store (beamstops_lockstep_store), and these
+      !> arrays get u, d and S u back at its end.
+      real(wp), allocatable :: u(:, :, :), d(:, :, :), su(:, :, :), g(:, :, :)
       !> Work array of the kernels (lanes, lockstep_work_columns).
       real(wp), allocatable :: partial(:, :)
       !> Per member, padded to p lanes (the plain loop: between blocks; during a block the chunks'
@@ -235,16 +237,18 @@ contains
 
    !> Member k's record row of step n from the members' arrays (the general loop's; the plain
    !> loop's is lockstep.f90's fill_row_lanes), the energy column left for later (fill_row).
-   subroutine fill_row_members(scene, model, ms, k, step, row)
+   subroutine fill_row_members(scene, model, ms, d_tip, k, step, row)
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
       type(members_type), intent(in) :: ms
+      !> Member k's d^n at the tip (the loop's vectors are in its store during a block).
+      real(wp), intent(in) :: d_tip
       integer, intent(in) :: k
       integer(ik), intent(in) :: step
       real(wp), intent(out) :: row(n_columns)
       row(col_t) = real(step, wp)*model%dt
       row(col_u) = ms%u_tip_prev(k)
-      row(col_v) = (ms%d(lane(k), model%tip, chunk(k)) + ms%d_tip_prev(k))/(2*model%dt)
+      row(col_v) = (d_tip + ms%d_tip_prev(k))/(2*model%dt)
       row(col_reaction) = scene%mass_per_length*ms%r_prev(k)
       row(col_energy) = 0
       row(col_work) = scene%mass_per_length*ms%work(k)

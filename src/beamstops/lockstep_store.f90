@@ -37,7 +37,6 @@ module beamstops_lockstep_store
       procedure :: row_end
    end type chunk_store
 
-
 contains
 
    !> The store of u, d, S u, g and C d (lanes, n, chunks; C d zero when absent), rhs zero.
