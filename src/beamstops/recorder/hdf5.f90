@@ -49,7 +49,8 @@ module beamstops_recorder_hdf5
       integer(hsize_t) :: written = 0, snaps_written = 0
       integer :: fill = 0
       integer :: nodes = 0
-      !> Buffered rows (buffer_rows, n_columns): each series a contiguous column.
+      !> Buffered rows (n_columns, buffer_rows): a record is one contiguous row of 64 bytes (one
+      !> store a step on the loop's thread; the writer thread picks the series out of it).
       real(wp), allocatable :: buffer(:, :)
       !> Scene of the run.
       type(scene_type) :: scene
@@ -140,7 +141,7 @@ contains
          return
       end if
       self%fill = self%fill + 1
-      self%buffer(self%fill, :) = row
+      self%buffer(:, self%fill) = row
       if (self%fill == buffer_rows) call write_buffer(self)
    end subroutine record
 
@@ -470,7 +471,7 @@ contains
       self%partial = partial_path(path)
       self%scene = scene
       self%nodes = size(model%x)
-      allocate (self%buffer(buffer_rows, n_columns))
+      allocate (self%buffer(n_columns, buffer_rows))
       if (.not. associated(self%order)) allocate (self%order)
       self%order%nodes = self%nodes
       if (scene%snapshot_every > 0) then

@@ -29,7 +29,7 @@ module beamstops_recorder_hdf5_writes
       integer(hsize_t) :: written = 0, stops_written = 0, snaps_written = 0
       !> Stops along the span and nodes of a snapshot.
       integer :: stops = 0, nodes = 0
-      !> Records (rows, columns), the stops' values (stops, rows), snapshot times and shapes (nodes, rows).
+      !> Records (columns, rows), the stops' values (stops, rows), snapshot times and shapes (nodes, rows).
       real(wp), allocatable :: rows(:, :), stops_u_rows(:, :), stops_r_rows(:, :), snap_t_rows(:), snap_u_rows(:, :)
       !> How many of each the order holds.
       integer :: fill = 0, stops_fill = 0, snap_fill = 0
@@ -65,9 +65,13 @@ contains
    !> Append the order's rows to their datasets.
    subroutine write_rows(order)
       type(write_order), intent(inout) :: order
+      real(wp), allocatable :: series(:)
       integer :: i
+      if (order%fill > 0) allocate (series(order%fill))
       do i = 1, n_series
-         call append(order, order%series(i), 1, order%written, order%fill, order%rows(:, series_column(i)))
+         if (order%fill == 0) exit
+         series = order%rows(series_column(i), :order%fill)
+         call append(order, order%series(i), 1, order%written, order%fill, series)
       end do
       if (order%stops_fill > 0) then
          call append(order, order%stops_u, order%stops, order%stops_written, order%stops_fill, order%stops_u_rows, &
