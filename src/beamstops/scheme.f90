@@ -28,6 +28,7 @@ module beamstops_scheme
    use beamstops_contact_mass_redistribution, only: equilibrium_rows
    use beamstops_start, only: start_state
    use beamstops_span_step, only: span_loop_type, start_span_block, next_span_step, span_step, end_span_block
+   use beamstops_observe_quiet, only: quiet_observer, take_quiet, give_quiet, observe_quiet
    use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running, &
       & check_divergence
    implicit none
@@ -233,6 +234,7 @@ contains
       logical :: held
       type(tip_outcome) :: outcome
       type(load_rotation) :: loads
+      type(quiet_observer) :: quiet
 
       call first_events(scene, state%step, next_record, next_snapshot)
       held = .false.
@@ -240,6 +242,7 @@ contains
       gd = 0
       ! sums: u.S u, d.S u and d.M d of this step's forward pass, and u.S u of the one before
       sums = 0
+      call take_quiet(quiet, state%observer)
       call start_loads(loads, state%step + 1, model%dt, scene%omega, scene%centered_load)
       do step = state%step, last
          sigma_next = loads%sigma
@@ -249,7 +252,7 @@ contains
             & state%u, state%d, model%dt2*weight, model%dt2, spring_term(scene, model, state), &
             & (held .and. step - 1 == next_record) .or. step == next_record, &
             & state%su, state%rhs, sums(1), sums(2), sums(3))
-         if (held) call settle_held(scene, model, state, recorder, step - 1, outcome, gd, held_weight, sums, &
+         if (held) call settle_held(scene, model, state, recorder, quiet, step - 1, outcome, gd, held_weight, sums, &
             & next_record, next_snapshot)
          sums(4) = sums(1)
          call back_substitution_edge(model%solver, state%rhs)
@@ -265,16 +268,17 @@ contains
       if (held) then
          if (last == next_record) call energy_dots(model%mass_diagonals, state%u, state%d, state%su, sums(1), sums(2), &
             & sums(3))
-         call settle_held(scene, model, state, recorder, last, outcome, gd, held_weight, sums, &
+         call settle_held(scene, model, state, recorder, quiet, last, outcome, gd, held_weight, sums, &
             & next_record, next_snapshot)
       end if
+      call give_quiet(quiet, state%observer)
    end subroutine advance_fused
 
    !> The books of step n of advance_fused, done while the forward pass of step n+1 runs (it
    !> leaves u^{n+1} and d^n alone): settle_tip with g.d^n (taken by the back substitution's
    !> update, d^n_tip as the update left it, before fix_tip, as in tip_step), the observer, the record row (its energy from `sums`) and the
    !> snapshot.
-   subroutine settle_held(scene, model, state, recorder, step, outcome, gd, weight, sums, next_record, &
+   subroutine settle_held(scene, model, state, recorder, quiet, step, outcome, gd, weight, sums, next_record, &
       & next_snapshot)
       !> Scene.
       type(scene_type), intent(in) :: scene
@@ -284,6 +288,8 @@ contains
       type(state_type), intent(inout) :: state
       !> Receives the records.
       class(recorder_type), intent(inout) :: recorder
+      !> The observer's quiet values (beamstops_observe_quiet).
+      type(quiet_observer), intent(inout) :: quiet
       !> Step n.
       integer(ik), intent(in) :: step
       !> The step's contact, reaction and tip values (tip_update).
@@ -297,8 +303,8 @@ contains
       real(wp) :: r_prev, row(n_columns)
       r_prev = state%reaction
       call settle_tip(scene, model, state, outcome, gd, weight)
-      if (state%observer%takes(real(step + 1, wp)*model%dt)) call state%observer%tip(real(step + 1, wp)*model%dt, &
-         & state%u(model%tip), merge(state%reaction, 0.0_wp, state%in_contact), state%dissipated)
+      call observe_quiet(quiet, state%observer, real(step + 1, wp)*model%dt, state%u(model%tip), &
+         & merge(state%reaction, 0.0_wp, state%in_contact), state%dissipated)
       if (step == next_record) then
          next_record = next_record + scene%record_every
          call fill_row(scene, model, state, step, outcome%u_tip_prev, outcome%d_tip_prev, r_prev, row)

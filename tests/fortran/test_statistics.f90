@@ -10,6 +10,8 @@ module test_statistics
    use beamstops_observe_shocks, only: shock_log, shock_row, new_shock_log, shock_row_values
    use beamstops_observe_statistics, only: statistics_type, new_statistics, validate_statistics, validate_ensemble, &
       & statistics_table, quantity_type, ensemble_table, student_t_quantile, student_t_cdf
+   use beamstops_observe_observer, only: observer_type, new_observer
+   use beamstops_observe_quiet, only: quiet_observer, take_quiet, give_quiet, observe_quiet
    use test_shocks, only: uniform, same_bits, expect_message
    implicit none
    private
@@ -36,6 +38,7 @@ contains
          & new_unittest('ensemble: mean and t s/sqrt(K) across members; bad members', test_ensemble), &
          & new_unittest('pack at a random midpoint, unpack, continue: the same tables bit for bit', test_pack_resume), &
          & new_unittest('unpack of a truncated, padded, foreign or corrupted vector: an error', test_unpack_bad), &
+         & new_unittest('quiet samples in the loop''s variables: the observer of tip, bit for bit', test_quiet), &
          & new_unittest('per-step cost of the shock log and the statistics (printed)', test_cost) &
          & ]
    end subroutine collect_statistics
@@ -536,6 +539,70 @@ contains
          if (.not. same_tables) return
       end do
    end function same_tables
+
+   !> The one-scene loop's observer (beamstops_observe_quiet) against observer_type's tip on the
+   !> same samples: quiet stretches, contact bursts with energy taken, the tip across the
+   !> histogram's bins and beyond its range, batch edges, the window's end, a NaN; the quiet values
+   !> handed back and taken again at random steps (the loop's calls). The packed observers and
+   !> the final tables agree bit for bit; before a hand-back they differ (the quiet path was
+   !> taken).
+   subroutine test_quiet(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: n = 6000
+      type(observer_type) :: a, b
+      type(quiet_observer) :: q
+      type(statistics_table) :: ta, tb
+      real(wp), allocatable :: va(:), vb(:), shocks_a(:, :), shocks_b(:, :)
+      real(wp) :: u, r, dissipated, t
+      integer(ik) :: s1, s2
+      integer :: trial, k
+      logical :: kept_apart
+      s1 = 7
+      s2 = 4242
+      do trial = 1, 4
+         kept_apart = .false.
+         call new_observer(a, 1, [0.0_wp], 2.0_wp, dt, 3*dt, 0.3_wp, n*dt, 6, 11, -0.1_wp, 0.1_wp, 0.0_wp, &
+            & int(n - 200*trial, ik), error)
+         if (allocated(error)) return
+         b = a
+         call take_quiet(q, b)
+         dissipated = 0
+         do k = 1, n
+            t = k*dt
+            u = 0.13_wp*sin(0.011_wp*k + trial) + 0.002_wp*uniform(s1, s2)
+            r = 0
+            if (abs(u) > 0.1_wp .and. uniform(s1, s2) < 0.6_wp) r = -sign(0.5_wp + uniform(s1, s2), u)
+            if (r /= 0 .and. uniform(s1, s2) < 0.5_wp) dissipated = dissipated + 0.01_wp*abs(r)
+            if (trial == 4 .and. k == n - 10) u = ieee_value(u, ieee_quiet_nan)
+            if (a%takes(t)) call a%tip(t, u, r, dissipated)
+            call observe_quiet(q, b, t, u, r, dissipated)
+            if (uniform(s1, s2) < 1.0e-3_wp) then
+               call give_quiet(q, b)
+               call take_quiet(q, b)
+            end if
+            if (mod(k, 250) == 0) then
+               call a%pack(va)
+               call b%pack(vb)
+               kept_apart = kept_apart .or. size(va) /= size(vb) .or. .not. all(same_bits(va, vb))
+            end if
+         end do
+         call check(error, kept_apart, 'trial '//int_text(trial)//': the quiet samples were kept in the loop''s '// &
+            & 'variables'); if (allocated(error)) return
+         call a%pack(va)
+         call give_quiet(q, b)
+         call b%pack(vb)
+         call check(error, size(va) == size(vb), 'trial '//int_text(trial)//': packed sizes'); if (allocated(error)) return
+         call check(error, all(same_bits(va, vb)), 'trial '//int_text(trial)//': packed observers bit for bit')
+         if (allocated(error)) return
+         call a%finish(shocks_a, ta)
+         call b%finish(shocks_b, tb)
+         call check(error, size(shocks_a) == size(shocks_b) .and. size(shocks_a, 2) > 0, 'trial '//int_text(trial)// &
+            & ': shocks'); if (allocated(error)) return
+         call check(error, all(same_bits(shocks_a, shocks_b)), 'trial '//int_text(trial)//': shock rows')
+         if (allocated(error)) return
+         call check(error, same_tables(ta, tb), 'trial '//int_text(trial)//': tables'); if (allocated(error)) return
+      end do
+   end subroutine test_quiet
 
    !> A shock log and statistics of 2 stops packed at a random midpoint (in the transient, in a
    !> batch, with rows waiting), unpacked into fresh objects, then both pairs continued with the
