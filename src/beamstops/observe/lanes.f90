@@ -22,7 +22,7 @@ module beamstops_observe_lanes
    use beamstops_observe_statistics, only: quiet_tip_stats
    implicit none
    private
-   public :: observer_lanes, gather_observers, scatter_observers, observe_lanes
+   public :: observer_lanes, gather_observers, scatter_observers, observe_lanes, quiet_pass, count_quiet
 
    !> The values quiet samples read and change, per lane of a chunk. Each test of a quiet sample is
    !> a compare of doubles (so that the chunk's test is a few whole-register compares): the lane's
@@ -99,38 +99,22 @@ contains
       !> Tip displacement (m), reaction and energy taken so far per unit mass, of every lane.
       real(wp), intent(in) :: u_tip(lockstep_lanes), reaction(lockstep_lanes), dissipated(lockstep_lanes)
       logical :: quiet(lockstep_lanes), other(lockstep_lanes)
-      real(wp) :: x, pass(lockstep_lanes)
+      real(wp) :: pass(lockstep_lanes)
       integer :: i
-      ! quiet: taken, no reaction, no energy, before the deadline and the batch's end, in the run's
-      ! bin (tip_sample's bin is int(x), x clamped to [0, bins - 1/2]), finite. Each test gives 1
-      ! or 0 by merge and the tests are multiplied: whole-register compares and selects, where
-      ! tests joined by .and. become a branch per lane and test (a compare may trap, so the
-      ! compiler keeps them in order).
+      ! quiet_pass and count_quiet lane by lane: whole-register compares, selects and adds
 !GCC$ ivdep
 !GCC$ vector
       do i = 1, lockstep_lanes
-         x = min(max((u_tip(i) - lanes%lower(i))*lanes%scale(i), 0.0_wp), lanes%top(i))
-         pass(i) = merge(1.0_wp, 0.0_wp, reaction(i) == 0)*merge(1.0_wp, 0.0_wp, dissipated(i) == lanes%seen(i)) &
-            & *merge(1.0_wp, 0.0_wp, lanes%left(i) > 0)*merge(1.0_wp, 0.0_wp, t < lanes%next_edge(i)) &
-            & *merge(1.0_wp, 0.0_wp, x >= lanes%bin_low(i))*merge(1.0_wp, 0.0_wp, x < lanes%bin_low(i) + 1) &
-            & *merge(1.0_wp, 0.0_wp, abs(u_tip(i)) <= huge(1.0_wp))*merge(1.0_wp, 0.0_wp, t <= lanes%t_stop(i))
+         pass(i) = quiet_pass(t, u_tip(i), reaction(i), dissipated(i), lanes%seen(i), lanes%left(i), &
+            & lanes%next_edge(i), lanes%lower(i), lanes%scale(i), lanes%top(i), lanes%bin_low(i), lanes%t_stop(i))
          quiet(i) = pass(i) > 0
          other(i) = t <= lanes%t_stop(i) .neqv. quiet(i)
       end do
 !GCC$ ivdep
 !GCC$ vector
       do i = 1, lockstep_lanes
-         if (quiet(i)) then
-            lanes%k(i) = lanes%k(i) + 1
-            lanes%left(i) = lanes%left(i) - 1
-            lanes%u2(i) = lanes%u1(i)
-            lanes%u1(i) = u_tip(i)
-            lanes%su(i) = lanes%su(i) + u_tip(i)
-            lanes%suu(i) = lanes%suu(i) + u_tip(i)*u_tip(i)
-            lanes%umin(i) = min(lanes%umin(i), u_tip(i))
-            lanes%umax(i) = max(lanes%umax(i), u_tip(i))
-            lanes%n(i) = lanes%n(i) + 1
-         end if
+         if (quiet(i)) call count_quiet(u_tip(i), lanes%k(i), lanes%left(i), lanes%u1(i), lanes%u2(i), lanes%su(i), &
+            & lanes%suu(i), lanes%umin(i), lanes%umax(i), lanes%n(i))
       end do
       if (.not. any(other)) return
       do i = 1, lockstep_lanes
@@ -142,6 +126,49 @@ contains
          end associate
       end do
    end subroutine observe_lanes
+
+   !> 1 when the sample of t (tip u_tip, the reaction, the stops' energy so far) is quiet for an
+   !> observer with these values (observer_lanes' components), else 0: taken (t <= t_stop), no
+   !> reaction, no energy (dissipated == seen), before the deadline and the batch's end, in the
+   !> run's bin (tip_sample's bin is int(x), x clamped to [0, bins - 1/2]), finite. Each test gives
+   !> 1 or 0 by merge and the tests are multiplied: whole-register compares and selects, where tests
+   !> joined by .and. become a branch per lane and test (a compare may trap, so the compiler keeps
+   !> them in order). beamstops_observe_quiet uses it for one scene.
+   elemental real(wp) function quiet_pass(t, u_tip, reaction, dissipated, seen, left, next_edge, lower, scale, top, &
+      & bin_low, t_stop) result(pass)
+      !> The sample: t (s), tip (m), reaction and energy taken so far (per unit mass).
+      real(wp), intent(in) :: t, u_tip, reaction, dissipated
+      !> The observer's values (observer_lanes).
+      real(wp), intent(in) :: seen, left, next_edge, lower, scale, top, bin_low, t_stop
+      real(wp) :: x
+      x = min(max((u_tip - lower)*scale, 0.0_wp), top)
+      pass = merge(1.0_wp, 0.0_wp, reaction == 0)*merge(1.0_wp, 0.0_wp, dissipated == seen) &
+         & *merge(1.0_wp, 0.0_wp, left > 0)*merge(1.0_wp, 0.0_wp, t < next_edge) &
+         & *merge(1.0_wp, 0.0_wp, x >= bin_low)*merge(1.0_wp, 0.0_wp, x < bin_low + 1) &
+         & *merge(1.0_wp, 0.0_wp, abs(u_tip) <= huge(1.0_wp))*merge(1.0_wp, 0.0_wp, t <= t_stop)
+   end function quiet_pass
+
+   !> A quiet sample u_tip: what the shock log's step_tip and the statistics' tip_sample do with it
+   !> (count it, shift the tip's last two values, add to the sums and extremes), in their order.
+   elemental subroutine count_quiet(u_tip, k, left, u1, u2, su, suu, umin, umax, n)
+      !> The tip (m).
+      real(wp), intent(in) :: u_tip
+      !> The log's samples seen and quiet samples left; the tip's last two values.
+      integer(ik), intent(inout) :: k
+      real(wp), intent(inout) :: left, u1, u2
+      !> The statistics' sum, sum of squares, extremes and count.
+      real(wp), intent(inout) :: su, suu, umin, umax
+      integer(ik), intent(inout) :: n
+      k = k + 1
+      left = left - 1
+      u2 = u1
+      u1 = u_tip
+      su = su + u_tip
+      suu = suu + u_tip*u_tip
+      umin = min(umin, u_tip)
+      umax = max(umax, u_tip)
+      n = n + 1
+   end subroutine count_quiet
 
    !> Lane i's values from its member's observer.
    subroutine take(lanes, i, observer)

@@ -2,14 +2,15 @@
 !> loop's own variables: the tip off the stops (no reaction), no energy taken, before the shock
 !> log's deadline and the batch's end, in the histogram run's bin. Such a sample only counts and
 !> adds (the tip's last two values, sums, extremes); every other sample goes to observer_type's
-!> tip, with the quiet values handed back first and taken again after. The tests and the
-!> operations are those of beamstops_observe_lanes for one lane (which the lockstep tests compare
-!> with observer_type's tip): the same bits. In the loop, the observer's tip through its shock log
+!> tip, with the quiet values handed back first and taken again after. The test and the count
+!> are beamstops_observe_lanes' quiet_pass and count_quiet, which the lockstep lanes use (and the
+!> lockstep tests compare with observer_type's tip): the same bits. In the loop, the observer's tip through its shock log
 !> and statistics cost about 13 ns a step (the program on the paper's Figure 4 scene, A/B).
 module beamstops_observe_quiet
    use beamstops_kinds, only: wp, ik
    use beamstops_observe_observer, only: observer_type
    use beamstops_observe_statistics, only: quiet_tip_stats
+   use beamstops_observe_lanes, only: quiet_pass, count_quiet
    implicit none
    private
    public :: quiet_observer, take_quiet, give_quiet, observe_quiet
@@ -67,21 +68,10 @@ contains
       type(observer_type), intent(inout) :: observer
       !> t_{n+1} (s), tip displacement (m), reaction and energy taken so far per unit mass.
       real(wp), intent(in) :: t, u_tip, reaction, dissipated
-      real(wp) :: x
       if (.not. q%live .or. t > q%t_stop) return
-      ! tip_sample's bin is int(x), x clamped to [0, bins - 1/2]
-      x = min(max((u_tip - q%s%lower)*q%s%scale, 0.0_wp), q%s%top)
-      if (reaction == 0 .and. dissipated == q%seen .and. q%left > 0 .and. t < q%s%next_edge .and. &
-         & x >= q%bin_low .and. x < q%bin_low + 1 .and. abs(u_tip) <= huge(1.0_wp)) then
-         q%k = q%k + 1
-         q%left = q%left - 1
-         q%u2 = q%u1
-         q%u1 = u_tip
-         q%s%su = q%s%su + u_tip
-         q%s%suu = q%s%suu + u_tip*u_tip
-         q%s%umin = min(q%s%umin, u_tip)
-         q%s%umax = max(q%s%umax, u_tip)
-         q%s%n = q%s%n + 1
+      if (quiet_pass(t, u_tip, reaction, dissipated, q%seen, q%left, q%s%next_edge, q%s%lower, q%s%scale, q%s%top, &
+         & q%bin_low, q%t_stop) > 0) then
+         call count_quiet(u_tip, q%k, q%left, q%u1, q%u2, q%s%su, q%s%suu, q%s%umin, q%s%umax, q%s%n)
       else
          call give_quiet(q, observer)
          call observer%tip(t, u_tip, reaction, dissipated)
