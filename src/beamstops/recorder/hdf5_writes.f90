@@ -65,13 +65,10 @@ contains
    !> Append the order's rows to their datasets.
    subroutine write_rows(order)
       type(write_order), intent(inout) :: order
-      real(wp), allocatable :: series(:)
       integer :: i
-      if (order%fill > 0) allocate (series(order%fill))
+      ! a series is a row of the records (columns, rows): its values go to append as a copy
       do i = 1, n_series
-         if (order%fill == 0) exit
-         series = order%rows(series_column(i), :order%fill)
-         call append(order, order%series(i), 1, order%written, order%fill, series)
+         call append(order, order%series(i), 1, order%written, order%fill, order%rows(series_column(i), :order%fill))
       end do
       if (order%stops_fill > 0) then
          call append(order, order%stops_u, order%stops, order%stops_written, order%stops_fill, order%stops_u_rows, &
