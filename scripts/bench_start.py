@@ -1,8 +1,10 @@
-"""The fixed cost of starting `beamstops run`: the program linked against HDF5's shared
-libraries against the default (static HDF5), the two alternating.
+"""The fixed cost of starting `beamstops run`: two builds of the program, the two alternating
+(by default one linked against HDF5's shared libraries against the default, static HDF5).
 
     meson setup build/shared -Dstatic_hdf5=false -Dpython=false -Dtests=false && meson compile -C build/shared
     python scripts/bench_start.py build/shared/beamstops .venv/bin/beamstops [--repeats 20]
+    meson setup build/dynlapack -Dstatic_lapack=false -Dpython=false -Dtests=false && meson compile -C build/dynlapack
+    python scripts/bench_start.py build/dynlapack/beamstops .venv/bin/beamstops --labels "shared LAPACK,static LAPACK"
 
 Three commands, each timed on both programs (wall, time.perf_counter; least and median of the
 repeats; OPENBLAS_NUM_THREADS=1): `--version`; a 100-step run of the paper's scene
@@ -35,12 +37,16 @@ def scene(text: str, folder: Path, name: str, **keys: str) -> Path:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("shared", help="the program built with -Dstatic_hdf5=false")
+    parser.add_argument("shared", help="the program built with -Dstatic_hdf5=false (or another option off)")
     parser.add_argument("static", help="the program built by default")
     parser.add_argument("--repeats", type=int, default=20)
+    parser.add_argument("--labels", default="shared HDF5,static HDF5", help="the two programs' columns")
     args = parser.parse_args()
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
-    programs = {"shared HDF5": args.shared, "static HDF5": args.static}
+    labels = args.labels.split(",")
+    if len(labels) != 2:
+        parser.error("--labels takes two names separated by a comma")
+    programs = {labels[0]: args.shared, labels[1]: args.static}
     base = (REPO / "input" / "paper_fig4.nml").read_text()
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
