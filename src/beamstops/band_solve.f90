@@ -15,6 +15,7 @@
 !> and each new row overwrites the farthest, so the roles rotate and no value is
 !> copied between rows (a register copy lengthens the chain by a cycle a row).
 module beamstops_band_solve
+   use, intrinsic :: iso_c_binding, only: c_int32_t, c_double
    use beamstops_kinds, only: wp
    use beamstops_band, only: kd
    implicit none
@@ -34,8 +35,15 @@ module beamstops_band_solve
       real(wp), allocatable :: inv_d2(:)
    end type band_solver
 
-   !> Partial sums of energy_dots (rows a vector operation).
-   integer, parameter :: energy_lanes = 4
+   interface
+      !> The sums of energy_dots (src/beamstops/energy_rows.c): u.su, d.su and d.M d.
+      pure subroutine energy_rows(n, m, u, d, su, sums) bind(C, name='beamstops_energy_rows')
+         import :: c_int32_t, c_double
+         integer(c_int32_t), value, intent(in) :: n
+         real(c_double), intent(in) :: m(n, 0:3), u(n), d(n), su(n)
+         real(c_double), intent(out) :: sums(3)
+      end subroutine energy_rows
+   end interface
 
    !> A symmetric kd = 3 band matrix stored by diagonals, the layout a vectorized product reads.
    type :: band_diagonals
@@ -121,11 +129,13 @@ contains
    end subroutine forward_rows
 
    !> The dot products of the discrete energy: usu = u.su, dsu = d.su and dmd = d.M d =
-   !> sum_j d_j (M_jj d_j + 2 sum_k M_j-k,j d_j-k) (M by diagonals), each in four partial sums
-   !> (row j in sum mod(j - 1, 4) + 1, so that four rows are one vector operation) added as
-   !> (s1 + s2) + (s3 + s4) at the end: a fixed order, with no running sum of products for the
-   !> compiler to round apart (beamstops_band_solve_lockstep's lockstep_energy_dots does the
-   !> same for each member).
+   !> sum_j d_j (M_jj d_j + 2 sum_k M_j-k,j d_j-k) (M by diagonals), each in eight partial sums
+   !> (row j in sum mod(j - 1, 8) + 1, so that eight rows are one vector operation) added as
+   !> ((s1 + s2) + (s3 + s4)) + ((s5 + s6) + (s7 + s8)) at the end: a fixed order, with no running
+   !> sum of products for the compiler to round apart (beamstops_band_solve_lockstep's
+   !> lockstep_energy_dots does the same for each member). A lane with no row (n < 8) stays 0.
+   !> The rows are those of src/beamstops/energy_rows.c (eight rows a vector operation with
+   !> AVX-512).
    pure subroutine energy_dots(mass, u, d, su, usu, dsu, dmd)
       !> M by diagonals.
       type(band_diagonals), intent(in) :: mass
@@ -133,68 +143,12 @@ contains
       real(wp), intent(in), contiguous :: u(:), d(:), su(:)
       !> u.su, d.su and d.M d.
       real(wp), intent(out) :: usu, dsu, dmd
-      integer :: i, j, n
-      real(wp) :: t
-      n = mass%n
-      if (n < energy_lanes) then
-         usu = 0
-         dsu = 0
-         dmd = 0
-         do j = 1, n
-            t = mass%a(j, 0)*d(j)
-            do i = max(1, j - kd), j - 1
-               t = t + 2*mass%a(j, j - i)*d(i)
-            end do
-            usu = usu + u(j)*su(j)
-            dsu = dsu + d(j)*su(j)
-            dmd = dmd + d(j)*t
-         end do
-         return
-      end if
-      call energy_rows(n, mass%a, u, d, su, usu, dsu, dmd)
+      real(wp) :: sums(3)
+      call energy_rows(mass%n, mass%a, u, d, su, sums)
+      usu = sums(1)
+      dsu = sums(2)
+      dmd = sums(3)
    end subroutine energy_dots
-
-   !> The rows of energy_dots for n >= 4 in explicit-shape arrays: the first four rows written
-   !> out (fewer neighbours), then four rows a turn, then the last rows (fewer than four). The
-   !> turn is a loop over the four lanes kept as a loop (unroll 1) and vectorized: one vector
-   !> operation per term, as each member's in beamstops_band_solve_lockstep. Unrolled, gfortran
-   !> vectorized the turns' loop instead, each partial sum a reduction in order (products
-   !> rounded apart: d.M d no longer matched the lockstep lanes'). 283 instructions a call at
-   !> J = 19 (callgrind, bench_kernels step 19 signorini 1), where the sums beside the forward
-   !> substitution had added 617 to it.
-   pure subroutine energy_rows(n, m, u, d, su, usu, dsu, dmd)
-      integer, intent(in) :: n
-      real(wp), intent(in) :: m(n, 0:kd), u(n), d(n), su(n)
-      real(wp), intent(out) :: usu, dsu, dmd
-      real(wp) :: a(energy_lanes), b(energy_lanes), c(energy_lanes)
-      integer :: j, l
-      a = u(1:4)*su(1:4)
-      b = d(1:4)*su(1:4)
-      c(1) = d(1)*(m(1, 0)*d(1))
-      c(2) = d(2)*(m(2, 0)*d(2) + 2*(m(2, 1)*d(1)))
-      c(3) = d(3)*(m(3, 0)*d(3) + 2*(m(3, 1)*d(2) + m(3, 2)*d(1)))
-      c(4) = d(4)*(m(4, 0)*d(4) + 2*(m(4, 1)*d(3) + m(4, 2)*d(2) + m(4, 3)*d(1)))
-      do j = energy_lanes + 1, n - energy_lanes + 1, energy_lanes
-!GCC$ unroll 1
-!GCC$ ivdep
-!GCC$ vector
-         do l = 0, energy_lanes - 1
-            a(l + 1) = a(l + 1) + u(j + l)*su(j + l)
-            b(l + 1) = b(l + 1) + d(j + l)*su(j + l)
-            c(l + 1) = c(l + 1) + d(j + l)*(m(j + l, 0)*d(j + l) + 2*(m(j + l, 1)*d(j + l - 1) &
-               & + m(j + l, 2)*d(j + l - 2) + m(j + l, 3)*d(j + l - 3)))
-         end do
-      end do
-      do l = 1, n - j + 1
-         a(l) = a(l) + u(j + l - 1)*su(j + l - 1)
-         b(l) = b(l) + d(j + l - 1)*su(j + l - 1)
-         c(l) = c(l) + d(j + l - 1)*(m(j + l - 1, 0)*d(j + l - 1) + 2*(m(j + l - 1, 1)*d(j + l - 2) &
-            & + m(j + l - 1, 2)*d(j + l - 3) + m(j + l - 1, 3)*d(j + l - 4)))
-      end do
-      usu = (a(1) + a(2)) + (a(3) + a(4))
-      dsu = (b(1) + b(2)) + (b(3) + b(4))
-      dmd = (c(1) + c(2)) + (c(3) + c(4))
-   end subroutine energy_rows
 
    !> The first three rows of the forward substitution (n >= 3): b(1:3) replaced by
    !> D^{-2} w(1:3), and w(1:3) returned in xa, xb, xc for the rows that follow.

@@ -114,8 +114,9 @@ contains
    end subroutine forward_last_rows
 
    !> The dot products of the discrete energy of every lane (beamstops_band_solve's
-   !> energy_dots): usu = u.su, dsu = d.su, dmd = d.M d, each in four partial sums per lane (row j
-   !> in sum mod(j - 1, 4) + 1) added as (s1 + s2) + (s3 + s4).
+   !> energy_dots): usu = u.su, dsu = d.su, dmd = d.M d, each in eight partial sums per lane (row
+   !> j in sum mod(j - 1, 8) + 1; a sum with no row stays 0) added as
+   !> ((s1 + s2) + (s3 + s4)) + ((s5 + s6) + (s7 + s8)).
    pure subroutine lockstep_energy_dots(mass, u, d, su, usu, dsu, dmd)
       !> M by diagonals.
       type(band_diagonals), intent(in) :: mass
@@ -123,28 +124,50 @@ contains
       real(wp), intent(in) :: u(lockstep_lanes, mass%n), d(lockstep_lanes, mass%n), su(lockstep_lanes, mass%n)
       !> u.su, d.su and d.M d of every lane (lanes).
       real(wp), intent(out) :: usu(lockstep_lanes), dsu(lockstep_lanes), dmd(lockstep_lanes)
-      real(wp) :: a(lockstep_lanes, 4), b(lockstep_lanes, 4), c(lockstep_lanes, 4)
+      integer, parameter :: sums = 8
+      real(wp) :: a(lockstep_lanes, sums), b(lockstep_lanes, sums), c(lockstep_lanes, sums)
       integer :: i, k, l, n
       n = mass%n
+      a = 0
+      b = 0
+      c = 0
       associate (m => mass%a)
+         do i = 1, min(n, sums)
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               a(k, i) = u(k, i)*su(k, i)
+               b(k, i) = d(k, i)*su(k, i)
+            end do
+         end do
 !GCC$ ivdep
 !GCC$ vector
          do k = 1, lockstep_lanes
-            a(k, 1) = u(k, 1)*su(k, 1)
-            a(k, 2) = u(k, 2)*su(k, 2)
-            a(k, 3) = u(k, 3)*su(k, 3)
-            a(k, 4) = u(k, 4)*su(k, 4)
-            b(k, 1) = d(k, 1)*su(k, 1)
-            b(k, 2) = d(k, 2)*su(k, 2)
-            b(k, 3) = d(k, 3)*su(k, 3)
-            b(k, 4) = d(k, 4)*su(k, 4)
             c(k, 1) = d(k, 1)*(m(1, 0)*d(k, 1))
-            c(k, 2) = d(k, 2)*(m(2, 0)*d(k, 2) + 2*(m(2, 1)*d(k, 1)))
-            c(k, 3) = d(k, 3)*(m(3, 0)*d(k, 3) + 2*(m(3, 1)*d(k, 2) + m(3, 2)*d(k, 1)))
-            c(k, 4) = d(k, 4)*(m(4, 0)*d(k, 4) + 2*(m(4, 1)*d(k, 3) + m(4, 2)*d(k, 2) + m(4, 3)*d(k, 1)))
          end do
-         do i = 5, n
-            l = mod(i - 1, 4) + 1
+         if (n >= 2) then
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               c(k, 2) = d(k, 2)*(m(2, 0)*d(k, 2) + 2*(m(2, 1)*d(k, 1)))
+            end do
+         end if
+         if (n >= 3) then
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               c(k, 3) = d(k, 3)*(m(3, 0)*d(k, 3) + 2*(m(3, 1)*d(k, 2) + m(3, 2)*d(k, 1)))
+            end do
+         end if
+         do i = 4, min(n, sums)
+!GCC$ ivdep
+!GCC$ vector
+            do k = 1, lockstep_lanes
+               c(k, i) = d(k, i)*(m(i, 0)*d(k, i) + 2*(m(i, 1)*d(k, i - 1) + m(i, 2)*d(k, i - 2) + m(i, 3)*d(k, i - 3)))
+            end do
+         end do
+         do i = sums + 1, n
+            l = mod(i - 1, sums) + 1
 !GCC$ ivdep
 !GCC$ vector
             do k = 1, lockstep_lanes
@@ -158,9 +181,9 @@ contains
 !GCC$ ivdep
 !GCC$ vector
       do k = 1, lockstep_lanes
-         usu(k) = (a(k, 1) + a(k, 2)) + (a(k, 3) + a(k, 4))
-         dsu(k) = (b(k, 1) + b(k, 2)) + (b(k, 3) + b(k, 4))
-         dmd(k) = (c(k, 1) + c(k, 2)) + (c(k, 3) + c(k, 4))
+         usu(k) = ((a(k, 1) + a(k, 2)) + (a(k, 3) + a(k, 4))) + ((a(k, 5) + a(k, 6)) + (a(k, 7) + a(k, 8)))
+         dsu(k) = ((b(k, 1) + b(k, 2)) + (b(k, 3) + b(k, 4))) + ((b(k, 5) + b(k, 6)) + (b(k, 7) + b(k, 8)))
+         dmd(k) = ((c(k, 1) + c(k, 2)) + (c(k, 3) + c(k, 4))) + ((c(k, 5) + c(k, 6)) + (c(k, 7) + c(k, 8)))
       end do
    end subroutine lockstep_energy_dots
 

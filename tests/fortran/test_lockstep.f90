@@ -49,6 +49,8 @@ contains
       tests = [ &
          & new_unittest('kernels: each lane equals the one-member kernel to the bit, J = 4..13, 19, 20, 100, 101', &
          & test_kernels), &
+         & new_unittest('energy sums: each lane equals energy_dots to the bit and the dot products to round-off, '// &
+         & 'n = 1..25, a band of random values', test_energy_sums), &
          & new_unittest('K = 1, Signorini, beta = 1/2', test_one), &
          & new_unittest('K = 3, no stops, beta = 1/4, different omega and amplitude', test_free_three), &
          & new_unittest('K = 5, Signorini, beta = 1/2, different stops, omega, amplitude, cadences', test_signorini_five), &
@@ -285,6 +287,60 @@ contains
    !> energy sums), the dot product, the update. The place to look first when the one-scene
    !> path or the compiler changes: the lockstep kernels reproduce where the compiled
    !> one-member kernels round (see the notes of beamstops_band_solve_lockstep).
+   !> lockstep_energy_dots against energy_dots (src/beamstops/energy_rows.c) on every n from 1 to
+   !> 25: the first and last rows under a mask, lanes with no row (n < 8), one or more whole turns.
+   !> A band of random values (of either sign) in place of M; u, d and su random. Each lane's three
+   !> sums equal energy_dots's to the bit, and the exact sums to n eps times the sums of the terms'
+   !> magnitudes.
+   subroutine test_energy_sums(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: lanes = lockstep_lanes
+      type(band_diagonals) :: m
+      real(wp), allocatable :: u(:, :), d(:, :), su(:, :), full(:, :)
+      real(wp) :: usu(lanes), dsu(lanes), dmd(lanes), e(3), f(3), g(3)
+      integer :: n, k, i, j, rep
+      character(len=:), allocatable :: where
+      do n = 1, 25
+         where = 'n = '//int_text(n)//': '
+         m%n = n
+         if (allocated(m%a)) deallocate (m%a, u, d, su, full)
+         allocate (m%a(n, 0:3), u(lanes, n), d(lanes, n), su(lanes, n), full(n, n))
+         do rep = 1, 5
+            call random_number(m%a)
+            call random_number(u)
+            call random_number(d)
+            call random_number(su)
+            m%a = m%a - 0.5_wp
+            d = d - 0.5_wp
+            su = su - 0.5_wp
+            ! the symmetric matrix of the band: m%a(j, k) is row j - k, column j
+            full = 0
+            do j = 1, n
+               full(j, j) = m%a(j, 0)
+               do i = max(1, j - 3), j - 1
+                  full(i, j) = m%a(j, j - i)
+                  full(j, i) = m%a(j, j - i)
+               end do
+            end do
+            call lockstep_energy_dots(m, u, d, su, usu, dsu, dmd)
+            do k = 1, lanes
+               call energy_dots(m, u(k, :), d(k, :), su(k, :), e(1), e(2), e(3))
+               if (.not. (same_bits(e(1), usu(k)) .and. same_bits(e(2), dsu(k)) .and. same_bits(e(3), dmd(k)))) then
+                  call test_failed(error, where//'lane '//int_text(k)//' is not energy_dots''s sums to the bit')
+                  return
+               end if
+               f = [dot_product(u(k, :), su(k, :)), dot_product(d(k, :), su(k, :)), dot_product(d(k, :), matmul(full, d(k, :)))]
+               g = [dot_product(abs(u(k, :)), abs(su(k, :))), dot_product(abs(d(k, :)), abs(su(k, :))), &
+                  & dot_product(abs(d(k, :)), matmul(abs(full), abs(d(k, :))))]
+               if (any(abs(f - e) > 8*n*epsilon(1.0_wp)*g)) then
+                  call test_failed(error, where//'lane '//int_text(k)//': the sums are not the dot products')
+                  return
+               end if
+            end do
+         end do
+      end do
+   end subroutine test_energy_sums
+
    subroutine test_kernels(error)
       type(error_type), allocatable, intent(out) :: error
       integer, parameter :: meshes(14) = [4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 19, 20, 100, 101]
