@@ -6,10 +6,10 @@
 !> the process may use more than one CPU and stops it at the end; a recorder without one (the
 !> Python layer's, a process bound to one CPU) carries the orders out where it posts them.
 module beamstops_writer_thread
-   use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_int, c_associated
+   use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_int, c_double, c_associated
    implicit none
    private
-   public :: writer_thread, start_writer, stop_writer, post_order, wait_orders
+   public :: writer_thread, start_writer, stop_writer, post_order, wait_orders, stream_row
 
    !> A handle on the writer thread (none: orders are carried out where they are posted).
    type :: writer_thread
@@ -38,6 +38,13 @@ module beamstops_writer_thread
          type(c_ptr), value :: handle
          type(c_ptr), value :: arg
       end subroutine c_writer_post
+      !> Copy a record of 8 values into a buffer that will be posted to the writer, past the
+      !> caches (writer_thread.c); post_order makes the copies visible to the writer.
+      subroutine stream_row(dst, src) bind(c, name='beamstops_stream_row')
+         import :: c_double
+         real(c_double), intent(out) :: dst(8)
+         real(c_double), intent(in) :: src(8)
+      end subroutine stream_row
    end interface
 
 contains

@@ -26,7 +26,7 @@ module beamstops_recorder_hdf5
    use beamstops_output_attributes, only: run_attributes, summary_attributes
    use beamstops_recorder_hdf5_observations, only: write_observations
    use beamstops_recorder_hdf5_writes, only: write_order, hand_over, n_series
-   use beamstops_writer_thread, only: writer_thread, wait_orders
+   use beamstops_writer_thread, only: writer_thread, wait_orders, stream_row
    implicit none
    private
    public :: hdf5_recorder, partial_path, check_output_path
@@ -141,7 +141,7 @@ contains
          return
       end if
       self%fill = self%fill + 1
-      self%buffer(:, self%fill) = row
+      call stream_row(self%buffer(:, self%fill), row)
       if (self%fill == buffer_rows) call write_buffer(self)
    end subroutine record
 
