@@ -140,30 +140,20 @@ contains
                b(k, i) = d(k, i)*su(k, i)
             end do
          end do
+         ! the first three rows, with fewer neighbours (n >= 1)
 !GCC$ ivdep
 !GCC$ vector
          do k = 1, lockstep_lanes
             c(k, 1) = d(k, 1)*(m(1, 0)*d(k, 1))
+            if (n >= 2) c(k, 2) = d(k, 2)*(m(2, 0)*d(k, 2) + 2*(m(2, 1)*d(k, 1)))
+            if (n >= 3) c(k, 3) = d(k, 3)*(m(3, 0)*d(k, 3) + 2*(m(3, 1)*d(k, 2) + m(3, 2)*d(k, 1)))
          end do
-         if (n >= 2) then
-!GCC$ ivdep
-!GCC$ vector
-            do k = 1, lockstep_lanes
-               c(k, 2) = d(k, 2)*(m(2, 0)*d(k, 2) + 2*(m(2, 1)*d(k, 1)))
-            end do
-         end if
-         if (n >= 3) then
-!GCC$ ivdep
-!GCC$ vector
-            do k = 1, lockstep_lanes
-               c(k, 3) = d(k, 3)*(m(3, 0)*d(k, 3) + 2*(m(3, 1)*d(k, 2) + m(3, 2)*d(k, 1)))
-            end do
-         end if
          do i = 4, min(n, sums)
 !GCC$ ivdep
 !GCC$ vector
             do k = 1, lockstep_lanes
-               c(k, i) = d(k, i)*(m(i, 0)*d(k, i) + 2*(m(i, 1)*d(k, i - 1) + m(i, 2)*d(k, i - 2) + m(i, 3)*d(k, i - 3)))
+               c(k, i) = d(k, i)*(m(i, 0)*d(k, i) + 2*(m(i, 1)*d(k, i - 1) + m(i, 2)*d(k, i - 2) &
+                  & + m(i, 3)*d(k, i - 3)))
             end do
          end do
          do i = sums + 1, n
