@@ -12,9 +12,9 @@
  * With AVX-512, eight rows are one vector operation, the first and last rows loaded under a mask:
  * about 190 instructions at n = 38 by its code (57 for the first eight rows, 18 a whole turn, 31
  * for the last rows, 30 for the three sums) where the Fortran rows took 283 (callgrind), the
- * largest part of the books of a recorded step (a step's instructions retire at a rate, about
- * 2.8 a cycle here, so that every instruction of the books costs the step). Without it, the same operations a row at
- * a time. */
+ * largest part of the books of a recorded step (a record costs the step about in proportion to
+ * its instructions: the README's "The Figure 4 run against its targets"). Without AVX-512, the
+ * same operations a row at a time. */
 #include <stdint.h>
 
 #if defined(__AVX512F__)

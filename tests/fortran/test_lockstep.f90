@@ -282,11 +282,6 @@ contains
       same = transfer(a, 1_int64) == transfer(b, 1_int64)
    end function same_bits
 
-   !> The kernels of beamstops_band_solve_lockstep against those of beamstops_band_solve, lane by
-   !> lane, on random vectors: the product by S, both substitutions (with and without the
-   !> energy sums), the dot product, the update. The place to look first when the one-scene
-   !> path or the compiler changes: the lockstep kernels reproduce where the compiled
-   !> one-member kernels round (see the notes of beamstops_band_solve_lockstep).
    !> lockstep_energy_dots against energy_dots (src/beamstops/energy_rows.c) on every n from 1 to
    !> 25: the first and last rows under a mask, lanes with no row (n < 8), one or more whole turns.
    !> A band of random values (of either sign) in place of M; u, d and su random. Each lane's three
@@ -341,6 +336,11 @@ contains
       end do
    end subroutine test_energy_sums
 
+   !> The kernels of beamstops_band_solve_lockstep against those of beamstops_band_solve, lane by
+   !> lane, on random vectors: the product by S, both substitutions (with and without the
+   !> energy sums), the dot product, the update. The place to look first when the one-scene
+   !> path or the compiler changes: the lockstep kernels reproduce where the compiled
+   !> one-member kernels round (see the notes of beamstops_band_solve_lockstep).
    subroutine test_kernels(error)
       type(error_type), allocatable, intent(out) :: error
       integer, parameter :: meshes(14) = [4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 19, 20, 100, 101]
