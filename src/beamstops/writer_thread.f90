@@ -39,12 +39,14 @@ module beamstops_writer_thread
          type(c_ptr), value :: arg
       end subroutine c_writer_post
       !> Copy a record of 8 values into a buffer that will be posted to the writer, past the
-      !> caches (writer_thread.c); post_order makes the copies visible to the writer.
-      subroutine stream_row(dst, src) bind(c, name='beamstops_stream_row')
-         import :: c_double
+      !> caches (writer_thread.c); post_order makes the copies visible to the writer. Returns
+      !> 1 when the values are all finite (beamstops_recorder's all_finite), 0 otherwise.
+      function stream_row(dst, src) bind(c, name='beamstops_stream_row') result(finite)
+         import :: c_double, c_int
          real(c_double), intent(out) :: dst(8)
          real(c_double), intent(in) :: src(8)
-      end subroutine stream_row
+         integer(c_int) :: finite
+      end function stream_row
    end interface
 
 contains

@@ -130,19 +130,21 @@ contains
       if (self%failed) call fatal_error(error, self%message)
    end subroutine open_file
 
-   !> Buffer one row; write the buffer when full.
+   !> Buffer one row; write the buffer when full. The row goes into the buffer's next place
+   !> first, and counts only when its values are finite (all_finite, tested by stream_row).
    subroutine record(self, row)
       class(hdf5_recorder), intent(inout) :: self
       real(wp), intent(in) :: row(n_columns)
-      if (self%blew_up .or. .not. all_finite(n_columns, row)) then
-         call self%stop_keeping(row(col_t))
-         ! the stops' values of this row came just before it
-         if (self%stops > 0 .and. self%stops_fill > 0) self%stops_fill = self%stops_fill - 1
-         return
+      if (.not. self%blew_up) then
+         if (stream_row(self%buffer(:, self%fill + 1), row) /= 0) then
+            self%fill = self%fill + 1
+            if (self%fill == buffer_rows) call write_buffer(self)
+            return
+         end if
       end if
-      self%fill = self%fill + 1
-      call stream_row(self%buffer(:, self%fill), row)
-      if (self%fill == buffer_rows) call write_buffer(self)
+      call self%stop_keeping(row(col_t))
+      ! the stops' values of this row came just before it
+      if (self%stops > 0 .and. self%stops_fill > 0) self%stops_fill = self%stops_fill - 1
    end subroutine record
 
    !> Buffer the stops' values of the row that follows; write the buffers when full.
