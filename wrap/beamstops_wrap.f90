@@ -29,8 +29,9 @@ subroutine bs_keys(text)
 end subroutine bs_keys
 
 !> The canonical text of a scene (every key, defaults filled in, values that read back
-!> exactly) from namelist text.
-subroutine bs_scene(text, source, canonical, status, message)
+!> exactly) from namelist text; `carried`: the keys it carries over from a scene being changed
+!> ('group:key' words; such a key that does nothing is dropped rather than refused).
+subroutine bs_scene(text, source, carried, canonical, status, message)
    use beamstops, only: error_type, scene_type, canonical_text
    use beamstops_wrap_support, only: scene_of, report
    implicit none
@@ -39,6 +40,8 @@ subroutine bs_scene(text, source, canonical, status, message)
    character(len=*), intent(in) :: text
    !> Source for messages.
    character(len=*), intent(in) :: source
+   !> Keys carried over ('group:key' words, blank-separated; blank: none).
+   character(len=*), intent(in) :: carried
    !> Canonical namelist text.
    character(len=131072), intent(out) :: canonical
    !> 0, or 1 with `message`.
@@ -48,7 +51,7 @@ subroutine bs_scene(text, source, canonical, status, message)
    type(scene_type) :: scene
    type(error_type), allocatable :: error
    canonical = ''
-   call scene_of(text, source, scene, error)
+   call scene_of(text, source, scene, error, carried)
    if (.not. allocated(error)) canonical = canonical_text(scene)
    call report(error, status, message)
 end subroutine bs_scene

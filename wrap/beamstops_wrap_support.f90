@@ -9,8 +9,9 @@ module beamstops_wrap_support
 contains
 
    !> The scene of namelist `text` (Scene.to_namelist's text), read, derived and validated by the
-   !> engine's one reader; `source` starts the messages.
-   subroutine scene_of(text, source, scene, error)
+   !> engine's one reader; `source` starts the messages; `carried`: the keys the text carries over
+   !> from a scene being changed (scene_from_text).
+   subroutine scene_of(text, source, scene, error, carried)
       !> Namelist text.
       character(len=*), intent(in) :: text
       !> Where the text came from ('scene', a file name).
@@ -19,7 +20,9 @@ contains
       type(scene_type), intent(out) :: scene
       !> Set on any bad input.
       type(error_type), allocatable, intent(out) :: error
-      call scene_from_text(text, trim(source), scene, error)
+      !> Keys carried over ('group:key' words).
+      character(len=*), intent(in), optional :: carried
+      call scene_from_text(text, trim(source), scene, error, carried=carried)
    end subroutine scene_of
 
    !> Turn an error object into status (0: none, 1: error) and a fixed-length message.

@@ -95,7 +95,11 @@ contains
    !> Read, derive and validate a scene from namelist text; `source` (a file name, or 'scene'
    !> for Python's text) starts every message. Missing groups and keys keep the paper's values;
    !> the output file is `default_file` when the text names none (unset when not given either).
-   subroutine scene_from_text(text, source, scene, error, default_file)
+   !> `carried` names keys the text carries over from a scene being changed rather than gives
+   !> anew (Python's Scene.replace), as 'group:key' words: such a key that does nothing under
+   !> the other keys (a spring without the compliance law, &damping modes without ratio) is
+   !> dropped where a key given anew is refused.
+   subroutine scene_from_text(text, source, scene, error, default_file, carried)
       !> Namelist text.
       character(len=*), intent(in) :: text
       !> Where the text came from, for messages.
@@ -106,6 +110,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
       !> Output file when the text names none.
       character(len=*), intent(in), optional :: default_file
+      !> Keys carried over from a scene being changed ('group:key' words, blank-separated).
+      character(len=*), intent(in), optional :: carried
       ! &beam
       real(wp) :: length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness
       ! &support
@@ -192,6 +198,10 @@ contains
          call fatal_error(error, source//": &stops law = '"//trim(law)//"' is out of range; allowed: "// &
             & "'signorini', 'compliance' or 'none'")
          return
+      end if
+      if (scene%law /= law_compliance) then
+         if (is_carried('stops:stiffness')) stiffness = unset
+         if (is_carried('stops:stiffness_per_mass')) stiffness_per_mass = unset
       end if
       if (scene%law /= law_compliance .and. (stiffness /= unset .or. stiffness_per_mass /= unset)) then
          spring_key = trim(merge('stiffness         ', 'stiffness_per_mass', stiffness /= unset))
@@ -334,6 +344,7 @@ contains
 
       !> &damping: the coefficients a and b, or the ratios (one value: both) at `modes`; not both.
       subroutine damping_forms()
+         if (ratio(1) == unset .and. ratio(2) == unset .and. is_carried('damping:modes')) modes = unset_node
          if (modes(1) /= unset_node .or. modes(2) /= unset_node) then
             if (modes(1) == unset_node .or. modes(2) == unset_node) then
                call fatal_error(error, source//': &damping modes = '//itoa(maxval(modes))//' (one value) is out of '// &
@@ -371,6 +382,13 @@ contains
          if (ratio(2) /= unset) scene%damping_ratio(2) = ratio(2)
          scene%damping_modes = modes
       end subroutine damping_forms
+
+      !> Whether `key` ('group:key') is among the keys carried over.
+      logical function is_carried(key)
+         character(len=*), intent(in) :: key
+         is_carried = .false.
+         if (present(carried)) is_carried = index(' '//carried//' ', ' '//key//' ') > 0
+      end function is_carried
 
       !> Read group g from `text` into the namelist variables.
       subroutine read_group(g, text, stat, msg)

@@ -49,7 +49,8 @@ contains
          & new_unittest('a bad logical followed by other keys names the key', test_bad_logical), &
          & new_unittest('a group not closed by / is told so', test_unclosed_group), &
          & new_unittest('more values than a list holds are out of range', test_too_many_values), &
-         & new_unittest('a bad value leaves no state: the next text is read whole', test_reader_state_after_bad_logical) &
+         & new_unittest('a bad value leaves no state: the next text is read whole', test_reader_state_after_bad_logical), &
+         & new_unittest('a carried key that does nothing is dropped, one given anew refused', test_carried_keys) &
          & ]
    end subroutine collect_namelist
 
@@ -508,4 +509,41 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_reader_state_after_bad_logical
+
+   !> Keys carried over from a scene being changed (Scene.replace): dropped where they do
+   !> nothing (a spring without the compliance law, &damping modes without ratio), kept where
+   !> they act, and refused when not carried.
+   subroutine test_carried_keys(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: spring = '&stops law = ''signorini'', stiffness_per_mass = 1e8 /', &
+         & compliance = '&stops law = ''compliance'', stiffness_per_mass = 1e8 / &time beta = 0.25, dt = 5e-6 /', &
+         & modes = '&damping modes = 1, 3 /', with_ratio = '&damping ratio = 0.01, modes = 1, 3 /'
+      type(scene_type) :: scene
+      type(error_type), allocatable :: failure
+      call scene_from_text(spring, 'scene', scene, failure)
+      call check(error, allocated(failure), 'a spring with law signorini, given anew, refused')
+      if (allocated(error)) return
+      deallocate (failure)
+      call scene_from_text(spring, 'scene', scene, failure, carried='stops:stiffness_per_mass')
+      call check(error, .not. allocated(failure), 'the same spring carried over, dropped')
+      if (allocated(error)) return
+      call check(error, scene%law == law_signorini, 'law signorini')
+      if (allocated(error)) return
+      call scene_from_text(compliance, 'scene', scene, failure, carried='stops:stiffness_per_mass')
+      call check(error, .not. allocated(failure), 'a carried spring with the compliance law')
+      if (allocated(error)) return
+      call check(error, scene%stiffness_per_mass, 1.0e8_wp, 'the carried spring acts')
+      if (allocated(error)) return
+      call scene_from_text(modes, 'scene', scene, failure, carried='stops:stiffness_per_mass')
+      call check(error, allocated(failure), 'modes without ratio, not carried, refused')
+      if (allocated(error)) return
+      deallocate (failure)
+      call scene_from_text(modes, 'scene', scene, failure, carried='stops:stiffness_per_mass damping:modes')
+      call check(error, .not. allocated(failure) .and. .not. scene%damping_by_ratio, 'carried modes without ratio dropped')
+      if (allocated(error)) return
+      call scene_from_text(with_ratio, 'scene', scene, failure, carried='damping:modes')
+      call check(error, .not. allocated(failure), 'carried modes with ratio')
+      if (allocated(error)) return
+      call check(error, scene%damping_modes(2), 3, 'the carried modes act with ratio')
+   end subroutine test_carried_keys
 end module test_namelist

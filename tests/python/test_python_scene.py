@@ -243,3 +243,20 @@ def test_replace_leaves_out_a_spring_or_modes_the_change_makes_useless() -> None
     assert coefficients.mass_coefficient == 0.1 and "modes" not in coefficients.groups()["damping"]
     with pytest.raises(ValueError, match="without ratio"):
         Scene().replace(damping_modes=(1, 3))
+
+
+def test_the_engine_drops_a_carried_key_that_does_nothing_and_refuses_one_given_anew() -> None:
+    """The rule of idle keys is the engine's: Scene.replace only says which keys it carries over."""
+    spring = "&stops law = 'signorini', stiffness_per_mass = 1e8 /\n"
+    with pytest.raises(ValueError, match="stiffness_per_mass = .* only with law = 'compliance'"):
+        engine.canonical(spring)
+    assert "stiffness_per_mass" not in engine.canonical(spring, carried=["stops:stiffness_per_mass"])
+    # carried keys are dropped only where they do nothing: with the compliance law the spring stays
+    compliance = "&stops law = 'compliance', stiffness_per_mass = 1e8 /\n&time beta = 0.25, dt = 5e-6 /\n"
+    assert Scene.from_text(engine.canonical(compliance, carried=["stops:stiffness_per_mass"])).stiffness_per_mass == 1e8
+    modes = "&damping modes = 1, 3 /\n"
+    with pytest.raises(ValueError, match="without ratio"):
+        engine.canonical(modes, carried=["stops:stiffness_per_mass"])
+    assert "modes" not in Scene.from_text(engine.canonical(modes, carried=["damping:modes"])).groups()["damping"]
+    with pytest.raises(ValueError, match="only with law = 'compliance'"):
+        Scene(law="compliance", stiffness_per_mass=1e8, beta=0.25, dt=5e-6).replace(law="signorini", stiffness=1e6)

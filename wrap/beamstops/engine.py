@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 import re
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable, Optional
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Optional
 
 import numpy as np
 
@@ -61,9 +61,15 @@ def keys() -> dict[str, tuple[str, ...]]:
     return out
 
 
-def canonical(text: str, source: str = "scene") -> str:
-    """The engine's canonical text of namelist text (every key, defaults filled in)."""
-    result, status, message = engine_call(_engine.bs_scene, text.encode("utf-8"), os.fsencode(source))
+def canonical(text: str, source: str = "scene", carried: Iterable[str] = ()) -> str:
+    """The engine's canonical text of namelist text (every key, defaults filled in).
+
+    ``carried``: keys (``"group:key"``) the text carries over from a scene being changed rather
+    than gives anew; the engine drops such a key where it would do nothing (a spring without the
+    compliance law, ``&damping modes`` without ``ratio``) instead of refusing it."""
+    words = " ".join(carried) or " "
+    result, status, message = engine_call(_engine.bs_scene, text.encode("utf-8"), os.fsencode(source),
+                                          words.encode("utf-8"))
     _check(status, message)
     return _text(result)
 

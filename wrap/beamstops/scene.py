@@ -30,7 +30,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal, Optional, Union
+from typing import Any, Iterable, Literal, Optional, Union
 
 __all__ = ["Scene", "GROUPS", "ROUTES", "namelist_value"]
 
@@ -219,13 +219,10 @@ class Scene:
             for derived in ROUTES[route]:
                 values.pop(derived, None)
         values.update(changes)
-        # Keys the engine refuses where they would do nothing: a spring without the compliance
-        # law, &damping modes without ratio (unless the change gives them itself).
-        if values.get("law") != "compliance" and not {"stiffness", "stiffness_per_mass"} & set(changes):
-            values.pop("stiffness_per_mass", None)
-        if not values.get("ratio") and "damping_modes" not in changes:
-            values.pop("damping_modes", None)
-        return Scene.from_text(_namelist(values), _source)
+        # The keys not in `changes` are carried over: the engine drops those that would do nothing
+        # under the new keys (its rule), where it refuses such a key given anew.
+        carried = [f"{_GROUP_OF[key]}:{_KEY_OF.get(key, (None, key))[1]}" for key in values if key not in changes]
+        return Scene._of_canonical(_canonical(_namelist(values), _source, carried))
 
     # ------------------------------------------------------------------ output
 
@@ -306,10 +303,10 @@ def _namelist(values: Mapping[str, Any]) -> str:
     return "".join(f"&{group}\n" + "\n".join(lines) + "\n/\n" for group, lines in groups.items()) or "&time /\n"
 
 
-def _canonical(text: str, source: str) -> str:
+def _canonical(text: str, source: str, carried: Iterable[str] = ()) -> str:
     from . import engine
 
-    return engine.canonical(text, source)
+    return engine.canonical(text, source, carried)
 
 
 _LINE = re.compile(r"^  (\w+) = (.*)$")
