@@ -221,7 +221,7 @@ class Scene:
         values.update(changes)
         # The keys not in `changes` are carried over: the engine drops those that would do nothing
         # under the new keys (its rule), where it refuses such a key given anew.
-        carried = [f"{_GROUP_OF[key]}:{_KEY_OF.get(key, (None, key))[1]}" for key in values if key not in changes]
+        carried = ["{}:{}".format(*_group_key(key)) for key in values if key not in changes]
         return Scene._of_canonical(_canonical(_namelist(values), _source, carried))
 
     # ------------------------------------------------------------------ output
@@ -298,9 +298,14 @@ def _namelist(values: Mapping[str, Any]) -> str:
             continue
         if key in defaults and type(value) is type(defaults[key]) and value == defaults[key]:
             continue
-        name = _KEY_OF[key][1] if key in _KEY_OF else key
-        groups.setdefault(_GROUP_OF[key], []).append(f"  {name} = {namelist_value(value, key)}")
+        group, name = _group_key(key)
+        groups.setdefault(group, []).append(f"  {name} = {namelist_value(value, key)}")
     return "".join(f"&{group}\n" + "\n".join(lines) + "\n/\n" for group, lines in groups.items()) or "&time /\n"
+
+
+def _group_key(field: str) -> tuple[str, str]:
+    """The namelist group and key of a field or route (``damping_modes`` is ``&damping modes``)."""
+    return _KEY_OF.get(field, (_GROUP_OF[field], field))
 
 
 def _canonical(text: str, source: str, carried: Iterable[str] = ()) -> str:
