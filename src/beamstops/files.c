@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 /* 1 when the paths name the same file (same device and inode: a hard link, a symbolic
    link or another spelling of one path), 0 otherwise or when either does not exist. */
@@ -68,4 +69,19 @@ int beamstops_same_path(const char *a, const char *b)
     free(dir_a);
     free(dir_b);
     return same;
+}
+
+/* Move the finished file `from` onto `to`: a regular file at `to` is removed first, then `from`
+   renamed. A rename onto an existing file makes ext4 (its default auto_da_alloc) write the new
+   file's data out before the rename: 0.12-0.27 s for the Figure 4 run's 145 MB, against 0.02 s
+   for the removal (strace -T, each three times). The price: for a moment `to` does not exist,
+   and after a power cut the new file may be incomplete where the rename would have kept the old
+   one; an output can be run again, so outputs take this and checkpoints keep the atomic rename.
+   0 on success, -1 otherwise (`from` then stays where it is). */
+int beamstops_replace_file(const char *from, const char *to)
+{
+    struct stat s;
+    if (lstat(to, &s) == 0 && S_ISREG(s.st_mode))
+        unlink(to); /* a failure shows in the rename, which then replaces it */
+    return rename(from, to) == 0 ? 0 : -1;
 }

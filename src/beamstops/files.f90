@@ -4,7 +4,7 @@ module beamstops_files
    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
    implicit none
    private
-   public :: file_exists, is_directory, same_file, same_path, rename_file, remove_file
+   public :: file_exists, is_directory, same_file, same_path, rename_file, replace_file, remove_file
 
    interface
       function c_rename(from, to) bind(c, name='rename') result(status)
@@ -12,6 +12,11 @@ module beamstops_files
          character(kind=c_char), intent(in) :: from(*), to(*)
          integer(c_int) :: status
       end function c_rename
+      function c_replace_file(from, to) bind(c, name='beamstops_replace_file') result(status)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: from(*), to(*)
+         integer(c_int) :: status
+      end function c_replace_file
       function c_remove(path) bind(c, name='remove') result(status)
          import :: c_char, c_int
          character(kind=c_char), intent(in) :: path(*)
@@ -83,6 +88,18 @@ contains
       logical, intent(out) :: ok
       ok = c_rename(from//c_null_char, to//c_null_char) == 0
    end subroutine rename_file
+
+   !> Move the finished file `from` onto `to`, removing a regular file `to` first (not atomic:
+   !> for outputs, not checkpoints; beamstops_replace_file in src/beamstops/files.c says why).
+   subroutine replace_file(from, to, ok)
+      !> Existing file.
+      character(len=*), intent(in) :: from
+      !> New name.
+      character(len=*), intent(in) :: to
+      !> Whether the file is now at `to`.
+      logical, intent(out) :: ok
+      ok = c_replace_file(from//c_null_char, to//c_null_char) == 0
+   end subroutine replace_file
 
    !> Remove a file if it exists.
    subroutine remove_file(path)

@@ -325,6 +325,29 @@ def test_diverged_run_replaces_the_output_and_says_so(tmp_path: Path) -> None:
     assert not list(tmp_path.glob("*.partial")) and not list(tmp_path.glob("*.checkpoint"))
 
 
+@pytest.mark.parametrize("kind", ["file", "symbolic link", "hard link"])
+def test_a_finished_run_replaces_the_name_of_an_earlier_output_only(kind: str, tmp_path: Path) -> None:
+    """The finished file takes the output's name: an earlier output there is replaced; a link there is
+    replaced as a name, and what it led to (another output, another name of it) is left as it was."""
+    earlier, before = complete_output(tmp_path, "earlier.h5")
+    out = tmp_path / "out.h5"
+    if kind == "file":
+        out = earlier
+    elif kind == "symbolic link":
+        out.symlink_to(earlier.name)
+    else:
+        os.link(earlier, out)
+    scene = write(tmp_path, "&time dt=5e-5, t_end=0.2 /\n")
+    done = beamstops("run", scene, "-o", out.name, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert not out.is_symlink()
+    with h5py.File(out) as f:
+        assert f.attrs["status"] == b"complete" and f.attrs["steps"] == 4000
+    if kind != "file":
+        assert earlier.read_bytes() == before
+    assert not list(tmp_path.glob("*.partial"))
+
+
 # ---------------------------------------------------------------- one entry point: the Python subcommands
 
 

@@ -19,7 +19,7 @@ module beamstops_recorder_hdf5
    use beamstops_scene, only: scene_type, law_name, law_compliance, stop_count, steps_of
    use beamstops_model, only: model_type
    use beamstops_summary, only: run_summary, status_running, status_complete, status_diverged, status_failed
-   use beamstops_files, only: file_exists, is_directory, same_file, rename_file
+   use beamstops_files, only: file_exists, is_directory, same_file, replace_file
    use beamstops_recorder_hdf5_vector, only: write_vector
    use beamstops_recorder, only: recorder_type, n_columns, col_t, all_finite
    use beamstops_attributes, only: attribute_list, kind_real, kind_int, kind_logical, kind_text
@@ -254,7 +254,7 @@ contains
          return
       end if
       if (summary%status == status_complete .or. summary%status == status_diverged) then
-         call rename_file(self%partial, self%path, ok)
+         call replace_file(self%partial, self%path, ok)
          if (.not. ok) call fatal_error(error, self%path//': cannot move '//self%partial//' onto it')
       end if
    end subroutine finish
