@@ -38,6 +38,14 @@ int beamstops_stream_row(double *dst, const double *src)
         _mm512_stream_pd(dst, v);
         return finite;
     }
+#elif defined(__AVX__)
+    /* |x| <= DBL_MAX, ordered (false for NaN), on two 4-lane vectors */
+    const __m256d magnitude = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffffLL));
+    const __m256d largest = _mm256_set1_pd(DBL_MAX);
+    __m256d lo = _mm256_and_pd(_mm256_loadu_pd(src), magnitude);
+    __m256d hi = _mm256_and_pd(_mm256_loadu_pd(src + 4), magnitude);
+    int finite = _mm256_movemask_pd(_mm256_and_pd(_mm256_cmp_pd(lo, largest, _CMP_LE_OQ),
+                                                  _mm256_cmp_pd(hi, largest, _CMP_LE_OQ))) == 0xf;
 #else
     int finite = 1;
     for (int j = 0; j < 8; j++)

@@ -12,7 +12,9 @@ module test_writer
    use beamstops_recorder_hdf5_vector, only: read_vector
    use beamstops_run, only: continue_run
    use beamstops_files, only: remove_file, file_exists
-   use beamstops_writer_thread, only: writer_thread, start_writer, stop_writer
+   use beamstops_writer_thread, only: writer_thread, start_writer, stop_writer, stream_row
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_signaling_nan, &
+      & ieee_positive_inf, ieee_negative_inf
    implicit none
    private
    public :: collect_writer
@@ -26,7 +28,9 @@ contains
       tests = [ &
          & new_unittest('records written by the writer thread, with checkpoints among them, are the in-memory '// &
          & 'recorder''s, bit for bit', test_thread), &
-         & new_unittest('without a thread, the orders carried out where posted: the same bits', test_inline) &
+         & new_unittest('without a thread, the orders carried out where posted: the same bits', test_inline), &
+         & new_unittest('a record streamed into a buffer is the same bits and is finite unless one value is a NaN or '// &
+         & 'an infinity, at every position and buffer alignment', test_stream_row) &
          & ]
    end subroutine collect_writer
 
@@ -100,6 +104,41 @@ contains
       call compare_file(path, memory, error)
       call remove_file(path)
    end subroutine compare_with_memory
+
+   !> stream_row on records of ordinary, extreme (+-huge, +-tiny, a subnormal, -0) and non-finite
+   !> (quiet and signalling NaN, +-infinity) values, each non-finite value at each of the eight
+   !> positions, into a buffer at eight successive 8-byte offsets (each alignment the copy tells apart: 64-byte, 16-byte
+   !> and none).
+   subroutine test_stream_row(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: buffer(8 + 7), row(8), bad(4)
+      real(wp), parameter :: extreme(8) = [huge(1.0_wp), -huge(1.0_wp), tiny(1.0_wp), -tiny(1.0_wp), &
+         & tiny(1.0_wp)/8, -0.0_wp, 1.5_wp, -2.0e-300_wp]
+      integer :: offset, k, j
+      bad = [ieee_value(1.0_wp, ieee_quiet_nan), ieee_value(1.0_wp, ieee_signaling_nan), &
+         & ieee_value(1.0_wp, ieee_positive_inf), ieee_value(1.0_wp, ieee_negative_inf)]
+      do offset = 0, 7
+         buffer = 0
+         call check(error, stream_row(buffer(1 + offset:8 + offset), extreme) == 1, &
+            & 'finite extreme values are finite (offset '//int_text(offset)//')')
+         if (allocated(error)) return
+         call check(error, all(transfer(buffer(1 + offset:8 + offset), 1_ik, 8) == transfer(extreme, 1_ik, 8)), &
+            & 'the record is copied bit for bit (offset '//int_text(offset)//')')
+         if (allocated(error)) return
+         do k = 1, size(bad)
+            do j = 1, 8
+               row = extreme
+               row(j) = bad(k)
+               call check(error, stream_row(buffer(1 + offset:8 + offset), row) == 0, 'a non-finite value ('// &
+                  & int_text(k)//' of NaN, signalling NaN, +inf, -inf) at position '//int_text(j)//' is seen')
+               if (allocated(error)) return
+               call check(error, all(transfer(buffer(1 + offset:8 + offset), 1_ik, 8) == transfer(row, 1_ik, 8)), &
+                  & 'a non-finite record is copied too')
+               if (allocated(error)) return
+            end do
+         end do
+      end do
+   end subroutine test_stream_row
 
    !> /tip/t, /tip/u, /energy/E, /energy/work and /snapshots/t of `path` against `memory`.
    subroutine compare_file(path, memory, error)
