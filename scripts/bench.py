@@ -189,6 +189,9 @@ def machine(build: Path, program: Path) -> str:
     try:
         info = Path("/proc/cpuinfo").read_text()
         cpu = re.search(r"model name\s*:\s*(.*)", info).group(1).strip()
+        flags = set(re.search(r"flags\s*:\s*(.*)", info).group(1).split())
+        # the widest vectors the native build's kernels use (the energy sums, the record's test)
+        cpu += " (AVX-512)" if "avx512f" in flags else " (AVX2, no AVX-512)" if "avx2" in flags else ""
     except (OSError, AttributeError):
         pass
     fc = subprocess.run([os.environ.get("FC", "gfortran"), "--version"], capture_output=True, text=True).stdout
