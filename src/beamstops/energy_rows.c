@@ -19,6 +19,32 @@
  * one). Without either, the same operations a row at a time. */
 #include <stdint.h>
 
+/* The terms of one vector of rows j, j+1, ... added into *a, *b, *c (set by the first rows), the
+ * same operations in each vector variant: VEC the vector type, MUL, FMADD and ADD its operations,
+ * LOAD(k, p) a load from p of the rows whose neighbour j-k exists (k = 0: the rows that exist), 0
+ * in the other lanes. */
+#define ROW_TERMS(VEC, MUL, FMADD, ADD, LOAD)                                                            \
+    do {                                                                                                 \
+        VEC dj = LOAD(0, d + j), s = LOAD(0, su + j), uj = LOAD(0, u + j);                               \
+        VEC d1 = LOAD(1, d + j - 1), d2 = LOAD(2, d + j - 2), d3 = LOAD(3, d + j - 3);                   \
+        VEC k0 = LOAD(0, m + j), k1 = LOAD(1, m + n + j), k2 = LOAD(2, m + 2 * n + j);                   \
+        VEC k3 = LOAD(3, m + 3 * n + j);                                                                 \
+        VEC t = MUL(k2, d2);                                                                             \
+        t = FMADD(k1, d1, t);                                                                            \
+        t = FMADD(k3, d3, t);                                                                            \
+        t = ADD(t, t);                                                                                   \
+        t = FMADD(k0, dj, t);                                                                            \
+        if (first) {                                                                                     \
+            *a = MUL(uj, s);                                                                             \
+            *b = MUL(dj, s);                                                                             \
+            *c = MUL(dj, t);                                                                             \
+        } else {                                                                                         \
+            *a = FMADD(uj, s, *a);                                                                       \
+            *b = FMADD(dj, s, *b);                                                                       \
+            *c = FMADD(dj, t, *c);                                                                       \
+        }                                                                                                \
+    } while (0)
+
 #if defined(__AVX512F__)
 #include <immintrin.h>
 
@@ -27,30 +53,10 @@ static inline void turn(const double *m, int n, const double *u, const double *d
                         __mmask8 mask, __mmask8 m1, __mmask8 m2, __mmask8 m3, __m512d *a, __m512d *b, __m512d *c,
                         int first)
 {
-    __m512d dj = _mm512_maskz_loadu_pd(mask, d + j);
-    __m512d s = _mm512_maskz_loadu_pd(mask, su + j);
-    __m512d uj = _mm512_maskz_loadu_pd(mask, u + j);
-    __m512d d1 = _mm512_maskz_loadu_pd(mask & m1, d + j - 1);
-    __m512d d2 = _mm512_maskz_loadu_pd(mask & m2, d + j - 2);
-    __m512d d3 = _mm512_maskz_loadu_pd(mask & m3, d + j - 3);
-    __m512d k0 = _mm512_maskz_loadu_pd(mask, m + j);
-    __m512d k1 = _mm512_maskz_loadu_pd(mask & m1, m + n + j);
-    __m512d k2 = _mm512_maskz_loadu_pd(mask & m2, m + 2 * n + j);
-    __m512d k3 = _mm512_maskz_loadu_pd(mask & m3, m + 3 * n + j);
-    __m512d t = _mm512_mul_pd(k2, d2);
-    t = _mm512_fmadd_pd(k1, d1, t);
-    t = _mm512_fmadd_pd(k3, d3, t);
-    t = _mm512_add_pd(t, t);
-    t = _mm512_fmadd_pd(k0, dj, t);
-    if (first) {
-        *a = _mm512_mul_pd(uj, s);
-        *b = _mm512_mul_pd(dj, s);
-        *c = _mm512_mul_pd(dj, t);
-    } else {
-        *a = _mm512_fmadd_pd(uj, s, *a);
-        *b = _mm512_fmadd_pd(dj, s, *b);
-        *c = _mm512_fmadd_pd(dj, t, *c);
-    }
+    const __mmask8 lanes[4] = {mask, mask & m1, mask & m2, mask & m3};
+#define LOAD(k, p) _mm512_maskz_loadu_pd(lanes[k], (p))
+    ROW_TERMS(__m512d, _mm512_mul_pd, _mm512_fmadd_pd, _mm512_add_pd, LOAD);
+#undef LOAD
 }
 
 /* ((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7)) in lane 0. */
@@ -100,30 +106,9 @@ static inline void half_turn(const double *m, int n, const double *u, const doub
                              int j, const __m256i mask[4], int masked, __m256d *a, __m256d *b, __m256d *c,
                              int first)
 {
-    __m256d dj = load(d + j, mask[0], masked);
-    __m256d s = load(su + j, mask[0], masked);
-    __m256d uj = load(u + j, mask[0], masked);
-    __m256d d1 = load(d + j - 1, mask[1], masked);
-    __m256d d2 = load(d + j - 2, mask[2], masked);
-    __m256d d3 = load(d + j - 3, mask[3], masked);
-    __m256d k0 = load(m + j, mask[0], masked);
-    __m256d k1 = load(m + n + j, mask[1], masked);
-    __m256d k2 = load(m + 2 * n + j, mask[2], masked);
-    __m256d k3 = load(m + 3 * n + j, mask[3], masked);
-    __m256d t = _mm256_mul_pd(k2, d2);
-    t = _mm256_fmadd_pd(k1, d1, t);
-    t = _mm256_fmadd_pd(k3, d3, t);
-    t = _mm256_add_pd(t, t);
-    t = _mm256_fmadd_pd(k0, dj, t);
-    if (first) {
-        *a = _mm256_mul_pd(uj, s);
-        *b = _mm256_mul_pd(dj, s);
-        *c = _mm256_mul_pd(dj, t);
-    } else {
-        *a = _mm256_fmadd_pd(uj, s, *a);
-        *b = _mm256_fmadd_pd(dj, s, *b);
-        *c = _mm256_fmadd_pd(dj, t, *c);
-    }
+#define LOAD(k, p) load((p), mask[k], masked)
+    ROW_TERMS(__m256d, _mm256_mul_pd, _mm256_fmadd_pd, _mm256_add_pd, LOAD);
+#undef LOAD
 }
 
 /* ((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7)), s0..s3 in lo and s4..s7 in hi. */
