@@ -837,9 +837,10 @@ contains
       real(wp), intent(in) :: length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness
       type(scene_type), intent(inout) :: scene
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: material(4)
+      real(wp) :: material(4), low(4), high(4)
       character(len=*), parameter :: names(4) = ['youngs_modulus', 'density       ', 'outer_diameter', &
-         & 'wall_thickness']
+         & 'wall_thickness'], units(4) = ['Pa    ', 'kg/m^3', 'm     ', 'm     ']
+      character(len=:), allocatable :: low_text, high_text
       integer :: i
       scene%length = length
       material = [youngs_modulus, density, outer_diameter, wall_thickness]
@@ -854,22 +855,30 @@ contains
                & 'youngs_modulus, density, outer_diameter, wall_thickness, or none of them (then k2)')
             return
          end if
-         if (.not. (material(i) > 0 .and. material(i) < huge(1.0_wp))) then
-            call fatal_error(error, path//': &beam '//trim(names(i))//' = '//fmt_real(material(i))// &
-               & ' is out of range; allowed: '//trim(names(i))//' > 0')
-            return
-         end if
       end do
       if (k2 /= unset .or. mass_per_length /= unset) then
          call fatal_error(error, path//': &beam gives k2 or mass_per_length together with the material; '// &
             & 'allowed: either k2 (and mass_per_length) or youngs_modulus, density, outer_diameter, wall_thickness')
          return
       end if
-      if (.not. wall_thickness <= outer_diameter/2) then
-         call fatal_error(error, path//': &beam wall_thickness = '//fmt_real(wall_thickness)// &
-            & ' is out of range; allowed: 0 < wall_thickness <= outer_diameter/2 = '//fmt_real(outer_diameter/2))
+      ! Beyond any real material (Young's modulus ten times diamond's, density four times
+      ! osmium's, lighter than air), and sections whose area and second moment are computed
+      ! without underflow or cancellation (k2 came out 0, NaN or -Inf).
+      low = [0.0_wp, 1.0e-3_wp, 1.0e-9_wp, 1.0e-6_wp*outer_diameter]
+      high = [1.0e13_wp, 1.0e5_wp, 1.0e3_wp, outer_diameter/2]
+      do i = 1, 4
+         if (material(i) > low(i) .or. (i > 1 .and. material(i) == low(i))) then
+            if (material(i) <= high(i)) cycle
+         end if
+         low_text = fmt_real(low(i))//' <= '
+         if (i == 1) low_text = '0 < '
+         if (i == 4) low_text = '1e-06*outer_diameter = '//low_text
+         high_text = fmt_real(high(i))
+         if (i == 4) high_text = 'outer_diameter/2 = '//high_text
+         call fatal_error(error, path//': &beam '//trim(names(i))//' = '//fmt_real(material(i))// &
+            & ' is out of range; allowed: '//low_text//trim(names(i))//' <= '//high_text//' '//trim(units(i)))
          return
-      end if
+      end do
       call tube_beam(youngs_modulus, density, outer_diameter, wall_thickness, scene%k2, scene%mass_per_length)
       ! What the material gives is told in the keys given (the file holds no k2 or mass_per_length).
       if (.not. (scene%k2 >= k2_range(1) .and. scene%k2 <= k2_range(2))) then

@@ -104,6 +104,12 @@ BAD = [
     ("half a material", "&beam youngs_modulus=2e11 /\n", ["&beam", "density"]),
     ("unstable explicit", "&time dt=2e-5, beta=0 /\n", ["&time", "dt", "stability limit", "allow_unstable"]),
     ("binary garbage", "&time dt=1e-5 /\n\x00\x01\x02\n", ["binary"]),
+    # infinite or huge damping ran and diverged at t = 0 (replacing an earlier output)
+    ("infinite mass damping", "&damping mass_coefficient=inf /\n",
+     ["&damping mass_coefficient = Inf is out of range", "allowed: 0 <= mass_coefficient <= 1.69e+08 1/s"]),
+    ("huge stiffness damping", "&damping stiffness_coefficient=1e100 /\n",
+     ["&damping stiffness_coefficient = 1e+100 is out of range", "allowed: 0 <= stiffness_coefficient <= 7.62 s"]),
+    ("infinite rest time", "&statistics rest_time=inf /\n", ["&statistics rest_time = Inf", "<= 1e+09 s"]),
 ]
 
 
@@ -568,3 +574,14 @@ def test_too_many_stops_along_the_span_are_refused_naming_the_limit(tmp_path: Pa
     scene = write(tmp_path, "&stops nodes=" + ",".join(["19"] * 1001) + ", lower=-0.01, upper=0.01 /\n")
     line = one_error_line(beamstops("run", scene, cwd=tmp_path))
     assert "&stops nodes" in line and "at most 1000 stops" in line
+
+
+def test_bad_damping_leaves_an_earlier_output_and_info_refuses_it(tmp_path: Path) -> None:
+    kept, before = complete_output(tmp_path, "in.h5")
+    for value in ("inf", "1e150", "1e300"):
+        scene = write(tmp_path, SHORT + f"&damping mass_coefficient={value} /\n", name="in.nml")
+        line = one_error_line(done := beamstops("run", scene, cwd=tmp_path))
+        assert done.returncode == 1 and "&damping mass_coefficient" in line and "is out of range" in line
+        assert kept.read_bytes() == before
+        done = beamstops("info", scene, cwd=tmp_path)
+        assert done.returncode == 1 and "&damping mass_coefficient" in one_error_line(done)
