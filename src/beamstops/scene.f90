@@ -25,6 +25,11 @@ module beamstops_scene
    real(wp), parameter :: min_stiffness_per_mass = 1.0e-12_wp, max_stiffness_per_mass = 1.0e20_wp
    !> Ranges of k2 (m^4/s^2) and mass_per_length (kg/m), given or derived from a tube's material.
    real(wp), parameter :: k2_range(2) = [1.0e-12_wp, 1.0e15_wp], mass_per_length_range(2) = [1.0e-12_wp, 1.0e9_wp]
+   !> Shortest time step and final time (s): a femtosecond, 1/50,000 of the first period of the
+   !> stiffest real beam the lengths allow (E/rho <= 1e9 m^2/s^2 and a section narrower than
+   !> the length give k2 <= 1e9 length^2: omega_1 <= 1.1e11 rad/s at length = 1e-6 m); far
+   !> above the underflow of dt^2 (subnormal below 1.5e-154 s: runs diverged at t = 0).
+   real(wp), parameter :: min_dt = 1.0e-15_wp
 
    !> Every input of a run. Defaults reproduce the paper's scene (Figure 2).
    type :: scene_type
@@ -363,9 +368,10 @@ contains
          return
       end if
       call span_stops_valid(); if (allocated(error)) return
-      call within('time', 't_end', scene%t_end, tiny(1.0_wp), 1.0e9_wp, '0 < t_end <= 1e+09 s')
+      call within('time', 't_end', scene%t_end, min_dt, 1.0e9_wp, fmt_real(min_dt)//' <= t_end <= 1e+09 s')
       if (allocated(error)) return
-      call within('time', 'dt', scene%dt, tiny(1.0_wp), scene%t_end, '0 < dt <= t_end = '//fmt_real(scene%t_end)//' s')
+      call within('time', 'dt', scene%dt, min_dt, scene%t_end, fmt_real(min_dt)//' <= dt <= t_end = '// &
+         & fmt_real(scene%t_end)//' s')
       if (allocated(error)) return
       if (scene%t_end/scene%dt > 1.0e13_wp) then
          call say('time', 'dt', fmt_real(scene%dt), 't_end/dt <= 1e13 steps'); return

@@ -3,7 +3,8 @@
 !> naming the file, the group and the key.
 module test_namelist
    use testing
-   use beamstops, only: scene_type, read_scene, law_signorini, law_compliance, scene_from_text, canonical_text
+   use beamstops, only: scene_type, read_scene, law_signorini, law_compliance, scene_from_text, canonical_text, &
+      & model_type, build_model, check_stability
    implicit none
    private
    public :: collect_namelist
@@ -52,7 +53,10 @@ contains
          & new_unittest('a bad value leaves no state: the next text is read whole', test_reader_state_after_bad_logical), &
          & new_unittest('a carried key that does nothing is dropped, one given anew refused', test_carried_keys), &
          & new_unittest('every real key refuses infinity and huge values, naming its range', test_real_keys_bounded), &
-         & new_unittest('a material beyond any real one is told in its own key', test_material_bounds) &
+         & new_unittest('a material beyond any real one is told in its own key', test_material_bounds), &
+         & new_unittest('dt and t_end below 1e-15 s refused; each message states a range the value violates', &
+         & test_tiny_time_step), &
+         & new_unittest('a dt refused for stability is beyond the limit as shown', test_stability_limit_shown) &
          & ]
    end subroutine collect_namelist
 
@@ -637,4 +641,47 @@ contains
          & [character(len=96) :: '&beam wall_thickness = 1e-17', &
          & 'allowed: 1e-06*outer_diameter = 1e-06 <= wall_thickness <= outer_diameter/2 = 0.5 m'], error)
    end subroutine test_material_bounds
+
+   !> dt = t_end = 1e-170 was accepted and diverged at t = 0 (dt^2 underflows); dt = 1e-310 with
+   !> t_end = 1e-300 was refused as out of 0 < dt <= t_end = 1e-300 s, a range it is in.
+   subroutine test_tiny_time_step(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_text_error('&time dt = 1e-170, t_end = 1e-170 /', [character(len=64) :: &
+         & '&time t_end = 1e-170 is out of range', 'allowed: 1e-15 <= t_end <= 1e+09 s'], error)
+      if (allocated(error)) return
+      call expect_text_error('&time dt = 1e-310, t_end = 1e-300 /', [character(len=64) :: &
+         & '&time t_end = 1e-300 is out of range', 'allowed: 1e-15 <= t_end <= 1e+09 s'], error)
+      if (allocated(error)) return
+      call expect_text_error('&time dt = 1e-310, t_end = 1e-3 /', [character(len=64) :: &
+         & '&time dt = 1e-310 is out of range', 'allowed: 1e-15 <= dt <= t_end = 0.001 s'], error)
+      if (allocated(error)) return
+      call expect_text_error('&time dt = 0.1, t_end = 1e-3 /', [character(len=64) :: &
+         & '&time dt = 0.1 is out of range', 'allowed: 1e-15 <= dt <= t_end = 0.001 s'], error)
+      if (allocated(error)) return
+      call expect_read('&time dt = 1e-15, t_end = 1e-15 /', error)
+   end subroutine test_tiny_time_step
+
+   !> The stability limit was shown rounded to the nearest: dt = the limit, refused, read as
+   !> within `dt < 1.23951e-05` (the limit is 1.2395061e-05).
+   subroutine test_stability_limit_shown(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(model_type) :: model
+      type(error_type), allocatable :: failure
+      real(wp) :: shown_limit
+      integer :: at, stat
+      call scene_from_text('&time dt = 1e-6, t_end = 1e-3, beta = 0 /', 'in.nml', scene, error)
+      if (allocated(error)) return
+      call build_model(scene, model, error)
+      if (allocated(error)) return
+      scene%dt = model%dt_newmark
+      call check_stability(scene, model, 'in.nml', failure)
+      call check(error, allocated(failure), 'dt at the limit refused')
+      if (allocated(error)) return
+      call note(failure%message)
+      at = index(failure%message, 'allowed: dt < ') + len('allowed: dt < ')
+      read (failure%message(at:index(failure%message(at:), ' ') + at - 2), *, iostat=stat) shown_limit
+      call check(error, stat == 0 .and. scene%dt >= shown_limit, 'dt = '//real_text(scene%dt)// &
+         & ' is beyond the limit shown: '//failure%message)
+   end subroutine test_stability_limit_shown
 end module test_namelist

@@ -110,6 +110,11 @@ BAD = [
     ("huge stiffness damping", "&damping stiffness_coefficient=1e100 /\n",
      ["&damping stiffness_coefficient = 1e+100 is out of range", "allowed: 0 <= stiffness_coefficient <= 7.62 s"]),
     ("infinite rest time", "&statistics rest_time=inf /\n", ["&statistics rest_time = Inf", "<= 1e+09 s"]),
+    # dt^2 underflowed: the run diverged at t = 0
+    ("tiny time step", "&time dt=1e-170, t_end=1e-170 /\n",
+     ["&time t_end = 1e-170 is out of range", "allowed: 1e-15 <= t_end <= 1e+09 s"]),
+    ("subnormal time step", "&time dt=1e-310, t_end=1e-3 /\n",
+     ["&time dt = 1e-310 is out of range", "allowed: 1e-15 <= dt <= t_end = 0.001 s"]),
 ]
 
 

@@ -153,6 +153,7 @@ REFUSED = [
     ("&time dt=1e-5 /\n\x00\x01\n", ["binary"]),
     ("&damping mass_coefficient=inf /", ["&damping mass_coefficient = Inf is out of range", "<= 1.69e+08 1/s"]),
     ("&damping stiffness_coefficient=1e300 /", ["&damping stiffness_coefficient = 1e+300 is out of range"]),
+    ("&time dt=1e-170, t_end=1e-170 /", ["&time t_end = 1e-170", "1e-15 <= t_end"]),
 ]
 
 
@@ -174,6 +175,8 @@ def test_keywords_out_of_range_are_refused_with_the_engines_message() -> None:
         Scene(mass_coefficient=float("inf"))
     with pytest.raises(ValueError, match=r"^scene: &damping stiffness_coefficient = 1e\+100 is out of range"):
         Scene().replace(stiffness_coefficient=1e100)
+    with pytest.raises(ValueError, match=r"^scene: &time dt = 1e-170 is out of range; allowed: 1e-15 <= dt"):
+        Scene(dt=1e-170)
     assert Scene(mass_coefficient=1e8, stiffness_coefficient=7.0).mass_coefficient == 1e8
 
 
