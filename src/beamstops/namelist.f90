@@ -4,13 +4,14 @@
 !> group, unknown keys, malformed and out-of-range values all end in one message naming the
 !> source, the group and the key.
 module beamstops_namelist
-   use, intrinsic :: iso_fortran_env, only: iostat_end
+   use, intrinsic :: iso_fortran_env, only: iostat_end, int64
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
+   use beamstops_files, only: read_whole_file, read_missing, read_folder, read_too_big, read_unopened, read_failed
    use beamstops_scene, only: scene_type, validate_scene, tube_beam, law_code, law_compliance, max_stops, stop_count, &
       & steps_of, min_stiffness_per_mass, max_stiffness_per_mass, k2_range, mass_per_length_range
-   use beamstops_strings, only: fmt_real, itoa, lower, squeeze
+   use beamstops_strings, only: fmt_real, fmt_int, itoa, lower, squeeze
    use beamstops_physics_checks, only: validate_physics
    use beamstops_observe_statistics, only: validate_statistics, validate_ensemble
    use beamstops_reduced, only: validate_reduced, stop_unknowns
@@ -35,7 +36,10 @@ module beamstops_namelist
 contains
 
    !> Read, derive and validate a scene from a namelist file; missing groups and keys keep
-   !> the paper's values. The output file defaults to the file's base name with '.h5'.
+   !> the paper's values. The output file defaults to the file's base name with '.h5'; a file
+   !> named by an open descriptor (/dev/stdin, /dev/fd/N, /proc/.../fd/N: a pipe, `<(...)`) or that
+   !> is not a regular file gives no name (the output file is then '', refused by the program's
+   !> check_output_path unless named by -o or &output file).
    subroutine read_scene(path, scene, error)
       !> Namelist file.
       character(len=*), intent(in) :: path
@@ -44,52 +48,60 @@ contains
       !> Set on any bad input.
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: text
-      call read_text_file(path, text, error)
+      logical :: regular
+      call read_text_file(path, text, error, regular)
       if (allocated(error)) return
-      call scene_from_text(text, path, scene, error, default_output(path))
+      if (regular .and. .not. descriptor_path(path)) then
+         call scene_from_text(text, path, scene, error, default_output(path))
+      else
+         call scene_from_text(text, path, scene, error, '')
+      end if
    end subroutine read_scene
 
-   !> The whole of a text file (lines separated by new_line('a')).
-   subroutine read_text_file(path, text, error)
+   !> Whether a path names an open file descriptor rather than a file: /dev/stdin, /dev/fd/N,
+   !> /proc/self/fd/N or /proc/PID/fd/N (what a shell's `<(...)` gives).
+   pure logical function descriptor_path(path)
+      !> Path.
+      character(len=*), intent(in) :: path
+      descriptor_path = path == '/dev/stdin' .or. index(path, '/dev/fd/') == 1 .or. &
+         & (index(path, '/proc/') == 1 .and. index(path, '/fd/') > 0)
+   end function descriptor_path
+
+   !> The whole of a text file (lines separated by new_line('a')), at most 64 MB: a regular file,
+   !> or a pipe, a FIFO or a device read to its end.
+   subroutine read_text_file(path, text, error, regular)
       !> File.
       character(len=*), intent(in) :: path
       !> Its content.
       character(len=:), allocatable, intent(out) :: text
       !> Set when the file cannot be read.
       type(error_type), allocatable, intent(out) :: error
-      integer :: unit, stat, size_bytes
-      character(len=512) :: msg
-      logical :: exists, is_dir
-      text = ''
-      inquire (file=path, exist=exists)
-      if (.not. exists) then
+      !> Whether it is a regular file (not a pipe, a FIFO or a device).
+      logical, intent(out), optional :: regular
+      integer(int64), parameter :: max_bytes = 64*1024*1024_int64
+      character(len=:), allocatable :: why
+      integer(int64) :: bytes
+      integer :: outcome
+      logical :: is_regular
+      call read_whole_file(path, max_bytes, text, outcome, bytes, is_regular, why)
+      if (present(regular)) regular = is_regular
+      select case (outcome)
+      case (read_missing)
          call fatal_error(error, path//': cannot open: no such file')
-         return
-      end if
-      inquire (file=path//'/.', exist=is_dir)
-      if (is_dir) then
+      case (read_folder)
          call fatal_error(error, path//': cannot open: a directory, not a namelist file')
-         return
-      end if
-      open (newunit=unit, file=path, status='old', action='read', access='stream', form='unformatted', &
-         & iostat=stat, iomsg=msg)
-      if (stat /= 0) then
-         call fatal_error(error, path//': cannot open: '//trim(msg))
-         return
-      end if
-      inquire (unit=unit, size=size_bytes)
-      if (size_bytes > 64*1024*1024) then
-         call fatal_error(error, path//': '//itoa(size_bytes)//' bytes; allowed: a namelist file of at most 64 MB')
-         close (unit)
-         return
-      end if
-      if (size_bytes > 0) then
-         deallocate (text)
-         allocate (character(len=size_bytes) :: text)
-         read (unit, iostat=stat, iomsg=msg) text
-         if (stat /= 0) call fatal_error(error, path//': cannot read: '//trim(msg))
-      end if
-      close (unit)
+      case (read_too_big)
+         if (bytes >= 0) then
+            call fatal_error(error, path//': '//fmt_int(bytes)//' bytes; allowed: a namelist file of at most 64 MB')
+         else
+            call fatal_error(error, path//': more than 64 MB read (a pipe or a device); allowed: a namelist file of '// &
+               & 'at most 64 MB')
+         end if
+      case (read_unopened)
+         call fatal_error(error, path//': cannot open: '//why)
+      case (read_failed)
+         call fatal_error(error, path//': cannot read: '//why)
+      end select
    end subroutine read_text_file
 
    !> Read, derive and validate a scene from namelist text; `source` (a file name, or 'scene'

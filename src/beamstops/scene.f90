@@ -72,7 +72,8 @@ module beamstops_scene
       logical :: taylor_start = .true.
       !> &time: run even beyond the linear stability limit of beta < 1/4.
       logical :: allow_unstable = .false.
-      !> &output: HDF5 file written by the program (not used by the in-memory path).
+      !> &output: HDF5 file written by the program (not used by the in-memory path); '' when the
+      !> namelist came from a pipe or a device, which gives the file no default name.
       character(len=:), allocatable :: output_file
       !> &output: refuse a run whose output would exceed this many gigabytes (1e9 bytes).
       real(wp) :: max_output_gb = 4.0_wp
@@ -302,8 +303,11 @@ contains
       call list%add_text('time', 'load_rule', trim(merge('centered', 'paper   ', scene%centered_load)))
       call list%add_text('time', 'start', trim(merge('taylor', 'euler ', scene%taylor_start)))
       call list%add_logical('time', 'allow_unstable', scene%allow_unstable, signature=.false.)
-      if (allocated(scene%output_file)) call list%add_text('output', 'file', scene%output_file, attribute=.false., &
-         & signature=.false.)
+      ! ('' when the input, a pipe or /dev/fd/N, gave no name: none to write)
+      if (allocated(scene%output_file)) then
+         if (len(scene%output_file) > 0) call list%add_text('output', 'file', scene%output_file, attribute=.false., &
+            & signature=.false.)
+      end if
       call list%add_int('output', 'record_every', int(scene%record_every, ik))
       call list%add_int('output', 'snapshot_every', int(scene%snapshot_every, ik))
       call list%add_int('output', 'checkpoint_every', scene%checkpoint_every, attribute=.false.)

@@ -56,7 +56,8 @@ contains
          & new_unittest('a material beyond any real one is told in its own key', test_material_bounds), &
          & new_unittest('dt and t_end below 1e-15 s refused; each message states a range the value violates', &
          & test_tiny_time_step), &
-         & new_unittest('a dt refused for stability is beyond the limit as shown', test_stability_limit_shown) &
+         & new_unittest('a dt refused for stability is beyond the limit as shown', test_stability_limit_shown), &
+         & new_unittest('a FIFO is read to its end and gives no output name', test_fifo) &
          & ]
    end subroutine collect_namelist
 
@@ -684,4 +685,31 @@ contains
       call check(error, stat == 0 .and. scene%dt >= shown_limit, 'dt = '//real_text(scene%dt)// &
          & ' is beyond the limit shown: '//failure%message)
    end subroutine test_stability_limit_shown
+
+   !> A FIFO (as a pipe, bash's `<(...)`) reports size 0: it was read as an empty text, 'no
+   !> namelist group'. It is read to its end, and gives no output name (its name, like /dev/fd/63,
+   !> says nothing of the scene); a regular file gives its own.
+   subroutine test_fifo(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      character(len=:), allocatable :: path
+      integer :: stat
+      path = temp_dir()//'/scene.fifo'
+      call execute_command_line('rm -f "'//path//'" && mkfifo "'//path//'" && '// &
+         & '(printf ''&time dt = 2e-5 /\n&mesh elements = 7 /\n'' > "'//path//'" &)', exitstat=stat)
+      call check(error, stat == 0, 'a FIFO with a writer')
+      if (allocated(error)) return
+      call read_scene(path, scene, error)
+      call remove(path)
+      if (allocated(error)) return
+      call check(error, scene%elements, 7, 'elements read from the FIFO')
+      if (allocated(error)) return
+      call check(error, scene%output_file == '', 'a FIFO gives no output name, got '//scene%output_file)
+      if (allocated(error)) return
+      path = write_file('named.nml', [character(len=ll) :: '&time dt = 1e-5 /'])
+      call read_scene(path, scene, error)
+      call remove(path)
+      if (allocated(error)) return
+      call check(error, scene%output_file == 'named.h5', 'named.nml gives named.h5, got '//scene%output_file)
+   end subroutine test_fifo
 end module test_namelist

@@ -590,3 +590,39 @@ def test_bad_damping_leaves_an_earlier_output_and_info_refuses_it(tmp_path: Path
         assert kept.read_bytes() == before
         done = beamstops("info", scene, cwd=tmp_path)
         assert done.returncode == 1 and "&damping mass_coefficient" in one_error_line(done)
+
+
+def test_a_namelist_from_a_pipe_is_read_whole_and_needs_an_output_name(tmp_path: Path) -> None:
+    text = "&time dt=5e-5, t_end=0.001 /\n"
+
+    def piped(*args: str) -> subprocess.CompletedProcess[str]:
+        return subprocess.run([PROGRAM, *args], cwd=tmp_path, input=text, capture_output=True, text=True,
+                              timeout=120)
+
+    # a pipe reports size 0: it was read as an empty text, 'no namelist group'
+    done = piped("info", "/dev/stdin")
+    assert done.returncode == 0, done.stderr
+    done = piped("run", "/dev/stdin", "-o", "piped.h5")
+    assert done.returncode == 0, done.stderr
+    with h5py.File(tmp_path / "piped.h5") as f:
+        assert f.attrs["status"] == b"complete" and f.attrs["steps"] == 20
+    # /dev/stdin or /dev/fd/63 (bash's <(...)) names no output: -o or &output file is needed
+    done = piped("run", "/dev/stdin")
+    assert done.returncode == 4
+    line = one_error_line(done)
+    assert "/dev/stdin: a namelist read from a pipe" in line and "-o OUT.h5 or &output file" in line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["piped.h5"]
+    text += "&output file='named.h5' /\n"
+    assert piped("run", "/dev/stdin").returncode == 0 and (tmp_path / "named.h5").exists()
+
+
+def test_a_pipe_beyond_64_mb_and_a_file_beyond_4_gib_are_refused_with_their_size(tmp_path: Path) -> None:
+    done = subprocess.run([PROGRAM, "info", "/dev/stdin"], cwd=tmp_path, input=b" " * (64 * 2**20 + 1),
+                          capture_output=True, timeout=120)
+    assert done.returncode == 1
+    assert "/dev/stdin: more than 64 MB read" in done.stderr.decode()
+    big = tmp_path / "big.nml"
+    with big.open("wb") as f:  # sparse: 5 GiB said 1073741824 bytes (an int32 size), 3 GiB 'no namelist group'
+        f.truncate(5 * 2**30)
+    line = one_error_line(beamstops("info", big, cwd=tmp_path))
+    assert "big.nml: 5368709120 bytes; allowed: a namelist file of at most 64 MB" in line
