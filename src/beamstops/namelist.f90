@@ -224,7 +224,12 @@ contains
          return
       end if
       if (scene%law == law_compliance) then
-         if ((stiffness == unset) .eqv. (stiffness_per_mass == unset)) then
+         if (stiffness /= unset .and. stiffness_per_mass /= unset) then
+            call fatal_error(error, source//": &stops stiffness and stiffness_per_mass are both given; allowed: "// &
+               & "one of them, the spring of law = 'compliance' (stiffness in N/m or stiffness_per_mass in 1/s^2)")
+            return
+         end if
+         if (stiffness == unset .and. stiffness_per_mass == unset) then
             call fatal_error(error, source//": &stops law = 'compliance' needs a spring; allowed: exactly one "// &
                & 'of stiffness (N/m) or stiffness_per_mass (1/s^2), > 0')
             return

@@ -57,6 +57,7 @@ contains
          & new_unittest('dt and t_end below 1e-15 s refused; each message states a range the value violates', &
          & test_tiny_time_step), &
          & new_unittest('a dt refused for stability is beyond the limit as shown', test_stability_limit_shown), &
+         & new_unittest('both springs of the compliance law are told as both given', test_two_springs), &
          & new_unittest('a FIFO is read to its end and gives no output name', test_fifo) &
          & ]
    end subroutine collect_namelist
@@ -685,6 +686,13 @@ contains
       call check(error, stat == 0 .and. scene%dt >= shown_limit, 'dt = '//real_text(scene%dt)// &
          & ' is beyond the limit shown: '//failure%message)
    end subroutine test_stability_limit_shown
+
+   !> Both springs given with the compliance law was told as `needs a spring`.
+   subroutine test_two_springs(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_text_error('&stops law = ''compliance'', stiffness = 1e5, stiffness_per_mass = 1e6 /', &
+         & [character(len=64) :: '&stops stiffness and stiffness_per_mass are both given', 'allowed: one of them'], error)
+   end subroutine test_two_springs
 
    !> A FIFO (as a pipe, bash's `<(...)`) reports size 0: it was read as an empty text, 'no
    !> namelist group'. It is read to its end, and gives no output name (its name, like /dev/fd/63,

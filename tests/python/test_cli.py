@@ -115,6 +115,8 @@ BAD = [
      ["&time t_end = 1e-170 is out of range", "allowed: 1e-15 <= t_end <= 1e+09 s"]),
     ("subnormal time step", "&time dt=1e-310, t_end=1e-3 /\n",
      ["&time dt = 1e-310 is out of range", "allowed: 1e-15 <= dt <= t_end = 0.001 s"]),
+    ("two springs", "&stops law='compliance', stiffness=1e5, stiffness_per_mass=1e6 /\n",
+     ["&stops stiffness and stiffness_per_mass are both given"]),
 ]
 
 
