@@ -17,7 +17,7 @@ program beamstops_main
    use beamstops_run, only: continue_run, continue_reduced
    use beamstops_writer_thread, only: writer_thread, start_writer, stop_writer
    use beamstops_batch, only: lockstep_groups, simulate_group, min_group_members
-   use beamstops_reduced, only: reduced_model_type, build_reduced, check_stability_reduced
+   use beamstops_reduced, only: reduced_model_type, reduce_model
    use beamstops_reduced_scheme, only: reduced_state_type, start_reduced
    use beamstops_reduced_checkpoint, only: read_reduced_checkpoint
    use beamstops_lapack, only: openblas_one_thread
@@ -110,6 +110,8 @@ program beamstops_main
    logical :: restart = .false.
    type(scene_type) :: scene
    type(model_type) :: model
+   !> With &mesh modes > 0, the reduced model the run steps (prepare_run).
+   type(reduced_model_type) :: reduced
    type(error_type), allocatable :: error
    !> The HDF5 writes of every run on a thread of their own (beamstops_writer_thread).
    type(writer_thread) :: writer
@@ -125,13 +127,13 @@ program beamstops_main
    call read_scene(path, scene, error)
    call stop_on(error, exit_input)
    if (allocated(out)) scene%output_file = out
-   call prepare_run(scene, path, model, error)
+   call prepare_run(scene, path, model, error, reduced)
    call stop_on(error, exit_input)
    select case (command)
    case ('info')
-      call print_info(scene, model)
+      call print_info(scene, model, run_limit(scene, model, reduced))
    case ('run')
-      call quit(run_to_file(scene, model, path, restart, c_isatty(2_c_int) == 1))
+      call quit(run_to_file(scene, model, path, restart, c_isatty(2_c_int) == 1, reduced))
    end select
 
 contains
@@ -347,31 +349,33 @@ contains
    !> (not the input, not a file other than a beamstops output); the run writes OUT.partial
    !> and the recorder renames it onto OUT when the run went to its end (complete or diverged).
    !> With `restart`, the partial file continues from the checkpoint OUT.checkpoint.
-   integer function run_to_file(scene, model, input, restart, progress) result(status)
+   recursive integer function run_to_file(scene, model, input, restart, progress, reduced) result(status)
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
       character(len=*), intent(in) :: input
       logical, intent(in) :: restart
       !> Print a progress line on stderr.
       logical, intent(in) :: progress
+      !> With &mesh modes > 0, the reduced model the run steps (prepare_run); built here when absent
+      !> (the scenes of `run A.nml B.nml ...`, prepared and checked up front without keeping it).
+      type(reduced_model_type), intent(in), optional :: reduced
       type(hdf5_recorder) :: recorder
       type(run_summary) :: summary
       type(state_type) :: state
-      type(reduced_model_type) :: reduced
+      type(reduced_model_type) :: built
       type(reduced_state_type) :: reduced_state
       type(error_type), allocatable :: error, write_error, finish_error
       character(len=:), allocatable :: output, partial, checkpoint
       integer(ik) :: records, snapshots
       logical :: resume
       status = 0
-      recorder%writer = writer
-      if (scene%modes > 0) then
-         ! The reduced (Craig-Bampton) model, before anything is written.
-         call build_reduced(scene, model, reduced, error)
+      if (scene%modes > 0 .and. .not. present(reduced)) then
+         call reduce_model(scene, model, input, built, error)
          if (reported(error, exit_input, status)) return
-         call check_stability_reduced(scene, reduced, input, error)
-         if (reported(error, exit_input, status)) return
+         status = run_to_file(scene, model, input, restart, progress, built)
+         return
       end if
+      recorder%writer = writer
       output = scene%output_file
       partial = partial_path(output)
       checkpoint = checkpoint_path(output)
@@ -703,9 +707,12 @@ contains
       end do
    end function headline
 
-   subroutine print_info(scene, model)
+   !> `beamstops info`: the scene as read, its model and the stability limit of the model its run
+   !> steps (prepare_run has applied the run's own check to it).
+   subroutine print_info(scene, model, limit)
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
+      type(run_limit_type), intent(in) :: limit
       character(len=*), parameter :: f = '(a,t30,es13.6,1x,a)', fi = '(a,t30,i0,1x,a)', fa = '(a,t30,a)'
       integer :: i
       write (output_unit, fa) 'file', path
@@ -771,7 +778,10 @@ contains
       write (output_unit, f) 'kappa_h', model%kappa_h, '1/s^2 ('//model%kappa_method//')'
       write (output_unit, f) 'kappa_bound (5.2)', model%kappa_bound, '1/s^2'
       if (scene%law == law_compliance) write (output_unit, f) 'kappa with spring', model%kappa_contact, '1/s^2'
-      write (output_unit, f) 'dt limit Newmark', model%dt_newmark, 's (2/sqrt((1-4 beta) kappa), beta < 1/4)'
+      if (scene%modes > 0 .and. scene%beta < 0.25_wp) write (output_unit, f) 'kappa of the run', limit%kappa, &
+         & '1/s^2 (the '//limit%model//', which the run steps)'
+      write (output_unit, f) 'dt limit Newmark', limit%dt_newmark, 's (2/sqrt((1-4 beta) kappa) of the '// &
+         & limit%model//', which the run steps; beta < 1/4)'
       write (output_unit, f) 'dt limit (3.1) exact', model%dt_paper_exact, 's (2/sqrt((1-2 beta) kappa_h))'
       write (output_unit, f) 'dt limit (3.1) bound', model%dt_paper_bound, 's (2/sqrt((1-2 beta) kappa_bound))'
       write (output_unit, fi) 'steps', steps_of(scene), ''

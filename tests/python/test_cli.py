@@ -568,3 +568,44 @@ def test_too_many_stops_along_the_span_are_refused_naming_the_limit(tmp_path: Pa
     scene = write(tmp_path, "&stops nodes=" + ",".join(["19"] * 1001) + ", lower=-0.01, upper=0.01 /\n")
     line = one_error_line(beamstops("run", scene, cwd=tmp_path))
     assert "&stops nodes" in line and "at most 1000 stops" in line
+
+
+# ---------------------------------------------------------------- info and run: one check (audit P6)
+
+
+def test_info_applies_the_check_of_run_with_the_limit_of_the_reduced_model(tmp_path: Path) -> None:
+    # beta = 0 with &mesh modes = 4: the run steps the reduced model, whose limit is 1.30e-3 s (the
+    # full model's, 1.24e-5 s, does not apply); info refuses what run refuses, with its message
+    unstable = write(tmp_path, "&time dt=1e-2, t_end=0.05, beta=0 /\n&mesh modes=4 /\n", "unstable.nml")
+    info, run = beamstops("info", unstable.name, cwd=tmp_path), beamstops("run", unstable.name, cwd=tmp_path)
+    assert info.returncode == run.returncode == 1 and info.stdout == ""
+    line = one_error_line(info)
+    assert line == one_error_line(run)
+    assert line.startswith("beamstops: error: unstable.nml: &time dt = 0.01 is out of range; allowed: dt < 0.00129667 s")
+    assert "of the reduced model with modes = 4" in line
+    # within the reduced model's limit, beyond the full model's: both accept, info shows the limit that applies
+    stable = write(tmp_path, "&time dt=1e-3, t_end=0.05, beta=0 /\n&mesh modes=4 /\n", "stable.nml")
+    info = beamstops("info", stable, cwd=tmp_path)
+    assert info.returncode == 0, info.stderr
+    shown = {line[:29].strip(): line[29:] for line in info.stdout.splitlines()}
+    limit = shown["dt limit Newmark"].split()
+    assert float(limit[0]) == pytest.approx(1.296673e-3, rel=1e-6) and "of the reduced model of 4 modes" in shown[
+        "dt limit Newmark"]
+    assert float(shown["kappa of the run"].split()[0]) == pytest.approx(2.379027e6, rel=1e-6)
+    assert beamstops("run", stable, cwd=tmp_path).returncode == 0
+    # the full model: its own limit, named as such
+    full = write(tmp_path, "&time dt=1e-6, t_end=0.001, beta=0 /\n", "full.nml")
+    shown = {line[:29].strip(): line[29:] for line in beamstops("info", full, cwd=tmp_path).stdout.splitlines()}
+    assert float(shown["dt limit Newmark"].split()[0]) == pytest.approx(1.239506e-5, rel=1e-6)
+    assert "of the full model" in shown["dt limit Newmark"] and "kappa of the run" not in shown
+
+
+def test_several_scenes_refuse_a_reduced_scene_beyond_its_limit_before_any_runs(tmp_path: Path) -> None:
+    good = write(tmp_path, SHORT, "good.nml")
+    bad = write(tmp_path, "&time dt=1e-2, t_end=0.05, beta=0 /\n&mesh modes=4 /\n", "bad.nml")
+    done = beamstops("run", good, bad, cwd=tmp_path)
+    assert done.returncode == 1
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 2 and "bad.nml: &time dt = 0.01 is out of range" in lines[0], done.stderr
+    assert lines[1] == "beamstops: none of the 2 scenes was run"
+    assert not list(tmp_path.glob("*.h5*"))
