@@ -12,7 +12,8 @@ program beamstops_main
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use beamstops
    use beamstops_checkpoint, only: checkpoint_path, temporary_path, read_checkpoint, is_checkpoint
-   use beamstops_files, only: file_exists, remove_file, same_file, same_path
+   use beamstops_files, only: file_exists, remove_file, same_file, same_path, creation_error
+   use beamstops_namelist, only: default_output
    use beamstops_recorder_hdf5, only: partial_path, check_output_path
    use beamstops_run, only: continue_run, continue_reduced
    use beamstops_writer_thread, only: writer_thread, start_writer, stop_writer
@@ -379,9 +380,7 @@ contains
       output = scene%output_file
       partial = partial_path(output)
       checkpoint = checkpoint_path(output)
-      call check_output_path(output, input, error)
-      if (reported(error, exit_output, status)) return
-      call check_checkpoint_path(checkpoint, error)
+      call check_outputs(scene, input, error)
       if (reported(error, exit_output, status)) return
       resume = .false.
       if (restart) then
@@ -428,13 +427,44 @@ contains
       status = run_outcome(scene, summary, error, write_error, finish_error)
    end function run_to_file
 
-   !> Refuse a checkpoint path that holds something else than a beamstops checkpoint.
-   subroutine check_checkpoint_path(checkpoint, error)
-      character(len=*), intent(in) :: checkpoint
+   !> Refuse, before anything is written, the output of a scene that the run cannot write or that
+   !> would destroy data (check_output_path), a checkpoint path that holds something else than a
+   !> beamstops checkpoint, and with checkpoint_every > 0 a checkpoint the system will not let the
+   !> run create; the messages say where the output's name came from (output_origin).
+   subroutine check_outputs(scene, input, error)
+      type(scene_type), intent(in) :: scene
+      character(len=*), intent(in) :: input
       type(error_type), allocatable, intent(out) :: error
-      if (file_exists(checkpoint) .and. .not. is_checkpoint(checkpoint)) call fatal_error(error, checkpoint// &
-         & ': exists and is not a beamstops checkpoint; refusing to overwrite it (move it away)')
-   end subroutine check_checkpoint_path
+      character(len=:), allocatable :: origin, checkpoint, why
+      origin = output_origin(scene, input)
+      call check_output_path(scene%output_file, input, origin, error)
+      if (allocated(error)) return
+      checkpoint = checkpoint_path(scene%output_file)
+      if (file_exists(checkpoint) .and. .not. is_checkpoint(checkpoint)) then
+         call fatal_error(error, scene%output_file//' ('//origin//'): '//checkpoint//', where the run saves its '// &
+            & 'checkpoints, exists and is not a beamstops checkpoint; refusing to overwrite it (move it away)')
+         return
+      end if
+      if (scene%checkpoint_every == 0) return
+      why = creation_error(temporary_path(checkpoint))
+      if (len(why) > 0) call fatal_error(error, scene%output_file//' ('//origin//'): cannot create '// &
+         & temporary_path(checkpoint)//', where the run saves its checkpoints (&output checkpoint_every): '//why)
+   end subroutine check_outputs
+
+   !> Where the output name of a scene came from: -o, or the &output file of its input (whose
+   !> default is the input's name with .h5).
+   function output_origin(scene, input) result(origin)
+      type(scene_type), intent(in) :: scene
+      character(len=*), intent(in) :: input
+      character(len=:), allocatable :: origin
+      if (allocated(out)) then
+         origin = '-o'
+      else if (scene%output_file == default_output(input)) then
+         origin = '&output file of '//input//', by default the input''s name with .h5'
+      else
+         origin = '&output file of '//input
+      end if
+   end function output_origin
 
    !> The end of a run whose recorder is finished: the messages, the summary line and the exit
    !> status (0 complete, 1 the run could not start, 3 diverged or failed, 4 a write failed).
@@ -514,14 +544,13 @@ contains
       end do
       do i = 1, n
          output = scenes(i)%output_file
-         call check_output_path(output, paths(i)%text, error)
+         call check_outputs(scenes(i), paths(i)%text, error)
          do j = 1, n
             if (allocated(error)) exit
             if (j /= i .and. same_file(output, paths(j)%text)) call fatal_error(error, output//': is the input '// &
                & 'file '//paths(j)%text//'; writing the output of '//paths(i)%text//' there would destroy it')
             if (j < i) call check_shared_files(output, paths(i)%text, scenes(j)%output_file, paths(j)%text, error)
          end do
-         if (.not. allocated(error)) call check_checkpoint_path(checkpoint_path(output), error)
          call refuse_all(error, exit_output, n)
          alone(i) = restart .and. file_exists(checkpoint_path(output)) .and. file_exists(partial_path(output))
       end do

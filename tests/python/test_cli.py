@@ -153,7 +153,10 @@ def test_unwritable_output_exits_4(tmp_path: Path) -> None:
     scene = write(tmp_path, SHORT)
     done = beamstops("run", scene, "-o", tmp_path / "no" / "such" / "dir.h5", cwd=tmp_path)
     assert done.returncode == 4
-    assert "dir.h5" in done.stderr
+    # the output, where its name came from, and the system's reason (not a guess)
+    assert one_error_line(done) == (f"beamstops: error: {tmp_path}/no/such/dir.h5 (-o): cannot create "
+                                    f"{tmp_path}/no/such/dir.h5.partial, where the run writes until it is done: "
+                                    "No such file or directory")
 
 
 # ---------------------------------------------------------------- no input can destroy data (issue 11)
@@ -188,7 +191,7 @@ def test_output_that_is_the_input_is_refused(spelling: str, tmp_path: Path) -> N
     done = beamstops("run", "scene.nml", "-o", out, cwd=tmp_path)
     assert done.returncode == 4
     line = one_error_line(done)
-    assert line.startswith(f"beamstops: error: {out}: ") and "input" in line
+    assert line.startswith(f"beamstops: error: {out} (-o): ") and "input" in line
     assert scene.read_bytes() == text
     assert not list(tmp_path.glob("*.partial"))
 
@@ -223,7 +226,7 @@ def test_existing_file_that_is_not_an_output_is_refused(kind: str, tmp_path: Pat
     done = beamstops("run", scene, "-o", target.name, cwd=tmp_path)
     assert done.returncode == 4
     line = one_error_line(done)
-    assert line.startswith(f"beamstops: error: {target.name}: ") and why in line
+    assert line.startswith(f"beamstops: error: {target.name} (-o): ") and why in line
     if before is not None:
         assert target.read_bytes() == before
     assert not list(tmp_path.glob("*.partial")) and not list(tmp_path.glob("*.checkpoint"))
@@ -236,7 +239,7 @@ def test_foreign_file_at_the_partial_or_checkpoint_name_is_refused(suffix: str, 
     mine.write_text("not HDF5\n")
     done = beamstops("run", scene, "-o", "out.h5", cwd=tmp_path)
     assert done.returncode == 4
-    assert one_error_line(done).startswith(f"beamstops: error: out.h5{suffix}: ")
+    assert one_error_line(done).startswith(f"beamstops: error: out.h5 (-o): out.h5{suffix}, where the run ")
     assert mine.read_text() == "not HDF5\n" and not (tmp_path / "out.h5").exists()
 
 
@@ -307,7 +310,8 @@ def test_unwritable_folder_exits_4_and_writes_nothing(tmp_path: Path) -> None:
                               text=True, timeout=120, preexec_fn=preexec)
         assert done.returncode == 4, done.stderr
         line = one_error_line(done)
-        assert line.startswith("beamstops: error: locked/out.h5: ") and "locked/out.h5.partial" in line
+        assert line == ("beamstops: error: locked/out.h5 (-o): cannot create locked/out.h5.partial, where the run "
+                        "writes until it is done: Permission denied")
         assert list(locked.iterdir()) == []
     finally:
         shutil.rmtree(base, ignore_errors=True)
@@ -610,3 +614,54 @@ def test_several_scenes_refuse_a_reduced_scene_beyond_its_limit_before_any_runs(
     assert len(lines) == 2 and "bad.nml: &time dt = 0.01 is out of range" in lines[0], done.stderr
     assert lines[1] == "beamstops: none of the 2 scenes was run"
     assert not list(tmp_path.glob("*.h5*"))
+
+
+# ---------------------------------------------------------------- output paths: origin and the system's reason (audit P10)
+
+
+def test_a_name_too_long_is_refused_with_the_systems_reason(tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT)
+    name = "a" * 300 + ".h5"
+    line = one_error_line(done := beamstops("run", scene, "-o", name, cwd=tmp_path))
+    assert done.returncode == 4
+    assert line == (f"beamstops: error: {name} (-o): cannot create {name}.partial, where the run writes until it is "
+                    "done: File name too long")
+    # the partial file fits the limit of 255 bytes, the checkpoint's temporary file does not: refused before the
+    # run when checkpoints are asked for, not at the first checkpoint
+    name = "b" * 243 + ".h5"
+    scene = write(tmp_path, SHORT + "&output checkpoint_every=1000 /\n")
+    line = one_error_line(done := beamstops("run", scene, "-o", name, cwd=tmp_path))
+    assert done.returncode == 4 and line.endswith(
+        f"cannot create {name}.checkpoint.tmp, where the run saves its checkpoints (&output checkpoint_every): "
+        "File name too long")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.nml"]
+
+
+def test_an_output_name_ending_in_a_slash_is_refused_naming_the_namelist(tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT + "&output file='out.h5/' /\n").name
+    done = beamstops("run", scene, cwd=tmp_path)
+    assert done.returncode == 4
+    assert one_error_line(done) == ("beamstops: error: out.h5/ (&output file of scene.nml): ends with /, the name of "
+                                    "a folder, not of a file; allowed: the name of the HDF5 file to write, e.g. out.h5")
+    (tmp_path / "out.h5").mkdir()  # an existing folder too
+    assert one_error_line(beamstops("run", scene, cwd=tmp_path)).startswith(
+        "beamstops: error: out.h5/ (&output file of scene.nml): ends with /")
+    # a name from -o; and the default, the input's name with .h5, says so
+    line = one_error_line(beamstops("run", scene, "-o", "x/", cwd=tmp_path))
+    assert line.startswith("beamstops: error: x/ (-o): ends with /") and line.endswith("e.g. x")
+    (tmp_path / "scene.h5").write_text("notes\n")
+    line = one_error_line(beamstops("run", write(tmp_path, SHORT).name, cwd=tmp_path))
+    assert line.startswith("beamstops: error: scene.h5 (&output file of scene.nml, by default the input's name "
+                           "with .h5): exists and is not a beamstops output")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.h5", "scene.h5", "scene.nml"]
+
+
+def test_several_scenes_refuse_an_output_the_system_refuses_before_any_runs(tmp_path: Path) -> None:
+    write(tmp_path, SHORT, "good.nml")
+    write(tmp_path, SHORT + "&output file='missing/bad.h5' /\n", "bad.nml")
+    done = beamstops("run", "good.nml", "bad.nml", cwd=tmp_path)
+    assert done.returncode == 4
+    assert done.stderr.splitlines() == [
+        "beamstops: error: missing/bad.h5 (&output file of bad.nml): cannot create missing/bad.h5.partial, where the "
+        "run writes until it is done: No such file or directory", "beamstops: none of the 2 scenes was run"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.nml", "good.nml"]
