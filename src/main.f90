@@ -153,8 +153,10 @@ contains
       command = trim(arg)
       select case (command)
       case ('-h', '--help', 'help')
+         call no_more_arguments(command)
          call usage()
       case ('-V', '--version', 'version')
+         call no_more_arguments(command)
          write (output_unit, '(a)') 'beamstops '//version
          stop
       case ('run', 'info')
@@ -171,10 +173,14 @@ contains
             if (allocated(out)) call usage("'-o' is given twice (one output: the last would have won)")
             call get_command_argument(i + 1, arg)
             if (len_trim(arg) == 0) call usage("'-o' takes a file name; it was given an empty one")
+            if (trim(arg) == '-') call usage("'-o -': beamstops cannot write its output to standard output (an "// &
+               & "HDF5 file is written in place, and renamed when the run is done); name a file (-o ./- for a "// &
+               & "file named -)")
             out = trim(arg)
             i = i + 1
          case ('--restart')
             if (command /= 'run') call usage("'--restart' goes with 'run'")
+            if (restart) call usage("'--restart' is given twice; allowed: once")
             restart = .true.
          case default
             if (arg(1:1) == '-' .or. (command /= 'run' .and. size(paths) > 0)) &
@@ -188,6 +194,15 @@ contains
       if (size(paths) > 1 .and. allocated(out)) call usage("'-o' names the output of one scene; with several "// &
          & 'namelist files each scene writes its own (&output file; default: the input''s name with .h5)')
    end subroutine parse_arguments
+
+   !> Refuse arguments after `command`, which takes none (--help, --version).
+   subroutine no_more_arguments(command)
+      character(len=*), intent(in) :: command
+      character(len=4096) :: arg
+      if (command_argument_count() < 2) return
+      call get_command_argument(2, arg)
+      call usage("unexpected argument '"//trim(arg)//"' after '"//command//"', which takes none")
+   end subroutine no_more_arguments
 
    !> The help (on stdout), or one line on stderr naming the problem, with exit status 2.
    subroutine usage(problem)

@@ -665,3 +665,31 @@ def test_several_scenes_refuse_an_output_the_system_refuses_before_any_runs(tmp_
         "beamstops: error: missing/bad.h5 (&output file of bad.nml): cannot create missing/bad.h5.partial, where the "
         "run writes until it is done: No such file or directory", "beamstops: none of the 2 scenes was run"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.nml", "good.nml"]
+
+
+def test_standard_output_is_refused_as_an_output(tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT)
+    done = beamstops("run", scene, "-o", "-", cwd=tmp_path)
+    lines = done.stderr.strip().splitlines()
+    assert done.returncode == 2 and len(lines) == 1 and lines[0].startswith(
+        "beamstops: '-o -': beamstops cannot write its output to standard output"), done.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.nml"]
+    # a file named - is still possible, spelt as a path
+    assert beamstops("run", scene, "-o", "./-", cwd=tmp_path).returncode == 0 and (tmp_path / "-").is_file()
+
+
+# ---------------------------------------------------------------- repeated or unexpected arguments
+
+
+@pytest.mark.parametrize(("args", "needle"), [
+    (["run", "scene.nml", "--restart", "--restart"], "'--restart' is given twice; allowed: once"),
+    (["--version", "junk"], "unexpected argument 'junk' after '--version', which takes none"),
+    (["-V", "junk"], "unexpected argument 'junk' after '-V', which takes none"),
+    (["--help", "run"], "unexpected argument 'run' after '--help', which takes none"),
+])
+def test_repeated_or_unexpected_arguments_are_refused(args: list[str], needle: str, tmp_path: Path) -> None:
+    write(tmp_path, SHORT)
+    done = beamstops(*args, cwd=tmp_path)
+    lines = done.stderr.strip().splitlines()
+    assert done.returncode == 2 and len(lines) == 1 and needle in lines[0], done.stderr
+    assert done.stdout == "" and sorted(p.name for p in tmp_path.iterdir()) == ["scene.nml"]
