@@ -22,6 +22,8 @@ program beamstops_main
    use beamstops_reduced_scheme, only: reduced_state_type, start_reduced
    use beamstops_reduced_checkpoint, only: read_reduced_checkpoint
    use beamstops_lapack, only: openblas_one_thread
+   use beamstops_strings, only: fmt_real, fmt_int
+   use beamstops_observe_statistics, only: statistics_table
    implicit none
 
    interface
@@ -699,23 +701,22 @@ contains
       end do
    end subroutine run_group_to_files
 
+   !> The summary line of a finished run; reals as the engine writes them (at most 4 digits here,
+   !> exponents of any size: 1e-118 too).
    function summary_line(scene, summary) result(line)
       type(scene_type), intent(in) :: scene
       type(run_summary), intent(in) :: summary
       character(len=:), allocatable :: line
-      character(len=768) :: buf
       character(len=24) :: cpu, per_step
       ! (f0.3 would drop the leading zero: ".003")
       write (cpu, '(f24.3)') summary%cpu_seconds
       write (per_step, '(f24.3)') 1.0e6_wp*summary%cpu_seconds/max(1_ik, summary%steps)
-      write (buf, '(a,": ",i0," steps, ",a," s CPU (",a," us/step), ",i0," impacts (",i0,' // &
-         & '" contact phases), largest violation ",' // &
-         & 'es9.3," m; energy (J): support work ",es10.3,", stops ",es10.3,", damping ",es10.3,' // &
-         & '", balance residual ",es9.2,"; status ",a)') scene%output_file, summary%steps, trim(adjustl(cpu)), &
-         & trim(adjustl(per_step)), summary%impacts, summary%contact_phases, &
-         & summary%max_violation, summary%work, summary%dissipated, summary%damped, summary%energy_residual, &
-         & summary%status
-      line = trim(buf)//headline(summary)
+      line = scene%output_file//': '//fmt_int(summary%steps)//' steps, '//trim(adjustl(cpu))//' s CPU ('// &
+         & trim(adjustl(per_step))//' us/step), '//fmt_int(summary%impacts)//' impacts ('// &
+         & fmt_int(summary%contact_phases)//' contact phases), largest violation '//fmt_real(summary%max_violation, 4)// &
+         & ' m; energy (J): support work '//fmt_real(summary%work, 4)//', stops '//fmt_real(summary%dissipated, 4)// &
+         & ', damping '//fmt_real(summary%damped, 4)//', balance residual '//fmt_real(summary%energy_residual, 3)// &
+         & '; status '//summary%status//headline(summary)
    end function summary_line
 
    !> The headline statistics after the transient, with their 95 % intervals: shocks per second,
@@ -723,33 +724,31 @@ contains
    function headline(summary) result(text)
       type(run_summary), intent(in) :: summary
       character(len=:), allocatable :: text
-      character(len=*), parameter :: names(4) = [character(len=17) :: 'shocks_per_second', 'power', &
-         & 'impulse_rate', 'tip_rms']
-      character(len=96) :: buf
-      integer :: i, k
       text = ''
       if (.not. allocated(summary%statistics%quantity)) return
-      text = new_line('a')//'statistics (95 % intervals):'
-      do i = 1, size(names)
-         k = summary%statistics%find(trim(names(i)))
-         if (k == 0) cycle
-         associate (q => summary%statistics%quantity(k))
-            write (buf, '(1x,a,1x,es11.4," +- ",es9.2,1x,a)') trim(names(i)), q%value(1), q%half_width(1), q%unit
-         end associate
-         text = text//trim(buf)//';'
-      end do
+      text = new_line('a')//'statistics (95 % intervals):'//headline_values(summary%statistics)
       if (summary%ensemble_members < 2 .or. .not. allocated(summary%ensemble%quantity)) return
-      write (buf, '(i0)') summary%ensemble_members
-      text = text//new_line('a')//'across '//trim(buf)//' members (95 %):'
-      do i = 1, size(names)
-         k = summary%ensemble%find(trim(names(i)))
-         if (k == 0) cycle
-         associate (q => summary%ensemble%quantity(k))
-            write (buf, '(1x,a,1x,es11.4," +- ",es9.2,1x,a)') trim(names(i)), q%value(1), q%half_width(1), q%unit
-         end associate
-         text = text//trim(buf)//';'
-      end do
+      text = text//new_line('a')//'across '//fmt_int(int(summary%ensemble_members, ik))//' members (95 %):'// &
+         & headline_values(summary%ensemble)
    end function headline
+
+   !> ' name value +- half-width unit;' for each headline statistic of a table.
+   function headline_values(table) result(text)
+      type(statistics_table), intent(in) :: table
+      character(len=:), allocatable :: text
+      character(len=*), parameter :: names(4) = [character(len=17) :: 'shocks_per_second', 'power', &
+         & 'impulse_rate', 'tip_rms']
+      integer :: i, k
+      text = ''
+      do i = 1, size(names)
+         k = table%find(trim(names(i)))
+         if (k == 0) cycle
+         associate (q => table%quantity(k))
+            text = text//' '//trim(names(i))//' '//fmt_real(q%value(1), 5)//' +- '//fmt_real(q%half_width(1), 3)// &
+               & ' '//q%unit//';'
+         end associate
+      end do
+   end function headline_values
 
    !> `beamstops info`: the scene as read, its model and the stability limit of the model its run
    !> steps (prepare_run has applied the run's own check to it).
@@ -757,44 +756,44 @@ contains
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
       type(run_limit_type), intent(in) :: limit
-      character(len=*), parameter :: f = '(a,t30,es13.6,1x,a)', fi = '(a,t30,i0,1x,a)', fa = '(a,t30,a)'
+      character(len=*), parameter :: fi = '(a,t30,i0,1x,a)', fa = '(a,t30,a)'
       integer :: i
       write (output_unit, fa) 'file', path
-      write (output_unit, f) '&beam length', scene%length, 'm'
-      write (output_unit, f) '      k2', scene%k2, 'm^4/s^2'
-      write (output_unit, f) '      mass_per_length', scene%mass_per_length, 'kg/m'
-      write (output_unit, f) '&support amplitude', scene%amplitude, 'm'
-      write (output_unit, f) '      omega', scene%omega, 'rad/s'
+      call show('&beam length', scene%length, 'm')
+      call show('      k2', scene%k2, 'm^4/s^2')
+      call show('      mass_per_length', scene%mass_per_length, 'kg/m')
+      call show('&support amplitude', scene%amplitude, 'm')
+      call show('      omega', scene%omega, 'rad/s')
       if (stop_count(scene) == 0) then
-         write (output_unit, f) '&stops lower', scene%lower, 'm'
-         write (output_unit, f) '      upper', scene%upper, 'm'
+         call show('&stops lower', scene%lower, 'm')
+         call show('      upper', scene%upper, 'm')
       else
          write (output_unit, fi) '&stops stops', stop_count(scene), 'along the span (node, x, lower, upper):'
          do i = 1, stop_count(scene)
-            write (output_unit, '(t9,i8,3(1x,es13.6))') scene%stop_nodes(i), model%stops%x(i), scene%stop_lower(i), &
-               & scene%stop_upper(i)
+            write (output_unit, '(t9,i8,3(1x,a))') scene%stop_nodes(i), fmt_real(model%stops%x(i), 7), &
+               & fmt_real(scene%stop_lower(i), 7), fmt_real(scene%stop_upper(i), 7)
          end do
       end if
       write (output_unit, fa) '      law', law_name(scene%law)
-      if (scene%law == law_compliance) write (output_unit, f) '      stiffness_per_mass', scene%stiffness_per_mass, &
-         & '1/s^2'
-      write (output_unit, f) '      restitution', scene%restitution, ''
+      if (scene%law == law_compliance) call show('      stiffness_per_mass', scene%stiffness_per_mass, &
+         & '1/s^2')
+      call show('      restitution', scene%restitution, '')
       write (output_unit, fa) '      mass', trim(merge('redistributed', 'consistent   ', scene%redistributed_mass))
       if (scene%damping_by_ratio) then
-         write (output_unit, '(a,t30,2(es13.6,1x),a,2(1x,i0))') '&damping ratio', scene%damping_ratio, 'at modes', &
-            & scene%damping_modes
-         write (output_unit, f) '      a (C = a M + b S)', model%damping_a, '1/s'
-         write (output_unit, f) '      b', model%damping_b, 's'
+         write (output_unit, '(a,t30,3(a,1x),2(1x,i0))') '&damping ratio', fmt_real(scene%damping_ratio(1), 7), &
+            & fmt_real(scene%damping_ratio(2), 7), 'at modes', scene%damping_modes
+         call show('      a (C = a M + b S)', model%damping_a, '1/s')
+         call show('      b', model%damping_b, 's')
       else
-         write (output_unit, f) '&damping mass_coefficient', model%damping_a, '1/s (a of C = a M + b S)'
-         write (output_unit, f) '      stiffness_coefficient', model%damping_b, 's (b)'
+         call show('&damping mass_coefficient', model%damping_a, '1/s (a of C = a M + b S)')
+         call show('      stiffness_coefficient', model%damping_b, 's (b)')
       end if
       write (output_unit, fi) '&mesh elements', scene%elements, ''
       write (output_unit, fi) '      modes', scene%modes, trim(merge('(a reduced model: r modes)', &
          & '(0: the full model)       ', scene%modes > 0))
-      write (output_unit, f) '&time dt', scene%dt, 's'
-      write (output_unit, f) '      t_end', scene%t_end, 's'
-      write (output_unit, f) '      beta', scene%beta, ''
+      call show('&time dt', scene%dt, 's')
+      call show('      t_end', scene%t_end, 's')
+      call show('      beta', scene%beta, '')
       write (output_unit, fa) '      load_rule', trim(merge('centered', 'paper   ', scene%centered_load))
       write (output_unit, fa) '      start', trim(merge('taylor', 'euler ', scene%taylor_start))
       write (output_unit, fa) '      allow_unstable', trim(merge('.true. ', '.false.', scene%allow_unstable))
@@ -802,16 +801,16 @@ contains
       write (output_unit, fi) '      record_every', scene%record_every, ''
       write (output_unit, fi) '      snapshot_every', scene%snapshot_every, '(0: none)'
       write (output_unit, fi) '      checkpoint_every', scene%checkpoint_every, '(0: none)'
-      write (output_unit, f) '      max_output_gb', scene%max_output_gb, 'GB'
+      call show('      max_output_gb', scene%max_output_gb, 'GB')
       write (output_unit, fa) '&statistics enabled', trim(merge('.true. ', '.false.', scene%statistics))
-      write (output_unit, f) '      transient', scene%transient, 's'
+      call show('      transient', scene%transient, 's')
       write (output_unit, fi) '      batches', scene%batches, ''
       write (output_unit, fi) '      bins', scene%bins, ''
-      write (output_unit, f) '      rest_time', scene%rest_time, 's'
-      write (output_unit, f) '      histogram_lower', scene%histogram_lower, 'm'
-      write (output_unit, f) '      histogram_upper', scene%histogram_upper, 'm'
+      call show('      rest_time', scene%rest_time, 's')
+      call show('      histogram_lower', scene%histogram_lower, 'm')
+      call show('      histogram_upper', scene%histogram_upper, 'm')
       write (output_unit, fi) '&ensemble members', scene%members, ''
-      write (output_unit, f) '      perturbation', scene%perturbation, 'm'
+      call show('      perturbation', scene%perturbation, 'm')
       write (output_unit, fi) '      seed', scene%seed, ''
       if (scene%modes > 0) then
          write (output_unit, '(a,t30,i0,a,i0,a)') 'unknowns n', model%n, ' of the full model (the run: a reduced '// &
@@ -819,20 +818,28 @@ contains
       else
          write (output_unit, fi) 'unknowns n', model%n, ''
       end if
-      write (output_unit, f) 'kappa_h', model%kappa_h, '1/s^2 ('//model%kappa_method//')'
-      write (output_unit, f) 'kappa_bound (5.2)', model%kappa_bound, '1/s^2'
-      if (scene%law == law_compliance) write (output_unit, f) 'kappa with spring', model%kappa_contact, '1/s^2'
-      if (scene%modes > 0 .and. scene%beta < 0.25_wp) write (output_unit, f) 'kappa of the run', limit%kappa, &
-         & '1/s^2 (the '//limit%model//', which the run steps)'
-      write (output_unit, f) 'dt limit Newmark', limit%dt_newmark, 's (2/sqrt((1-4 beta) kappa) of the '// &
-         & limit%model//', which the run steps; beta < 1/4)'
-      write (output_unit, f) 'dt limit (3.1) exact', model%dt_paper_exact, 's (2/sqrt((1-2 beta) kappa_h))'
-      write (output_unit, f) 'dt limit (3.1) bound', model%dt_paper_bound, 's (2/sqrt((1-2 beta) kappa_bound))'
+      call show('kappa_h', model%kappa_h, '1/s^2 ('//model%kappa_method//')')
+      call show('kappa_bound (5.2)', model%kappa_bound, '1/s^2')
+      if (scene%law == law_compliance) call show('kappa with spring', model%kappa_contact, '1/s^2')
+      if (scene%modes > 0 .and. scene%beta < 0.25_wp) call show('kappa of the run', limit%kappa, &
+         & '1/s^2 (the '//limit%model//', which the run steps)')
+      call show('dt limit Newmark', limit%dt_newmark, 's (2/sqrt((1-4 beta) kappa) of the '// &
+         & limit%model//', which the run steps; beta < 1/4)')
+      call show('dt limit (3.1) exact', model%dt_paper_exact, 's (2/sqrt((1-2 beta) kappa_h))')
+      call show('dt limit (3.1) bound', model%dt_paper_bound, 's (2/sqrt((1-2 beta) kappa_bound))')
       write (output_unit, fi) 'steps', steps_of(scene), ''
       write (output_unit, fi) 'records', record_count(scene), ''
       write (output_unit, fi) 'snapshots', snapshot_count(scene), ''
-      write (output_unit, f) 'output size', output_bytes(scene)/1.0e6_wp, 'MB'
+      call show('output size', output_bytes(scene)/1.0e6_wp, 'MB')
       write (output_unit, fa) 'energy ledger', 'support work /energy/work, stops /energy/dissipated, damping '// &
          & '/energy/damped (J, cumulative); balance residual E - E(0) - (work - stops - damping) in the summary'
    end subroutine print_info
+
+   !> A line of `beamstops info`: the label, then from column 30 the value (at most 7 digits, as
+   !> the engine writes reals: exponents of any size) and its unit.
+   subroutine show(label, value, unit)
+      character(len=*), intent(in) :: label, unit
+      real(wp), intent(in) :: value
+      write (output_unit, '(a,t30,a)') label, fmt_real(value, 7)//' '//unit
+   end subroutine show
 end program beamstops_main

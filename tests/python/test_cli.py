@@ -693,3 +693,25 @@ def test_repeated_or_unexpected_arguments_are_refused(args: list[str], needle: s
     lines = done.stderr.strip().splitlines()
     assert done.returncode == 2 and len(lines) == 1 and needle in lines[0], done.stderr
     assert done.stdout == "" and sorted(p.name for p in tmp_path.iterdir()) == ["scene.nml"]
+
+
+# ---------------------------------------------------------------- numbers of any exponent
+
+
+def test_numbers_with_three_digit_exponents_are_printed_with_their_e(tmp_path: Path) -> None:
+    import re
+
+    scene = write(tmp_path, "&time dt=1e-60, t_end=1e-60 /\n")
+    done = beamstops("run", scene, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    info = beamstops("info", write(tmp_path, "&time dt=1e-60, t_end=1e-60 /\n&stops lower=-1e-120, upper=1e-120 /\n",
+                                   "tiny.nml"), cwd=tmp_path)
+    assert info.returncode == 0, info.stderr
+    for text in (done.stdout, info.stdout):
+        # a mantissa followed by a signed exponent without its e (gfortran's ES of |exponent| > 99)
+        assert not re.search(r"\d[-+]\d{3}\b", text), text
+    assert "support work -2.142e-118" in done.stdout
+    shown = {line[:29].strip(): line[29:].split() for line in info.stdout.splitlines()}
+    assert float(shown["&time dt"][0]) == 1e-60 and float(shown["&stops lower"][0]) == -1e-120
+    with h5py.File(tmp_path / "scene.h5") as f:  # the text attributes: the scene's canonical text
+        assert "dt = 1e-60" in f.attrs["scene"].decode() and f.attrs["dt"] == 1e-60
