@@ -12,15 +12,18 @@ program beamstops_main
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use beamstops
    use beamstops_checkpoint, only: checkpoint_path, temporary_path, read_checkpoint, is_checkpoint
-   use beamstops_files, only: file_exists, remove_file, same_file, same_path
+   use beamstops_files, only: file_exists, remove_file, same_file, same_path, creation_error
+   use beamstops_namelist, only: default_output
    use beamstops_recorder_hdf5, only: partial_path, check_output_path
    use beamstops_run, only: continue_run, continue_reduced
    use beamstops_writer_thread, only: writer_thread, start_writer, stop_writer
    use beamstops_batch, only: lockstep_groups, simulate_group, min_group_members
-   use beamstops_reduced, only: reduced_model_type, build_reduced, check_stability_reduced
+   use beamstops_reduced, only: reduced_model_type, reduce_model
    use beamstops_reduced_scheme, only: reduced_state_type, start_reduced
    use beamstops_reduced_checkpoint, only: read_reduced_checkpoint
    use beamstops_lapack, only: openblas_one_thread
+   use beamstops_strings, only: fmt_real, fmt_int
+   use beamstops_observe_statistics, only: statistics_table
    implicit none
 
    interface
@@ -110,6 +113,8 @@ program beamstops_main
    logical :: restart = .false.
    type(scene_type) :: scene
    type(model_type) :: model
+   !> With &mesh modes > 0, the reduced model the run steps (prepare_run).
+   type(reduced_model_type) :: reduced
    type(error_type), allocatable :: error
    !> The HDF5 writes of every run on a thread of their own (beamstops_writer_thread).
    type(writer_thread) :: writer
@@ -125,13 +130,13 @@ program beamstops_main
    call read_scene(path, scene, error)
    call stop_on(error, exit_input)
    if (allocated(out)) scene%output_file = out
-   call prepare_run(scene, path, model, error)
+   call prepare_run(scene, path, model, error, reduced)
    call stop_on(error, exit_input)
    select case (command)
    case ('info')
-      call print_info(scene, model)
+      call print_info(scene, model, run_limit(scene, model, reduced))
    case ('run')
-      call quit(run_to_file(scene, model, path, restart, c_isatty(2_c_int) == 1))
+      call quit(run_to_file(scene, model, path, restart, c_isatty(2_c_int) == 1, reduced))
    end select
 
 contains
@@ -150,8 +155,10 @@ contains
       command = trim(arg)
       select case (command)
       case ('-h', '--help', 'help')
+         call no_more_arguments(command)
          call usage()
       case ('-V', '--version', 'version')
+         call no_more_arguments(command)
          write (output_unit, '(a)') 'beamstops '//version
          stop
       case ('run', 'info')
@@ -168,10 +175,14 @@ contains
             if (allocated(out)) call usage("'-o' is given twice (one output: the last would have won)")
             call get_command_argument(i + 1, arg)
             if (len_trim(arg) == 0) call usage("'-o' takes a file name; it was given an empty one")
+            if (trim(arg) == '-') call usage("'-o -': beamstops cannot write its output to standard output (an "// &
+               & "HDF5 file is written in place, and renamed when the run is done); name a file (-o ./- for a "// &
+               & "file named -)")
             out = trim(arg)
             i = i + 1
          case ('--restart')
             if (command /= 'run') call usage("'--restart' goes with 'run'")
+            if (restart) call usage("'--restart' is given twice; allowed: once")
             restart = .true.
          case default
             if (arg(1:1) == '-' .or. (command /= 'run' .and. size(paths) > 0)) &
@@ -185,6 +196,15 @@ contains
       if (size(paths) > 1 .and. allocated(out)) call usage("'-o' names the output of one scene; with several "// &
          & 'namelist files each scene writes its own (&output file; default: the input''s name with .h5)')
    end subroutine parse_arguments
+
+   !> Refuse arguments after `command`, which takes none (--help, --version).
+   subroutine no_more_arguments(command)
+      character(len=*), intent(in) :: command
+      character(len=4096) :: arg
+      if (command_argument_count() < 2) return
+      call get_command_argument(2, arg)
+      call usage("unexpected argument '"//trim(arg)//"' after '"//command//"', which takes none")
+   end subroutine no_more_arguments
 
    !> The help (on stdout), or one line on stderr naming the problem, with exit status 2.
    subroutine usage(problem)
@@ -347,37 +367,37 @@ contains
    !> (not the input, not a file other than a beamstops output); the run writes OUT.partial
    !> and the recorder renames it onto OUT when the run went to its end (complete or diverged).
    !> With `restart`, the partial file continues from the checkpoint OUT.checkpoint.
-   integer function run_to_file(scene, model, input, restart, progress) result(status)
+   recursive integer function run_to_file(scene, model, input, restart, progress, reduced) result(status)
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
       character(len=*), intent(in) :: input
       logical, intent(in) :: restart
       !> Print a progress line on stderr.
       logical, intent(in) :: progress
+      !> With &mesh modes > 0, the reduced model the run steps (prepare_run); built here when absent
+      !> (the scenes of `run A.nml B.nml ...`, prepared and checked up front without keeping it).
+      type(reduced_model_type), intent(in), optional :: reduced
       type(hdf5_recorder) :: recorder
       type(run_summary) :: summary
       type(state_type) :: state
-      type(reduced_model_type) :: reduced
+      type(reduced_model_type) :: built
       type(reduced_state_type) :: reduced_state
       type(error_type), allocatable :: error, write_error, finish_error
       character(len=:), allocatable :: output, partial, checkpoint
       integer(ik) :: records, snapshots
       logical :: resume
       status = 0
-      recorder%writer = writer
-      if (scene%modes > 0) then
-         ! The reduced (Craig-Bampton) model, before anything is written.
-         call build_reduced(scene, model, reduced, error)
+      if (scene%modes > 0 .and. .not. present(reduced)) then
+         call reduce_model(scene, model, input, built, error)
          if (reported(error, exit_input, status)) return
-         call check_stability_reduced(scene, reduced, input, error)
-         if (reported(error, exit_input, status)) return
+         status = run_to_file(scene, model, input, restart, progress, built)
+         return
       end if
+      recorder%writer = writer
       output = scene%output_file
       partial = partial_path(output)
       checkpoint = checkpoint_path(output)
-      call check_output_path(output, input, error)
-      if (reported(error, exit_output, status)) return
-      call check_checkpoint_path(checkpoint, error)
+      call check_outputs(scene, input, error)
       if (reported(error, exit_output, status)) return
       resume = .false.
       if (restart) then
@@ -424,13 +444,44 @@ contains
       status = run_outcome(scene, summary, error, write_error, finish_error)
    end function run_to_file
 
-   !> Refuse a checkpoint path that holds something else than a beamstops checkpoint.
-   subroutine check_checkpoint_path(checkpoint, error)
-      character(len=*), intent(in) :: checkpoint
+   !> Refuse, before anything is written, the output of a scene that the run cannot write or that
+   !> would destroy data (check_output_path), a checkpoint path that holds something else than a
+   !> beamstops checkpoint, and with checkpoint_every > 0 a checkpoint the system will not let the
+   !> run create; the messages say where the output's name came from (output_origin).
+   subroutine check_outputs(scene, input, error)
+      type(scene_type), intent(in) :: scene
+      character(len=*), intent(in) :: input
       type(error_type), allocatable, intent(out) :: error
-      if (file_exists(checkpoint) .and. .not. is_checkpoint(checkpoint)) call fatal_error(error, checkpoint// &
-         & ': exists and is not a beamstops checkpoint; refusing to overwrite it (move it away)')
-   end subroutine check_checkpoint_path
+      character(len=:), allocatable :: origin, checkpoint, why
+      origin = output_origin(scene, input)
+      call check_output_path(scene%output_file, input, origin, error)
+      if (allocated(error)) return
+      checkpoint = checkpoint_path(scene%output_file)
+      if (file_exists(checkpoint) .and. .not. is_checkpoint(checkpoint)) then
+         call fatal_error(error, scene%output_file//' ('//origin//'): '//checkpoint//', where the run saves its '// &
+            & 'checkpoints, exists and is not a beamstops checkpoint; refusing to overwrite it (move it away)')
+         return
+      end if
+      if (scene%checkpoint_every == 0) return
+      why = creation_error(temporary_path(checkpoint))
+      if (len(why) > 0) call fatal_error(error, scene%output_file//' ('//origin//'): cannot create '// &
+         & temporary_path(checkpoint)//', where the run saves its checkpoints (&output checkpoint_every): '//why)
+   end subroutine check_outputs
+
+   !> Where the output name of a scene came from: -o, or the &output file of its input (whose
+   !> default is the input's name with .h5).
+   function output_origin(scene, input) result(origin)
+      type(scene_type), intent(in) :: scene
+      character(len=*), intent(in) :: input
+      character(len=:), allocatable :: origin
+      if (allocated(out)) then
+         origin = '-o'
+      else if (scene%output_file == default_output(input)) then
+         origin = '&output file of '//input//', by default the input''s name with .h5'
+      else
+         origin = '&output file of '//input
+      end if
+   end function output_origin
 
    !> The end of a run whose recorder is finished: the messages, the summary line and the exit
    !> status (0 complete, 1 the run could not start, 3 diverged or failed, 4 a write failed).
@@ -510,14 +561,13 @@ contains
       end do
       do i = 1, n
          output = scenes(i)%output_file
-         call check_output_path(output, paths(i)%text, error)
+         call check_outputs(scenes(i), paths(i)%text, error)
          do j = 1, n
             if (allocated(error)) exit
             if (j /= i .and. same_file(output, paths(j)%text)) call fatal_error(error, output//': is the input '// &
                & 'file '//paths(j)%text//'; writing the output of '//paths(i)%text//' there would destroy it')
             if (j < i) call check_shared_files(output, paths(i)%text, scenes(j)%output_file, paths(j)%text, error)
          end do
-         if (.not. allocated(error)) call check_checkpoint_path(checkpoint_path(output), error)
          call refuse_all(error, exit_output, n)
          alone(i) = restart .and. file_exists(checkpoint_path(output)) .and. file_exists(partial_path(output))
       end do
@@ -651,23 +701,22 @@ contains
       end do
    end subroutine run_group_to_files
 
+   !> The summary line of a finished run; reals as the engine writes them (at most 4 digits here,
+   !> exponents of any size: 1e-118 too).
    function summary_line(scene, summary) result(line)
       type(scene_type), intent(in) :: scene
       type(run_summary), intent(in) :: summary
       character(len=:), allocatable :: line
-      character(len=768) :: buf
       character(len=24) :: cpu, per_step
       ! (f0.3 would drop the leading zero: ".003")
       write (cpu, '(f24.3)') summary%cpu_seconds
       write (per_step, '(f24.3)') 1.0e6_wp*summary%cpu_seconds/max(1_ik, summary%steps)
-      write (buf, '(a,": ",i0," steps, ",a," s CPU (",a," us/step), ",i0," impacts (",i0,' // &
-         & '" contact phases), largest violation ",' // &
-         & 'es9.3," m; energy (J): support work ",es10.3,", stops ",es10.3,", damping ",es10.3,' // &
-         & '", balance residual ",es9.2,"; status ",a)') scene%output_file, summary%steps, trim(adjustl(cpu)), &
-         & trim(adjustl(per_step)), summary%impacts, summary%contact_phases, &
-         & summary%max_violation, summary%work, summary%dissipated, summary%damped, summary%energy_residual, &
-         & summary%status
-      line = trim(buf)//headline(summary)
+      line = scene%output_file//': '//fmt_int(summary%steps)//' steps, '//trim(adjustl(cpu))//' s CPU ('// &
+         & trim(adjustl(per_step))//' us/step), '//fmt_int(summary%impacts)//' impacts ('// &
+         & fmt_int(summary%contact_phases)//' contact phases), largest violation '//fmt_real(summary%max_violation, 4)// &
+         & ' m; energy (J): support work '//fmt_real(summary%work, 4)//', stops '//fmt_real(summary%dissipated, 4)// &
+         & ', damping '//fmt_real(summary%damped, 4)//', balance residual '//fmt_real(summary%energy_residual, 3)// &
+         & '; status '//summary%status//headline(summary)
    end function summary_line
 
    !> The headline statistics after the transient, with their 95 % intervals: shocks per second,
@@ -675,75 +724,76 @@ contains
    function headline(summary) result(text)
       type(run_summary), intent(in) :: summary
       character(len=:), allocatable :: text
-      character(len=*), parameter :: names(4) = [character(len=17) :: 'shocks_per_second', 'power', &
-         & 'impulse_rate', 'tip_rms']
-      character(len=96) :: buf
-      integer :: i, k
       text = ''
       if (.not. allocated(summary%statistics%quantity)) return
-      text = new_line('a')//'statistics (95 % intervals):'
-      do i = 1, size(names)
-         k = summary%statistics%find(trim(names(i)))
-         if (k == 0) cycle
-         associate (q => summary%statistics%quantity(k))
-            write (buf, '(1x,a,1x,es11.4," +- ",es9.2,1x,a)') trim(names(i)), q%value(1), q%half_width(1), q%unit
-         end associate
-         text = text//trim(buf)//';'
-      end do
+      text = new_line('a')//'statistics (95 % intervals):'//headline_values(summary%statistics)
       if (summary%ensemble_members < 2 .or. .not. allocated(summary%ensemble%quantity)) return
-      write (buf, '(i0)') summary%ensemble_members
-      text = text//new_line('a')//'across '//trim(buf)//' members (95 %):'
-      do i = 1, size(names)
-         k = summary%ensemble%find(trim(names(i)))
-         if (k == 0) cycle
-         associate (q => summary%ensemble%quantity(k))
-            write (buf, '(1x,a,1x,es11.4," +- ",es9.2,1x,a)') trim(names(i)), q%value(1), q%half_width(1), q%unit
-         end associate
-         text = text//trim(buf)//';'
-      end do
+      text = text//new_line('a')//'across '//fmt_int(int(summary%ensemble_members, ik))//' members (95 %):'// &
+         & headline_values(summary%ensemble)
    end function headline
 
-   subroutine print_info(scene, model)
+   !> ' name value +- half-width unit;' for each headline statistic of a table.
+   function headline_values(table) result(text)
+      type(statistics_table), intent(in) :: table
+      character(len=:), allocatable :: text
+      character(len=*), parameter :: names(4) = [character(len=17) :: 'shocks_per_second', 'power', &
+         & 'impulse_rate', 'tip_rms']
+      integer :: i, k
+      text = ''
+      do i = 1, size(names)
+         k = table%find(trim(names(i)))
+         if (k == 0) cycle
+         associate (q => table%quantity(k))
+            text = text//' '//trim(names(i))//' '//fmt_real(q%value(1), 5)//' +- '//fmt_real(q%half_width(1), 3)// &
+               & ' '//q%unit//';'
+         end associate
+      end do
+   end function headline_values
+
+   !> `beamstops info`: the scene as read, its model and the stability limit of the model its run
+   !> steps (prepare_run has applied the run's own check to it).
+   subroutine print_info(scene, model, limit)
       type(scene_type), intent(in) :: scene
       type(model_type), intent(in) :: model
-      character(len=*), parameter :: f = '(a,t30,es13.6,1x,a)', fi = '(a,t30,i0,1x,a)', fa = '(a,t30,a)'
+      type(run_limit_type), intent(in) :: limit
+      character(len=*), parameter :: fi = '(a,t30,i0,1x,a)', fa = '(a,t30,a)'
       integer :: i
       write (output_unit, fa) 'file', path
-      write (output_unit, f) '&beam length', scene%length, 'm'
-      write (output_unit, f) '      k2', scene%k2, 'm^4/s^2'
-      write (output_unit, f) '      mass_per_length', scene%mass_per_length, 'kg/m'
-      write (output_unit, f) '&support amplitude', scene%amplitude, 'm'
-      write (output_unit, f) '      omega', scene%omega, 'rad/s'
+      call show('&beam length', scene%length, 'm')
+      call show('      k2', scene%k2, 'm^4/s^2')
+      call show('      mass_per_length', scene%mass_per_length, 'kg/m')
+      call show('&support amplitude', scene%amplitude, 'm')
+      call show('      omega', scene%omega, 'rad/s')
       if (stop_count(scene) == 0) then
-         write (output_unit, f) '&stops lower', scene%lower, 'm'
-         write (output_unit, f) '      upper', scene%upper, 'm'
+         call show('&stops lower', scene%lower, 'm')
+         call show('      upper', scene%upper, 'm')
       else
          write (output_unit, fi) '&stops stops', stop_count(scene), 'along the span (node, x, lower, upper):'
          do i = 1, stop_count(scene)
-            write (output_unit, '(t9,i8,3(1x,es13.6))') scene%stop_nodes(i), model%stops%x(i), scene%stop_lower(i), &
-               & scene%stop_upper(i)
+            write (output_unit, '(t9,i8,3(1x,a))') scene%stop_nodes(i), fmt_real(model%stops%x(i), 7), &
+               & fmt_real(scene%stop_lower(i), 7), fmt_real(scene%stop_upper(i), 7)
          end do
       end if
       write (output_unit, fa) '      law', law_name(scene%law)
-      if (scene%law == law_compliance) write (output_unit, f) '      stiffness_per_mass', scene%stiffness_per_mass, &
-         & '1/s^2'
-      write (output_unit, f) '      restitution', scene%restitution, ''
+      if (scene%law == law_compliance) call show('      stiffness_per_mass', scene%stiffness_per_mass, &
+         & '1/s^2')
+      call show('      restitution', scene%restitution, '')
       write (output_unit, fa) '      mass', trim(merge('redistributed', 'consistent   ', scene%redistributed_mass))
       if (scene%damping_by_ratio) then
-         write (output_unit, '(a,t30,2(es13.6,1x),a,2(1x,i0))') '&damping ratio', scene%damping_ratio, 'at modes', &
-            & scene%damping_modes
-         write (output_unit, f) '      a (C = a M + b S)', model%damping_a, '1/s'
-         write (output_unit, f) '      b', model%damping_b, 's'
+         write (output_unit, '(a,t30,3(a,1x),2(1x,i0))') '&damping ratio', fmt_real(scene%damping_ratio(1), 7), &
+            & fmt_real(scene%damping_ratio(2), 7), 'at modes', scene%damping_modes
+         call show('      a (C = a M + b S)', model%damping_a, '1/s')
+         call show('      b', model%damping_b, 's')
       else
-         write (output_unit, f) '&damping mass_coefficient', model%damping_a, '1/s (a of C = a M + b S)'
-         write (output_unit, f) '      stiffness_coefficient', model%damping_b, 's (b)'
+         call show('&damping mass_coefficient', model%damping_a, '1/s (a of C = a M + b S)')
+         call show('      stiffness_coefficient', model%damping_b, 's (b)')
       end if
       write (output_unit, fi) '&mesh elements', scene%elements, ''
       write (output_unit, fi) '      modes', scene%modes, trim(merge('(a reduced model: r modes)', &
          & '(0: the full model)       ', scene%modes > 0))
-      write (output_unit, f) '&time dt', scene%dt, 's'
-      write (output_unit, f) '      t_end', scene%t_end, 's'
-      write (output_unit, f) '      beta', scene%beta, ''
+      call show('&time dt', scene%dt, 's')
+      call show('      t_end', scene%t_end, 's')
+      call show('      beta', scene%beta, '')
       write (output_unit, fa) '      load_rule', trim(merge('centered', 'paper   ', scene%centered_load))
       write (output_unit, fa) '      start', trim(merge('taylor', 'euler ', scene%taylor_start))
       write (output_unit, fa) '      allow_unstable', trim(merge('.true. ', '.false.', scene%allow_unstable))
@@ -751,16 +801,16 @@ contains
       write (output_unit, fi) '      record_every', scene%record_every, ''
       write (output_unit, fi) '      snapshot_every', scene%snapshot_every, '(0: none)'
       write (output_unit, fi) '      checkpoint_every', scene%checkpoint_every, '(0: none)'
-      write (output_unit, f) '      max_output_gb', scene%max_output_gb, 'GB'
+      call show('      max_output_gb', scene%max_output_gb, 'GB')
       write (output_unit, fa) '&statistics enabled', trim(merge('.true. ', '.false.', scene%statistics))
-      write (output_unit, f) '      transient', scene%transient, 's'
+      call show('      transient', scene%transient, 's')
       write (output_unit, fi) '      batches', scene%batches, ''
       write (output_unit, fi) '      bins', scene%bins, ''
-      write (output_unit, f) '      rest_time', scene%rest_time, 's'
-      write (output_unit, f) '      histogram_lower', scene%histogram_lower, 'm'
-      write (output_unit, f) '      histogram_upper', scene%histogram_upper, 'm'
+      call show('      rest_time', scene%rest_time, 's')
+      call show('      histogram_lower', scene%histogram_lower, 'm')
+      call show('      histogram_upper', scene%histogram_upper, 'm')
       write (output_unit, fi) '&ensemble members', scene%members, ''
-      write (output_unit, f) '      perturbation', scene%perturbation, 'm'
+      call show('      perturbation', scene%perturbation, 'm')
       write (output_unit, fi) '      seed', scene%seed, ''
       if (scene%modes > 0) then
          write (output_unit, '(a,t30,i0,a,i0,a)') 'unknowns n', model%n, ' of the full model (the run: a reduced '// &
@@ -768,17 +818,28 @@ contains
       else
          write (output_unit, fi) 'unknowns n', model%n, ''
       end if
-      write (output_unit, f) 'kappa_h', model%kappa_h, '1/s^2 ('//model%kappa_method//')'
-      write (output_unit, f) 'kappa_bound (5.2)', model%kappa_bound, '1/s^2'
-      if (scene%law == law_compliance) write (output_unit, f) 'kappa with spring', model%kappa_contact, '1/s^2'
-      write (output_unit, f) 'dt limit Newmark', model%dt_newmark, 's (2/sqrt((1-4 beta) kappa), beta < 1/4)'
-      write (output_unit, f) 'dt limit (3.1) exact', model%dt_paper_exact, 's (2/sqrt((1-2 beta) kappa_h))'
-      write (output_unit, f) 'dt limit (3.1) bound', model%dt_paper_bound, 's (2/sqrt((1-2 beta) kappa_bound))'
+      call show('kappa_h', model%kappa_h, '1/s^2 ('//model%kappa_method//')')
+      call show('kappa_bound (5.2)', model%kappa_bound, '1/s^2')
+      if (scene%law == law_compliance) call show('kappa with spring', model%kappa_contact, '1/s^2')
+      if (scene%modes > 0 .and. scene%beta < 0.25_wp) call show('kappa of the run', limit%kappa, &
+         & '1/s^2 (the '//limit%model//', which the run steps)')
+      call show('dt limit Newmark', limit%dt_newmark, 's (2/sqrt((1-4 beta) kappa) of the '// &
+         & limit%model//', which the run steps; beta < 1/4)')
+      call show('dt limit (3.1) exact', model%dt_paper_exact, 's (2/sqrt((1-2 beta) kappa_h))')
+      call show('dt limit (3.1) bound', model%dt_paper_bound, 's (2/sqrt((1-2 beta) kappa_bound))')
       write (output_unit, fi) 'steps', steps_of(scene), ''
       write (output_unit, fi) 'records', record_count(scene), ''
       write (output_unit, fi) 'snapshots', snapshot_count(scene), ''
-      write (output_unit, f) 'output size', output_bytes(scene)/1.0e6_wp, 'MB'
+      call show('output size', output_bytes(scene)/1.0e6_wp, 'MB')
       write (output_unit, fa) 'energy ledger', 'support work /energy/work, stops /energy/dissipated, damping '// &
          & '/energy/damped (J, cumulative); balance residual E - E(0) - (work - stops - damping) in the summary'
    end subroutine print_info
+
+   !> A line of `beamstops info`: the label, then from column 30 the value (at most 7 digits, as
+   !> the engine writes reals: exponents of any size) and its unit.
+   subroutine show(label, value, unit)
+      character(len=*), intent(in) :: label, unit
+      real(wp), intent(in) :: value
+      write (output_unit, '(a,t30,a)') label, fmt_real(value, 7)//' '//unit
+   end subroutine show
 end program beamstops_main

@@ -100,27 +100,37 @@ subroutine bs_sizes(text, source, records, snapshots, nodes, stops, status, mess
    call report(error, status, message)
 end subroutine bs_sizes
 
-!> kappa_h, the paper's bound kappa_tilde and the time-step limits of a scene, and
-!> whether the engine would refuse to run it (`refused` = 1, with its reason).
+!> kappa_h, the paper's bound kappa_tilde and the time-step limits of a scene, the linear limit of
+!> the model its run steps (`run_model`: the full model, or the reduced one of &mesh modes > 0),
+!> and whether the engine would refuse to run it (`refused` = 1, with its reason): check_run,
+!> the check of `beamstops run` and `beamstops info`.
 subroutine bs_stability(text, source, kappa_h, kappa_bound, kappa_contact, dt_limit_newmark, dt_limit_paper, &
-   & dt_limit_paper_bound, kappa_method, refused, refusal, status, message)
-   use beamstops, only: error_type, scene_type, model_type, build_model, check_stability
+   & dt_limit_paper_bound, kappa_method, kappa_run, dt_limit_run, run_model, refused, refusal, status, message)
+   use beamstops, only: error_type, scene_type, model_type, build_model, check_run, run_limit_type, run_limit, &
+      & reduced_model_type
    use beamstops_wrap_support, only: scene_of, report
    implicit none
    !f2py threadsafe
    character(len=*), intent(in) :: text, source
    real(8), intent(out) :: kappa_h, kappa_bound, kappa_contact, dt_limit_newmark, dt_limit_paper, dt_limit_paper_bound
    character(len=32), intent(out) :: kappa_method
+   !> The largest eigenvalue (0: not computed) and the linear limit of the model the run steps.
+   real(8), intent(out) :: kappa_run, dt_limit_run
+   !> Which model the run steps: 'full model' or 'reduced model of r modes'.
+   character(len=64), intent(out) :: run_model
    integer, intent(out) :: refused
    character(len=1024), intent(out) :: refusal
    integer, intent(out) :: status
    character(len=1024), intent(out) :: message
    type(scene_type) :: scene
    type(model_type) :: model
+   type(reduced_model_type) :: reduced
+   type(run_limit_type) :: limit
    type(error_type), allocatable :: error, refusal_error
    kappa_h = 0; kappa_bound = 0; kappa_contact = 0
    dt_limit_newmark = 0; dt_limit_paper = 0; dt_limit_paper_bound = 0
    kappa_method = ''
+   kappa_run = 0; dt_limit_run = 0; run_model = ''
    refused = 0
    refusal = ''
    call scene_of(text, source, scene, error)
@@ -133,7 +143,11 @@ subroutine bs_stability(text, source, kappa_h, kappa_bound, kappa_contact, dt_li
       dt_limit_paper = model%dt_paper_exact
       dt_limit_paper_bound = model%dt_paper_bound
       kappa_method = model%kappa_method
-      call check_stability(scene, model, trim(source), refusal_error)
+      call check_run(scene, trim(source), model, refusal_error, reduced)
+      limit = run_limit(scene, model, reduced)
+      kappa_run = limit%kappa
+      dt_limit_run = limit%dt_newmark
+      run_model = limit%model
       call report(refusal_error, refused, refusal)
    end if
    call report(error, status, message)
@@ -150,7 +164,7 @@ subroutine bs_run(text, source, records, snapshots, nodes, stops, shock_capacity
    & stops_reaction, filled, snaps, shocks, shock_count, shock_labels, stat_value, stat_half, stat_entries, stat_labels, &
    & attributes, status, message)
    use beamstops, only: error_type, fatal_error, scene_type, record_count, snapshot_count, stop_count, &
-      & model_type, prepare_run, simulate, array_recorder, n_columns, run_summary
+      & model_type, prepare_run, simulate, array_recorder, n_columns, run_summary, reduced_model_type
    use beamstops_recorder, only: col_t, col_u, col_v, col_reaction, col_energy, col_work, col_dissipated, col_damped
    use beamstops_attributes, only: attribute_list, attribute_lines
    use beamstops_output_attributes, only: run_attributes, summary_attributes
@@ -185,6 +199,7 @@ subroutine bs_run(text, source, records, snapshots, nodes, stops, shock_capacity
    character(len=1024), intent(out) :: message
    type(scene_type) :: scene
    type(model_type) :: model
+   type(reduced_model_type) :: reduced
    type(array_recorder) :: recorder
    type(run_summary) :: summary
    type(attribute_list) :: list
@@ -209,7 +224,7 @@ subroutine bs_run(text, source, records, snapshots, nodes, stops, shock_capacity
          & nodes /= scene%elements + 1 .or. stops /= stop_count(scene)) call fatal_error(error, &
          & trim(source)//': the arrays given to bs_run do not have the sizes bs_sizes returns for this scene')
    end if
-   if (.not. allocated(error)) call prepare_run(scene, trim(source), model, error)
+   if (.not. allocated(error)) call prepare_run(scene, trim(source), model, error, reduced)
    if (.not. allocated(error)) then
       ! The array recorder's buffers, sized as its `reserve` would, but allocated with a status.
       allocate (recorder%rows(n_columns, records), recorder%snap_t(snapshots), recorder%snap_u(nodes, snapshots), &
@@ -219,7 +234,7 @@ subroutine bs_run(text, source, records, snapshots, nodes, stops, shock_capacity
       recorder%snaps = 0
       recorder%stops_filled = 0
    end if
-   if (.not. allocated(error)) call simulate(scene, model, recorder, summary, error)
+   if (.not. allocated(error)) call simulate(scene, model, recorder, summary, error, reduced)
    if (allocated(error)) then
       call report(error, status, message)
       return

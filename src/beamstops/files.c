@@ -173,4 +173,37 @@ int beamstops_read_file(const char *path, int64_t limit, char **data, int64_t *s
     }
     *size = *regular ? (int64_t)used : -1;
     return 3;
+/* 0 when a run can write the file `path` and rename it in its folder, else the errno that says
+   why not (ENAMETOOLONG, ENOENT, ENOTDIR, EACCES, EROFS, ...). A new file is created and removed
+   again (O_EXCL: only what this call created is removed); an existing one is not opened, only
+   tested for writing, with its folder (where the finished file is renamed). */
+int beamstops_creation_errno(const char *path)
+{
+    size_t size = strlen(path) + 2;
+    char *dir;
+    int fd, code = 0;
+    if (access(path, F_OK) != 0) {
+        fd = open(path, O_WRONLY | O_CREAT | O_EXCL, 0666);
+        if (fd < 0)
+            return errno;
+        close(fd);
+        unlink(path);
+        return 0;
+    }
+    if (access(path, W_OK) != 0)
+        return errno;
+    dir = malloc(size);
+    if (dir == NULL)
+        return ENOMEM;
+    split_path(path, dir, size);
+    if (access(dir, W_OK | X_OK) != 0)
+        code = errno;
+    free(dir);
+    return code;
+}
+
+/* The system's text of an errno (strerror) into `text`, NUL-terminated within `size` bytes. */
+void beamstops_errno_text(int code, char *text, size_t size)
+{
+    snprintf(text, size, "%s", strerror(code));
 }

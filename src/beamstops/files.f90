@@ -1,10 +1,11 @@
 !> Files as the engine handles them: existence, identity (same file under two names),
 !> atomic replacement by rename, removal. The C library and src/beamstops/files.c do the work.
 module beamstops_files
-   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_int64_t, c_null_char, c_ptr, c_f_pointer, c_associated
+   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_int64_t, c_null_char, c_ptr, c_f_pointer, c_associated, &
+      & c_size_t
    implicit none
    private
-   public :: file_exists, is_directory, same_file, same_path, rename_file, replace_file, remove_file
+   public :: file_exists, is_directory, same_file, same_path, rename_file, replace_file, remove_file, creation_error
    public :: read_whole_file, read_ok, read_missing, read_folder, read_too_big, read_unopened, read_failed
 
    !> Outcomes of read_whole_file: read, no such file, a folder, more bytes than allowed, not
@@ -59,6 +60,17 @@ module beamstops_files
          import :: c_ptr
          type(c_ptr), value :: pointer
       end subroutine c_free
+      function c_creation_errno(path) bind(c, name='beamstops_creation_errno') result(code)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int) :: code
+      end function c_creation_errno
+      subroutine c_errno_text(code, text, size) bind(c, name='beamstops_errno_text')
+         import :: c_char, c_int, c_size_t
+         integer(c_int), value :: code
+         character(kind=c_char), intent(out) :: text(*)
+         integer(c_size_t), value :: size
+      end subroutine c_errno_text
    end interface
 
 contains
@@ -162,6 +174,27 @@ contains
       logical, intent(out) :: ok
       ok = c_replace_file(from//c_null_char, to//c_null_char) == 0
    end subroutine replace_file
+
+   !> Why a run could not write the file `path` (create it, or write it, and rename it in its
+   !> folder): the system's reason, e.g. 'File name too long', 'No such file or directory',
+   !> 'Permission denied', 'Read-only file system'; '' when it can. Nothing is left behind: a file
+   !> created to find out is removed again.
+   function creation_error(path) result(why)
+      !> File.
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: why
+      character(kind=c_char) :: text(256)
+      integer(c_int) :: code
+      integer :: i
+      why = ''
+      code = c_creation_errno(path//c_null_char)
+      if (code == 0) return
+      call c_errno_text(code, text, int(size(text), c_size_t))
+      do i = 1, size(text)
+         if (text(i) == c_null_char) exit
+         why = why//text(i)
+      end do
+   end function creation_error
 
    !> Remove a file if it exists.
    subroutine remove_file(path)

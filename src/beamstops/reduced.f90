@@ -63,7 +63,7 @@ module beamstops_reduced
       & dpotrf_message, dsygv_message
    implicit none
    private
-   public :: reduced_model_type, block_solver_type, build_reduced, prepare_reduced, validate_reduced
+   public :: reduced_model_type, block_solver_type, build_reduced, prepare_reduced, validate_reduced, reduce_model
    public :: check_stability_reduced, block_solve, reduced_stiffness_product, reduced_mass_product
    public :: reduced_matrices, expand, stop_unknowns, max_reduced_unknowns, reduced_damping_product, massless_solve
 
@@ -215,10 +215,29 @@ contains
       type(model_type) :: model
       call build_model(scene, model, error)
       if (allocated(error)) return
-      call build_reduced(scene, model, reduced, error)
-      if (allocated(error)) return
-      call check_stability_reduced(scene, reduced, source, error)
+      call reduce_model(scene, model, source, reduced, error)
    end subroutine prepare_reduced
+
+   !> The reduced model of a scene (modes > 0) from its full model, refused beyond its own linear
+   !> stability limit: the model a run of the scene steps (prepare_run, prepare_reduced).
+   subroutine reduce_model(scene, model, source, reduced, error)
+      !> Validated scene (modes > 0).
+      type(scene_type), intent(in) :: scene
+      !> Its full model (build_model).
+      type(model_type), intent(in) :: model
+      !> Where the scene came from, for messages.
+      character(len=*), intent(in) :: source
+      !> Reduced model built.
+      type(reduced_model_type), intent(out) :: reduced
+      !> Set when the reduced model cannot be built or dt exceeds its limit.
+      type(error_type), allocatable, intent(out) :: error
+      call build_reduced(scene, model, reduced, error)
+      if (allocated(error)) then
+         error%message = source//': '//error%message
+         return
+      end if
+      call check_stability_reduced(scene, reduced, source, error)
+   end subroutine reduce_model
 
    !> Build the reduced model of a scene (scene%modes = r >= 1) from its full model.
    subroutine build_reduced(scene, model, reduced, error, inverse_iteration)

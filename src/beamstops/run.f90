@@ -5,8 +5,9 @@
 !> recorder is flushed, then the loop's state is saved (beamstops_checkpoint): the recorder
 !> never sees the state, and a checkpoint never refers to records that are not stored.
 module beamstops_run
-   use beamstops_kinds, only: ik
+   use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
+   use beamstops_strings, only: fmt_int
    use beamstops_scene, only: scene_type, steps_of
    use beamstops_model, only: model_type, build_model, check_stability
    use beamstops_scheme, only: state_type, start_state, run_scheme
@@ -14,17 +15,32 @@ module beamstops_run
    use beamstops_checkpoint, only: write_checkpoint
    use beamstops_summary, only: run_summary, status_running, status_failed, status_complete
    use beamstops_ensemble, only: run_members
-   use beamstops_reduced, only: reduced_model_type, build_reduced, check_stability_reduced
+   use beamstops_reduced, only: reduced_model_type, reduce_model
    use beamstops_reduced_scheme, only: simulate_reduced, reduced_state_type, run_reduced
    use beamstops_reduced_checkpoint, only: write_reduced_checkpoint
    implicit none
    private
-   public :: prepare_run, simulate, continue_run, close_run, continue_reduced
+   public :: prepare_run, check_run, simulate, continue_run, close_run, continue_reduced
+   public :: run_limit_type, run_limit
+
+   !> The linear stability limit of the model a run steps: the full model, or with &mesh modes > 0
+   !> its reduced (Craig-Bampton) model, whose kappa is smaller.
+   type :: run_limit_type
+      !> Largest generalized eigenvalue of that model, with the compliance spring (1/s^2); 0 when
+      !> not computed (a reduced model with beta >= 1/4).
+      real(wp) :: kappa = 0
+      !> 2/sqrt((1 - 4 beta) kappa) for beta < 1/4, +Inf otherwise (s).
+      real(wp) :: dt_newmark = 0
+      !> Which model: 'full model' or 'reduced model of r modes'.
+      character(len=:), allocatable :: model
+   end type run_limit_type
 
 contains
 
-   !> Build the model of a scene and refuse an unstable explicit scheme.
-   subroutine prepare_run(scene, source, model, error)
+   !> Build the model of a scene and refuse an unstable explicit scheme (check_run): the one
+   !> preparation of `beamstops run`, `beamstops info` and the Python engine, so that all three
+   !> refuse the same scenes with the same message.
+   subroutine prepare_run(scene, source, model, error, reduced)
       !> Validated scene.
       type(scene_type), intent(in) :: scene
       !> Where the scene came from, for messages.
@@ -33,20 +49,63 @@ contains
       type(model_type), intent(out) :: model
       !> Set when the scene cannot run.
       type(error_type), allocatable, intent(out) :: error
+      !> With &mesh modes > 0, the reduced model the run steps (built and checked either way).
+      type(reduced_model_type), intent(out), optional :: reduced
       call build_model(scene, model, error)
       if (allocated(error)) then
          ! the model's messages name group and key; the file is named here, as the reader does
          error%message = source//': '//error%message
          return
       end if
-      ! A reduced model (modes > 0) has its own spectrum: simulate checks it.
-      if (scene%modes == 0) call check_stability(scene, model, source, error)
+      call check_run(scene, source, model, error, reduced)
    end subroutine prepare_run
+
+   !> Refuse a scene whose time step exceeds the linear stability limit (beta < 1/4, unless
+   !> allow_unstable) of the model its run steps: the full model (check_stability), or with
+   !> &mesh modes > 0 the reduced model, built here from `model` (reduce_model).
+   subroutine check_run(scene, source, model, error, reduced)
+      !> Validated scene.
+      type(scene_type), intent(in) :: scene
+      !> Where the scene came from, for messages.
+      character(len=*), intent(in) :: source
+      !> Its full model (build_model).
+      type(model_type), intent(in) :: model
+      !> Set when the scene cannot run.
+      type(error_type), allocatable, intent(out) :: error
+      !> With &mesh modes > 0, the reduced model the run steps.
+      type(reduced_model_type), intent(out), optional :: reduced
+      type(reduced_model_type) :: built
+      if (scene%modes == 0) then
+         call check_stability(scene, model, source, error)
+      else if (present(reduced)) then
+         call reduce_model(scene, model, source, reduced, error)
+      else
+         call reduce_model(scene, model, source, built, error)
+      end if
+   end subroutine check_run
+
+   !> The linear stability limit check_run applies: the full model's, or with &mesh modes > 0 that
+   !> of `reduced` (from prepare_run or check_run).
+   function run_limit(scene, model, reduced) result(limit)
+      !> Validated scene.
+      type(scene_type), intent(in) :: scene
+      !> Its full model.
+      type(model_type), intent(in) :: model
+      !> Its reduced model (used only with &mesh modes > 0).
+      type(reduced_model_type), intent(in) :: reduced
+      type(run_limit_type) :: limit
+      if (scene%modes == 0) then
+         limit = run_limit_type(model%kappa_contact, model%dt_newmark, 'full model')
+      else
+         limit = run_limit_type(reduced%kappa, reduced%dt_newmark, 'reduced model of '// &
+            & fmt_int(int(reduced%r, ik))//' modes')
+      end if
+   end function run_limit
 
    !> Run a prepared scene from t = 0 to t_end, feeding `recorder` (no checkpoints); a scene with
    !> &mesh modes > 0 runs its reduced (Craig-Bampton) model. A recorder
    !> that cannot write ends the run with status 'failed' and its message in the summary.
-   subroutine simulate(scene, model, recorder, summary, error)
+   subroutine simulate(scene, model, recorder, summary, error, reduced)
       !> Validated scene.
       type(scene_type), intent(in) :: scene
       !> Its model (from prepare_run).
@@ -57,15 +116,19 @@ contains
       type(run_summary), intent(out) :: summary
       !> Set when the run cannot start.
       type(error_type), allocatable, intent(out) :: error
+      !> With &mesh modes > 0, its reduced model (from prepare_run; built here when absent).
+      type(reduced_model_type), intent(in), optional :: reduced
       type(state_type) :: state
       type(error_type), allocatable :: write_error
-      type(reduced_model_type) :: reduced
+      type(reduced_model_type) :: built
       if (scene%modes > 0) then
-         call build_reduced(scene, model, reduced, error)
+         if (present(reduced)) then
+            call simulate_reduced(scene, reduced, recorder, summary, error)
+            return
+         end if
+         call reduce_model(scene, model, 'scene', built, error)
          if (allocated(error)) return
-         call check_stability_reduced(scene, reduced, 'scene', error)
-         if (allocated(error)) return
-         call simulate_reduced(scene, reduced, recorder, summary, error)
+         call simulate_reduced(scene, built, recorder, summary, error)
          return
       end if
       call start_state(scene, model, state, recorder, error)

@@ -10,7 +10,8 @@ module test_reduced
    use testing
    use test_support, only: run_recorded, band_eigenvalues, dense_eigenvalues, solve_spd, int_text, tube, balance_defect
    use beamstops, only: ik, scene_type, array_recorder, run_summary, law_none, law_signorini, law_compliance, &
-      & validate_scene, record_count, stop_count, status_complete, model_type, build_model, prepare_run, simulate
+      & validate_scene, record_count, stop_count, status_complete, model_type, build_model, prepare_run, simulate, &
+      & run_limit_type, run_limit
    use beamstops_band, only: cholesky_factor, cholesky_solve, band_to_dense
    use beamstops_forcing, only: load_average
    use beamstops_reduced, only: reduced_model_type, prepare_reduced, build_reduced, validate_reduced, &
@@ -45,6 +46,7 @@ contains
          & new_unittest('modes by inverse iteration (the default) and by dsbgvx: the same reduced runs', test_inverse_iteration), &
          & new_unittest('snapshots: u = T q at the nodes, the full run''s with all modes', test_snapshots), &
          & new_unittest('&mesh modes: range checks with messages', test_validate), &
+         & new_unittest('prepare_run: beta < 1/4 against the limit of the reduced model the run steps', test_run_limit), &
          & new_unittest('one element, its one interior unknown as the mode: the full engine', test_one_element) &
          & ]
    end subroutine collect_reduced
@@ -718,6 +720,65 @@ contains
       call note(error%message)
       deallocate (error)
    end subroutine test_validate
+
+   !> prepare_run (the preparation of `beamstops run`, `info` and the Python engine) applies the
+   !> linear stability limit of the model the run steps: with &mesh modes = 4 and beta = 0 the
+   !> reduced model's (1.3e-3 s for the paper's beam), not the full model's (1.24e-5 s), and
+   !> run_limit reports that limit and names that model.
+   subroutine test_run_limit(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(model_type) :: model
+      type(reduced_model_type) :: reduced
+      type(run_limit_type) :: limit
+      character(len=:), allocatable :: message
+      character(len=*), parameter :: expected = 'in.nml: &time dt = 0.01 is out of range; allowed: dt < 0.00129667 s'
+      scene%beta = 0
+      scene%t_end = 0.05_wp
+      scene%modes = 4
+      scene%dt = 1e-3_wp
+      call validate_scene(scene, 'in.nml', error)
+      if (allocated(error)) return
+      call prepare_run(scene, 'in.nml', model, error, reduced)
+      call check(error, .not. allocated(error), 'dt = 1e-3 beyond the full limit, within the reduced: accepted')
+      if (allocated(error)) return
+      limit = run_limit(scene, model, reduced)
+      call check(error, limit%dt_newmark, 2/sqrt(reduced%kappa), 'the limit of the reduced model', rel=.true., &
+         & thr=1e-15_wp)
+      if (allocated(error)) return
+      call check(error, limit%dt_newmark > 1e-3_wp .and. model%dt_newmark < 2e-5_wp, 'the reduced limit '// &
+         & real_text(limit%dt_newmark)//' s above dt, the full '//real_text(model%dt_newmark)//' s below')
+      if (allocated(error)) return
+      call check(error, limit%model == 'reduced model of 4 modes', 'the model named: '//limit%model)
+      if (allocated(error)) return
+      scene%dt = 1e-2_wp
+      message = refusal(scene)
+      call check(error, index(message, expected) == 1 .and. index(message, 'reduced model with modes = 4') > 0, &
+         & 'dt = 1e-2, beyond the reduced limit: refused with "'//expected//' ... reduced model with modes = 4 ...", '// &
+         & 'got "'//message//'"')
+      if (allocated(error)) return
+      scene%modes = 0
+      scene%dt = 1e-3_wp
+      call check(error, len(refusal(scene)) > 0, 'the full model at dt = 1e-3 refused')
+      if (allocated(error)) return
+      call build_model(scene, model, error)
+      if (allocated(error)) return
+      limit = run_limit(scene, model, reduced)
+      call check(error, limit%dt_newmark, model%dt_newmark, 'the full model''s limit')
+      if (allocated(error)) return
+      call check(error, limit%model == 'full model', 'the model named: '//limit%model)
+   end subroutine test_run_limit
+
+   !> prepare_run's message for a scene ('' when it accepts it).
+   function refusal(scene) result(message)
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: message
+      type(model_type) :: model
+      type(error_type), allocatable :: error
+      message = ''
+      call prepare_run(scene, 'in.nml', model, error)
+      if (allocated(error)) message = error%message
+   end function refusal
 
    !> One element with tip stops leaves one interior unknown (the tip's slope), fewer than the
    !> band's half-bandwidth: the fixed-interface mode is still found (LAPACK's band eigensolver

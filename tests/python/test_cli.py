@@ -166,7 +166,10 @@ def test_unwritable_output_exits_4(tmp_path: Path) -> None:
     scene = write(tmp_path, SHORT)
     done = beamstops("run", scene, "-o", tmp_path / "no" / "such" / "dir.h5", cwd=tmp_path)
     assert done.returncode == 4
-    assert "dir.h5" in done.stderr
+    # the output, where its name came from, and the system's reason (not a guess)
+    assert one_error_line(done) == (f"beamstops: error: {tmp_path}/no/such/dir.h5 (-o): cannot create "
+                                    f"{tmp_path}/no/such/dir.h5.partial, where the run writes until it is done: "
+                                    "No such file or directory")
 
 
 # ---------------------------------------------------------------- no input can destroy data (issue 11)
@@ -201,7 +204,7 @@ def test_output_that_is_the_input_is_refused(spelling: str, tmp_path: Path) -> N
     done = beamstops("run", "scene.nml", "-o", out, cwd=tmp_path)
     assert done.returncode == 4
     line = one_error_line(done)
-    assert line.startswith(f"beamstops: error: {out}: ") and "input" in line
+    assert line.startswith(f"beamstops: error: {out} (-o): ") and "input" in line
     assert scene.read_bytes() == text
     assert not list(tmp_path.glob("*.partial"))
 
@@ -236,7 +239,7 @@ def test_existing_file_that_is_not_an_output_is_refused(kind: str, tmp_path: Pat
     done = beamstops("run", scene, "-o", target.name, cwd=tmp_path)
     assert done.returncode == 4
     line = one_error_line(done)
-    assert line.startswith(f"beamstops: error: {target.name}: ") and why in line
+    assert line.startswith(f"beamstops: error: {target.name} (-o): ") and why in line
     if before is not None:
         assert target.read_bytes() == before
     assert not list(tmp_path.glob("*.partial")) and not list(tmp_path.glob("*.checkpoint"))
@@ -249,7 +252,7 @@ def test_foreign_file_at_the_partial_or_checkpoint_name_is_refused(suffix: str, 
     mine.write_text("not HDF5\n")
     done = beamstops("run", scene, "-o", "out.h5", cwd=tmp_path)
     assert done.returncode == 4
-    assert one_error_line(done).startswith(f"beamstops: error: out.h5{suffix}: ")
+    assert one_error_line(done).startswith(f"beamstops: error: out.h5 (-o): out.h5{suffix}, where the run ")
     assert mine.read_text() == "not HDF5\n" and not (tmp_path / "out.h5").exists()
 
 
@@ -320,7 +323,8 @@ def test_unwritable_folder_exits_4_and_writes_nothing(tmp_path: Path) -> None:
                               text=True, timeout=120, preexec_fn=preexec)
         assert done.returncode == 4, done.stderr
         line = one_error_line(done)
-        assert line.startswith("beamstops: error: locked/out.h5: ") and "locked/out.h5.partial" in line
+        assert line == ("beamstops: error: locked/out.h5 (-o): cannot create locked/out.h5.partial, where the run "
+                        "writes until it is done: Permission denied")
         assert list(locked.iterdir()) == []
     finally:
         shutil.rmtree(base, ignore_errors=True)
@@ -400,7 +404,8 @@ def test_python_subcommands_run_from_the_program(tmp_path: Path) -> None:
     done = beamstops("plot", "missing.h5", cwd=tmp_path)
     assert done.returncode == 1 and done.stderr.startswith("beamstops: error: missing.h5")
     done = beamstops("plot", cwd=tmp_path)
-    assert done.returncode == 2 and "usage: beamstops plot" in done.stderr
+    assert done.returncode == 2 and done.stderr == ("beamstops plot: error: the following arguments are required: "
+                                                    "file (beamstops plot --help: the options)\n")
     for name in ["sweep", "converge", "work-precision", "stability-map", "compliance"]:
         done = beamstops(name, "--help", cwd=tmp_path)
         assert done.returncode == 0 and f"usage: beamstops {name}" in done.stdout, (name, done.stderr)
@@ -628,3 +633,147 @@ def test_a_pipe_beyond_64_mb_and_a_file_beyond_4_gib_are_refused_with_their_size
         f.truncate(5 * 2**30)
     line = one_error_line(beamstops("info", big, cwd=tmp_path))
     assert "big.nml: 5368709120 bytes; allowed: a namelist file of at most 64 MB" in line
+# ---------------------------------------------------------------- info and run: one check (audit P6)
+
+
+def test_info_applies_the_check_of_run_with_the_limit_of_the_reduced_model(tmp_path: Path) -> None:
+    # beta = 0 with &mesh modes = 4: the run steps the reduced model, whose limit is 1.30e-3 s (the
+    # full model's, 1.24e-5 s, does not apply); info refuses what run refuses, with its message
+    unstable = write(tmp_path, "&time dt=1e-2, t_end=0.05, beta=0 /\n&mesh modes=4 /\n", "unstable.nml")
+    info, run = beamstops("info", unstable.name, cwd=tmp_path), beamstops("run", unstable.name, cwd=tmp_path)
+    assert info.returncode == run.returncode == 1 and info.stdout == ""
+    line = one_error_line(info)
+    assert line == one_error_line(run)
+    assert line.startswith("beamstops: error: unstable.nml: &time dt = 0.01 is out of range; allowed: dt < 0.00129667 s")
+    assert "of the reduced model with modes = 4" in line
+    # within the reduced model's limit, beyond the full model's: both accept, info shows the limit that applies
+    stable = write(tmp_path, "&time dt=1e-3, t_end=0.05, beta=0 /\n&mesh modes=4 /\n", "stable.nml")
+    info = beamstops("info", stable, cwd=tmp_path)
+    assert info.returncode == 0, info.stderr
+    shown = {line[:29].strip(): line[29:] for line in info.stdout.splitlines()}
+    limit = shown["dt limit Newmark"].split()
+    assert float(limit[0]) == pytest.approx(1.296673e-3, rel=1e-6) and "of the reduced model of 4 modes" in shown[
+        "dt limit Newmark"]
+    assert float(shown["kappa of the run"].split()[0]) == pytest.approx(2.379027e6, rel=1e-6)
+    assert beamstops("run", stable, cwd=tmp_path).returncode == 0
+    # the full model: its own limit, named as such
+    full = write(tmp_path, "&time dt=1e-6, t_end=0.001, beta=0 /\n", "full.nml")
+    shown = {line[:29].strip(): line[29:] for line in beamstops("info", full, cwd=tmp_path).stdout.splitlines()}
+    assert float(shown["dt limit Newmark"].split()[0]) == pytest.approx(1.239506e-5, rel=1e-6)
+    assert "of the full model" in shown["dt limit Newmark"] and "kappa of the run" not in shown
+
+
+def test_several_scenes_refuse_a_reduced_scene_beyond_its_limit_before_any_runs(tmp_path: Path) -> None:
+    good = write(tmp_path, SHORT, "good.nml")
+    bad = write(tmp_path, "&time dt=1e-2, t_end=0.05, beta=0 /\n&mesh modes=4 /\n", "bad.nml")
+    done = beamstops("run", good, bad, cwd=tmp_path)
+    assert done.returncode == 1
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 2 and "bad.nml: &time dt = 0.01 is out of range" in lines[0], done.stderr
+    assert lines[1] == "beamstops: none of the 2 scenes was run"
+    assert not list(tmp_path.glob("*.h5*"))
+
+
+# ---------------------------------------------------------------- output paths: origin and the system's reason (audit P10)
+
+
+def test_a_name_too_long_is_refused_with_the_systems_reason(tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT)
+    name = "a" * 300 + ".h5"
+    line = one_error_line(done := beamstops("run", scene, "-o", name, cwd=tmp_path))
+    assert done.returncode == 4
+    assert line == (f"beamstops: error: {name} (-o): cannot create {name}.partial, where the run writes until it is "
+                    "done: File name too long")
+    # the partial file fits the limit of 255 bytes, the checkpoint's temporary file does not: refused before the
+    # run when checkpoints are asked for, not at the first checkpoint
+    name = "b" * 243 + ".h5"
+    scene = write(tmp_path, SHORT + "&output checkpoint_every=1000 /\n")
+    line = one_error_line(done := beamstops("run", scene, "-o", name, cwd=tmp_path))
+    assert done.returncode == 4 and line.endswith(
+        f"cannot create {name}.checkpoint.tmp, where the run saves its checkpoints (&output checkpoint_every): "
+        "File name too long")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.nml"]
+
+
+def test_an_output_name_ending_in_a_slash_is_refused_naming_the_namelist(tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT + "&output file='out.h5/' /\n").name
+    done = beamstops("run", scene, cwd=tmp_path)
+    assert done.returncode == 4
+    assert one_error_line(done) == ("beamstops: error: out.h5/ (&output file of scene.nml): ends with /, the name of "
+                                    "a folder, not of a file; allowed: the name of the HDF5 file to write, e.g. out.h5")
+    (tmp_path / "out.h5").mkdir()  # an existing folder too
+    assert one_error_line(beamstops("run", scene, cwd=tmp_path)).startswith(
+        "beamstops: error: out.h5/ (&output file of scene.nml): ends with /")
+    # a name from -o; and the default, the input's name with .h5, says so
+    line = one_error_line(beamstops("run", scene, "-o", "x/", cwd=tmp_path))
+    assert line.startswith("beamstops: error: x/ (-o): ends with /") and line.endswith("e.g. x")
+    (tmp_path / "scene.h5").write_text("notes\n")
+    line = one_error_line(beamstops("run", write(tmp_path, SHORT).name, cwd=tmp_path))
+    assert line.startswith("beamstops: error: scene.h5 (&output file of scene.nml, by default the input's name "
+                           "with .h5): exists and is not a beamstops output")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.h5", "scene.h5", "scene.nml"]
+
+
+def test_several_scenes_refuse_an_output_the_system_refuses_before_any_runs(tmp_path: Path) -> None:
+    write(tmp_path, SHORT, "good.nml")
+    write(tmp_path, SHORT + "&output file='missing/bad.h5' /\n", "bad.nml")
+    done = beamstops("run", "good.nml", "bad.nml", cwd=tmp_path)
+    assert done.returncode == 4
+    assert done.stderr.splitlines() == [
+        "beamstops: error: missing/bad.h5 (&output file of bad.nml): cannot create missing/bad.h5.partial, where the "
+        "run writes until it is done: No such file or directory", "beamstops: none of the 2 scenes was run"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.nml", "good.nml"]
+
+
+def test_standard_output_is_refused_as_an_output(tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT)
+    done = beamstops("run", scene, "-o", "-", cwd=tmp_path)
+    lines = done.stderr.strip().splitlines()
+    assert done.returncode == 2 and len(lines) == 1 and lines[0].startswith(
+        "beamstops: '-o -': beamstops cannot write its output to standard output"), done.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.nml"]
+    # a file named - is still possible, spelt as a path
+    assert beamstops("run", scene, "-o", "./-", cwd=tmp_path).returncode == 0 and (tmp_path / "-").is_file()
+
+
+# ---------------------------------------------------------------- repeated or unexpected arguments
+
+
+@pytest.mark.parametrize(("args", "needle"), [
+    (["run", "scene.nml", "--restart", "--restart"], "'--restart' is given twice; allowed: once"),
+    (["--version", "junk"], "unexpected argument 'junk' after '--version', which takes none"),
+    (["-V", "junk"], "unexpected argument 'junk' after '-V', which takes none"),
+    (["--help", "run"], "unexpected argument 'run' after '--help', which takes none"),
+])
+def test_repeated_or_unexpected_arguments_are_refused(args: list[str], needle: str, tmp_path: Path) -> None:
+    write(tmp_path, SHORT)
+    done = beamstops(*args, cwd=tmp_path)
+    lines = done.stderr.strip().splitlines()
+    assert done.returncode == 2 and len(lines) == 1 and needle in lines[0], done.stderr
+    assert done.stdout == "" and sorted(p.name for p in tmp_path.iterdir()) == ["scene.nml"]
+
+
+# ---------------------------------------------------------------- numbers of any exponent
+
+
+def test_numbers_with_three_digit_exponents_are_printed_with_their_e(tmp_path: Path) -> None:
+    import re
+
+    # a support amplitude of 1e-60 m: the support's work is of order 1e-120 J
+    text = "&time dt=1e-5, t_end=1e-4 /\n&support amplitude=1e-60 /\n"
+    done = beamstops("run", write(tmp_path, text), cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    info = beamstops("info", write(tmp_path, text + "&stops lower=-1e-120, upper=1e-120 /\n", "tiny.nml"),
+                     cwd=tmp_path)
+    assert info.returncode == 0, info.stderr
+    for shown_text in (done.stdout, info.stdout):
+        # a mantissa followed by a signed exponent without its e (gfortran's ES of |exponent| > 99)
+        assert not re.search(r"\d[-+]\d{3}\b", shown_text), shown_text
+    work = re.search(r"support work (\S+),", done.stdout)
+    assert work is not None, done.stdout
+    shown = {line[:29].strip(): line[29:].split() for line in info.stdout.splitlines()}
+    assert float(shown["&support amplitude"][0]) == 1e-60 and float(shown["&stops lower"][0]) == -1e-120
+    with h5py.File(tmp_path / "scene.h5") as f:  # the summary's number is the file's, to its 4 digits
+        assert 0 < abs(f.attrs["work"]) < 1e-99
+        assert float(work.group(1)) == pytest.approx(f.attrs["work"], rel=1e-3)
+        assert "amplitude = 1e-60" in f.attrs["scene"].decode() and f.attrs["amplitude"] == 1e-60

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from beamstops.sweep import load_spec, read_summary, run_sweep
-from beamstops.sweep.runner import batches
+from beamstops.sweep.runner import batches, prepare_folder
 
 #: Root attributes that differ from one run of the same scene to the next.
 TIMING_ATTRS = ("cpu_seconds",)
@@ -175,8 +175,8 @@ def test_a_sweep_in_lockstep_batches_gives_the_results_of_one_point_at_a_time(
 
 def test_a_batch_refused_as_a_whole_runs_its_points_alone(tmp_path: Path, write_spec: Callable[..., Path],
                                                           program: str) -> None:
-    # beta = 0 at this dt is beyond the explicit scheme's stability limit: the engine refuses
-    # that point, hence the batch's `beamstops run` as a whole; the others then run alone.
+    # a folder is where point 1 would write its partial output: the program refuses the batch's
+    # `beamstops run` as a whole (it checks every output first); the others then run alone.
     spec = load_spec(write_spec("""
 [sweep]
 lockstep = 4
@@ -185,12 +185,14 @@ elements = 6
 dt = 2e-4
 t_end = 0.1
 [axes]
-beta = [0.5, 0.0, 0.25, 0.5]
+beta = [0.5, 0.3, 0.25, 0.5]
 """))
+    prepare_folder(spec, tmp_path / "out", program)
+    (tmp_path / "out" / "points" / "00001.h5.partial").mkdir()
     outcome = run_sweep(spec, tmp_path / "out", jobs=1, stream=None, program=program)
     rows = read_summary(tmp_path / "out")
     assert [r["status"] for r in rows] == ["complete", "failed", "complete", "complete"]
-    assert "beta" in rows[1]["message"] or "stab" in rows[1]["message"]
+    assert "00001.h5.partial" in rows[1]["message"] and "a folder" in rows[1]["message"]
     assert (outcome.complete, outcome.failed) == (3, 1)
 
 

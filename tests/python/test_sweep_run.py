@@ -19,6 +19,7 @@ import pytest
 
 import beamstops
 from beamstops.sweep import load_spec, read_summary, run_sweep
+from beamstops.sweep.runner import prepare_folder
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -75,22 +76,27 @@ def test_every_point_writes_its_file_and_the_summary_gathers_them(tmp_path: Path
     assert {"max_violation", "dissipated", "strobe", "strobe_offset", "strobe_period", "v_rms", "message"} <= set(header)
 
 
-def test_a_failed_point_is_recorded_and_the_sweep_goes_on(tmp_path: Path, write_spec: Callable[..., Path]) -> None:
+def test_a_failed_point_is_recorded_and_the_sweep_goes_on(tmp_path: Path, write_spec: Callable[..., Path],
+                                                          program: str) -> None:
     spec = load_spec(write_spec("""
 [scene]
 elements = 4
 t_end = 0.05
 beta = 0.0
 [axes]
-dt = [1e-4, 1e-3, 2e-5]
+dt = [1e-4, 2e-5, 5e-5]
 """))
-    outcome = run_sweep(spec, tmp_path / "out", jobs=2, stream=None)
+    # a folder is where point 1 would write its partial output: the program refuses to run it
+    prepare_folder(spec, tmp_path / "out", program)
+    (tmp_path / "out" / "points" / "00001.h5.partial").mkdir()
+    outcome = run_sweep(spec, tmp_path / "out", jobs=2, stream=None, program=program)
     assert (outcome.complete, outcome.failed) == (2, 1)
     rows = read_summary(tmp_path / "out")
     assert [r["status"] for r in rows] == ["complete", "failed", "complete"]
-    assert "dt" in rows[1]["message"] and "beamstops" in rows[1]["message"]  # the program's one-line message
+    assert "00001.h5.partial" in rows[1]["message"] and "a folder" in rows[1]["message"]  # the program's line
+    assert (tmp_path / "out" / "points" / "00001.h5.partial").is_dir()
     # a failed point runs again on the next call; finished ones do not
-    again = run_sweep(spec, tmp_path / "out", jobs=2, stream=None)
+    again = run_sweep(spec, tmp_path / "out", jobs=2, stream=None, program=program)
     assert (again.ran, again.skipped, again.failed) == (1, 2, 1)
 
 
@@ -393,6 +399,9 @@ dt = 1e-3
 [axes]
 omega = [5, 10]
 """
+STABLE = UNSTABLE.replace("beta = 0", "elements = 4").replace("1e-3", "1e-4")
+#: Points that do not complete: 1e9 steps each, over their time limit.
+SLOW = "[sweep]\ntimeout = 0.3\n" + STABLE.replace("t_end = 0.01", "t_end = 1e5\nrecord_every = 1000000")
 
 
 def sweep_command(*args: str | Path, cwd: Path) -> subprocess.CompletedProcess[str]:
@@ -401,7 +410,7 @@ def sweep_command(*args: str | Path, cwd: Path) -> subprocess.CompletedProcess[s
 
 
 def test_a_sweep_with_failed_points_exits_3_and_says_so(tmp_path: Path, write_spec: Callable[..., Path]) -> None:
-    spec = write_spec(UNSTABLE)
+    spec = write_spec(SLOW)
     done = sweep_command(spec, "-o", tmp_path / "out", "-j", "2", cwd=tmp_path)
     assert done.returncode == 3, done.stderr
     last = done.stderr.strip().splitlines()[-1]
@@ -424,8 +433,7 @@ def test_a_sweep_with_a_diverged_point_exits_3(tmp_path: Path, write_spec: Calla
 
 
 def test_a_sweep_whose_points_all_complete_exits_0(tmp_path: Path, write_spec: Callable[..., Path]) -> None:
-    done = sweep_command(write_spec(UNSTABLE.replace("beta = 0", "elements = 4").replace("1e-3", "1e-4")),
-                         "-o", tmp_path / "out", "-j", "2", cwd=tmp_path)
+    done = sweep_command(write_spec(STABLE), "-o", tmp_path / "out", "-j", "2", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert "2 complete, 0 diverged, 0 failed" in done.stderr and "error" not in done.stderr
 
@@ -434,10 +442,10 @@ def test_a_sweep_whose_points_all_complete_exits_0(tmp_path: Path, write_spec: C
                                            ("--interval", "-5"), ("--interval", "0")])
 def test_non_positive_timeout_and_interval_are_refused(option: str, value: str, tmp_path: Path,
                                                        write_spec: Callable[..., Path]) -> None:
-    done = sweep_command(write_spec(UNSTABLE), "-o", tmp_path / "out", option, value, cwd=tmp_path)
+    done = sweep_command(write_spec(STABLE), "-o", tmp_path / "out", option, value, cwd=tmp_path)
     assert done.returncode == 2
-    last = done.stderr.strip().splitlines()[-1]
-    assert f"argument {option}: '{value}': allowed: a number of seconds > 0" in last
+    assert done.stderr == (f"python -m beamstops sweep: error: argument {option}: '{value}': allowed: a number of "
+                           "seconds > 0 (python -m beamstops sweep --help: the options)\n")
     assert not (tmp_path / "out").exists()
 
 
@@ -446,11 +454,57 @@ def test_fewer_than_one_worker_is_refused_before_the_folder_is_made(value: str, 
                                                                     write_spec: Callable[..., Path]) -> None:
     """-j 0 was refused only after the folder, its summary (every point 'pending') and its
     specification were written."""
-    done = sweep_command(write_spec(UNSTABLE), "-o", tmp_path / "out", "-j", value, cwd=tmp_path)
+    done = sweep_command(write_spec(STABLE), "-o", tmp_path / "out", "-j", value, cwd=tmp_path)
     assert done.returncode == 2
-    assert f"argument -j/--jobs: '{value}': allowed: a whole number of worker processes >= 1" in \
-        done.stderr.strip().splitlines()[-1]
+    assert done.stderr.splitlines() == [f"python -m beamstops sweep: error: argument -j/--jobs: '{value}': allowed: "
+                                        "a whole number of worker processes >= 1 (python -m beamstops sweep --help: "
+                                        "the options)"]
     assert not (tmp_path / "out").exists()
     with pytest.raises(ValueError, match="-j 0: the number of workers must be >= 1"):
-        run_sweep(load_spec(write_spec(UNSTABLE)), tmp_path / "api", jobs=0)
+        run_sweep(load_spec(write_spec(STABLE)), tmp_path / "api", jobs=0)
     assert not (tmp_path / "api").exists()
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["-j", "0"], "argument -j/--jobs: '0': allowed: a whole number of worker processes >= 1"),
+    (["--timeout", "-1"], "argument --timeout: '-1': allowed: a number of seconds > 0"),
+    (["--interval", "inf"], "argument --interval: 'inf': allowed: a number of seconds > 0"),
+    (["--executor", "cloud"], "argument --executor: invalid choice: 'cloud' (choose from 'auto', 'local', 'mpi')"),
+    (["--jobs"], "argument -j/--jobs: expected one argument"),
+    (["--fast"], "unrecognized arguments: --fast"),
+])
+def test_a_bad_command_line_value_is_one_line_from_the_program(args: list[str], message: str, tmp_path: Path,
+                                                              write_spec: Callable[..., Path], program: str) -> None:
+    """`beamstops sweep` (the program hands the command to Python): one line naming the option and what
+    it allows, exit status 2, nothing written (argparse printed its usage block first: six lines)."""
+    done = subprocess.run([program, "sweep", str(write_spec(STABLE)), "-o", str(tmp_path / "out"), *args],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2
+    assert done.stderr == f"beamstops sweep: error: {message} (beamstops sweep --help: the options)\n"
+    assert done.stdout == "" and not (tmp_path / "out").exists()
+
+
+def test_a_point_the_engine_refuses_refuses_the_specification_before_anything_is_written(
+        tmp_path: Path, write_spec: Callable[..., Path], program: str) -> None:
+    """beta = 0 beyond its stability limit, found by the engine's own check of `beamstops run` (as
+    elements = 0 is found by its reader): exit status 1, the engine's message, no folder."""
+    done = subprocess.run([program, "sweep", str(write_spec(UNSTABLE)), "-o", str(tmp_path / "out")],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 1
+    lines = done.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(
+        f"beamstops: error: {tmp_path / 'spec.toml'}: point 0 (omega=5): scene: &time dt = 0.001 is out of range; "
+        "allowed: dt < 1.23951e-05 s, the linear stability limit"), done.stderr
+    assert not (tmp_path / "out").exists()
+    # the limit is that of the model the point runs: a reduced model's (&mesh modes = 4) is 1.3e-3 s
+    reduced = UNSTABLE.replace("beta = 0", "beta = 0\nmodes = 4")
+    spec = load_spec(write_spec(reduced, "reduced.toml"))
+    assert len(spec.points) == 2
+    with pytest.raises(ValueError) as refused:
+        load_spec(write_spec(reduced.replace("dt = 1e-3", "dt = 1e-2"), "too_long.toml"))
+    assert "point 0 (omega=5): scene: &time dt = 0.01 is out of range; allowed: dt < 0.00129667 s" in str(refused.value)
+    assert "of the reduced model with modes = 4" in str(refused.value)
+    # beamstops.stability says which limit the engine applies, and of which model
+    limits = beamstops.stability(spec.points[0].scene)
+    assert limits.runnable and limits.run_model == "reduced model of 4 modes"
+    assert limits.dt_limit_run == pytest.approx(1.296673e-3, rel=1e-6) and limits.dt_limit_newmark < 2e-5

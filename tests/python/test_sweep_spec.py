@@ -197,13 +197,19 @@ def test_command_line_in_a_fresh_process_has_no_traceback(tmp_path: Path, write_
     assert "[scene] elements = 'many': not an integer" in done.stderr
 
 
-def test_dry_run_lists_points_and_flags_refused_ones(capsys: pytest.CaptureFixture[str],
-                                                     write_spec: Callable[..., Path]) -> None:
-    # a point beyond the stability limit of beta = 0 would be refused by the program: flagged
-    path = write_spec("[scene]\nt_end = 0.1\nbeta = 0.0\nelements = 4\n[axes]\ndt = [1e-4, 1e-3]\n")
+def test_dry_run_lists_points_and_refuses_a_point_the_engine_refuses(capsys: pytest.CaptureFixture[str],
+                                                                     write_spec: Callable[..., Path]) -> None:
+    path = write_spec("[scene]\nt_end = 0.1\nbeta = 0.0\nelements = 4\n[axes]\ndt = [1e-4, 2e-4]\n")
     assert cli.main(["sweep", str(path), "--dry-run"]) == 0
     out = capsys.readouterr().out
-    assert "2 points" in out and "00001: dt=0.001" in out and "REFUSED" in out
+    assert "2 points" in out and "00001: dt=0.0002" in out
+    # a point beyond the stability limit of beta = 0, which the program would refuse: the engine's check
+    # refuses the specification, as its reader does a value out of range
+    path = write_spec("[scene]\nt_end = 0.1\nbeta = 0.0\nelements = 4\n[axes]\ndt = [1e-4, 1e-3]\n")
+    assert cli.main(["sweep", str(path), "--dry-run"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"beamstops: error: {path}: point 1 (dt=0.001): scene: &time dt = 0.001 is out of range; "
+                          "allowed: dt < ") and "stability limit" in err and len(err.splitlines()) == 1
     # a point with a value out of range: the engine's reader refuses the specification at once
     path = write_spec("[scene]\nt_end = 0.1\n[axes]\ndt = [1e-4, 0.5]\n")
     assert cli.main(["sweep", str(path), "--dry-run"]) == 1

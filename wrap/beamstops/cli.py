@@ -19,7 +19,7 @@ import sys
 from pathlib import Path
 from typing import Callable, Optional, Sequence
 
-from .arguments import MAX_DPI, number, whole
+from .arguments import MAX_DPI, OneLineParser, number, whole
 
 
 def _plot(args: argparse.Namespace) -> int:
@@ -96,8 +96,7 @@ COMMANDS.append(register_plan)
 def build_parser(prog: str = "python -m beamstops") -> argparse.ArgumentParser:
     from . import version
 
-    parser = argparse.ArgumentParser(prog=prog,
-                                     description="beamstops: a beam on a vibrating support between rigid stops.")
+    parser = OneLineParser(prog=prog, description="beamstops: a beam on a vibrating support between rigid stops.")
     parser.add_argument("-V", "--version", action="version", version=f"beamstops {version()}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for register in COMMANDS:
@@ -105,11 +104,13 @@ def build_parser(prog: str = "python -m beamstops") -> argparse.ArgumentParser:
     return parser
 
 
+def _subcommands(parser: argparse.ArgumentParser) -> argparse._SubParsersAction:
+    return next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+
+
 def commands() -> dict[str, str]:
     """The subcommands and their one-line help, in the order ``--help`` lists them."""
-    parser = build_parser()
-    action = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
-    return {choice.dest: choice.help or "" for choice in action._choices_actions}
+    return {choice.dest: choice.help or "" for choice in _subcommands(build_parser())._choices_actions}
 
 
 def quiet_font_lookup() -> None:
@@ -125,7 +126,10 @@ def quiet_font_lookup() -> None:
 def main(argv: Optional[Sequence[str]] = None, prog: str = "python -m beamstops") -> int:
     """Run a subcommand; ``prog`` names the command in messages (``beamstops`` when the
     program hands a subcommand on)."""
-    args = build_parser(prog).parse_args(argv)
+    parser = build_parser(prog)
+    args, extra = parser.parse_known_args(argv)
+    if extra:  # the subcommand's parser says so, in its name ("beamstops sweep: error: ...")
+        _subcommands(parser).choices[args.command].error(f"unrecognized arguments: {' '.join(extra)}")
     quiet_font_lookup()
     try:
         return int(args.handler(args))

@@ -75,12 +75,12 @@ def canonical(text: str, source: str = "scene", carried: Iterable[str] = ()) -> 
 
 
 def validate(scene: Scene, source: str = "scene") -> None:
-    """Whether the program would run the scene: its text read again with messages starting with
-    ``source``, and its time step against the stability limit (ValueError when refused)."""
-    canonical(_scene_text(scene).decode("utf-8"), source)
-    refusal = stability(scene).refusal
+    """Whether the program would run the scene (ValueError with the engine's message when not): the
+    engine's reader and the check of ``beamstops run`` (the time step against the stability limit
+    of the model the run steps), messages starting with ``source``."""
+    refusal = stability(scene, source).refusal
     if refusal is not None:
-        raise ValueError(refusal.replace("scene:", f"{source}:", 1))
+        raise ValueError(refusal)
 
 
 def read_file(path: PathLike) -> str:
@@ -124,10 +124,18 @@ class Stability:
     """Paper's condition (3.1) with the exact κ_h, 2/sqrt((1-2β)κ_h); +inf for β = 1/2 (s)."""
     dt_limit_paper_bound: float
     """Paper's condition (3.1) with its bound κ̃ (s); 3.3469e-6 s for the paper's scene at β = 1/4."""
+    kappa_run: float
+    """Largest eigenvalue of the model the run steps (the reduced one with ``modes`` > 0; with the
+    compliance spring); 0 for a reduced model with β ≥ 1/4, where it is not computed (1/s²)."""
+    dt_limit_run: float
+    """Linear Newmark limit of the model the run steps, the one the engine applies (s)."""
+    run_model: str
+    """Which model the run steps: 'full model' or 'reduced model of r modes'."""
     dt: float
     """The scene's time step (s)."""
     refusal: Optional[str]
-    """Why the engine would refuse to run the scene (dt beyond the linear limit), or None."""
+    """Why the engine would refuse to run the scene (dt beyond the linear limit of the model the
+    run steps: the check of ``beamstops run`` and ``beamstops info``), or None."""
 
     @property
     def runnable(self) -> bool:
@@ -135,14 +143,17 @@ class Stability:
         return self.refusal is None
 
 
-def stability(scene: Scene) -> Stability:
-    """κ_h, the paper's κ̃ and the time-step limits of a scene (builds the model, does not run)."""
-    (kappa_h, kappa_bound, kappa_contact, dt_newmark, dt_paper, dt_paper_bound, method, refused, refusal,
-     status, message) = engine_call(_engine.bs_stability, _scene_text(scene), b"scene")
+def stability(scene: Scene, source: str = "scene") -> Stability:
+    """κ_h, the paper's κ̃ and the time-step limits of a scene (builds the model, does not run);
+    messages start with ``source``."""
+    (kappa_h, kappa_bound, kappa_contact, dt_newmark, dt_paper, dt_paper_bound, method, kappa_run, dt_run,
+     run_model, refused, refusal, status, message) = engine_call(_engine.bs_stability, _scene_text(scene),
+                                                                 os.fsencode(source))
     _check(status, message)
     return Stability(kappa_h=float(kappa_h), kappa_bound=float(kappa_bound), kappa_contact=float(kappa_contact),
                      kappa_method=_text(method), dt_limit_newmark=float(dt_newmark),
                      dt_limit_paper=float(dt_paper), dt_limit_paper_bound=float(dt_paper_bound),
+                     kappa_run=float(kappa_run), dt_limit_run=float(dt_run), run_model=_text(run_model),
                      dt=scene.dt, refusal=_text(refusal) if refused else None)
 
 

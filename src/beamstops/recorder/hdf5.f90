@@ -4,7 +4,8 @@
 !> The run writes OUT.partial beside the output OUT and renames it onto OUT when it has gone
 !> to its end ('complete' or 'diverged') and the file is closed: a killed or failed run never
 !> touches OUT. `check_output_path` refuses, before anything is written, an OUT that is the
-!> input itself or an existing file that is not a beamstops output.
+!> input itself, an existing file that is not a beamstops output, a folder's name (OUT/), or one
+!> whose partial file the system will not let the run create (with the system's reason).
 !>
 !>   /tip/t, /tip/u, /tip/v, /tip/reaction
 !>   /energy/t, /energy/E, /energy/work, /energy/dissipated, /energy/damped
@@ -19,7 +20,7 @@ module beamstops_recorder_hdf5
    use beamstops_scene, only: scene_type, law_name, law_compliance, stop_count, steps_of
    use beamstops_model, only: model_type
    use beamstops_summary, only: run_summary, status_running, status_complete, status_diverged, status_failed
-   use beamstops_files, only: file_exists, is_directory, same_file, replace_file
+   use beamstops_files, only: file_exists, is_directory, same_file, replace_file, creation_error
    use beamstops_recorder_hdf5_vector, only: write_vector
    use beamstops_recorder, only: recorder_type, n_columns, col_t, all_finite
    use beamstops_attributes, only: attribute_list, kind_real, kind_int, kind_logical, kind_text
@@ -101,7 +102,7 @@ contains
       call prepare(self, path, scene, model)
       call h5fcreate_f(self%partial, H5F_ACC_TRUNC_F, self%file, hdferr)
       if (hdferr /= 0) then
-         call fail(self, 'cannot create '//self%partial//' (no such folder, or not writable?)')
+         call fail(self, 'cannot create '//self%partial//': '//creation_failure(self%partial))
          call fatal_error(error, self%message)
          return
       end if
@@ -389,39 +390,58 @@ contains
       path = output//'.partial'
    end function partial_path
 
-   !> Refuse, before anything is written, an output that would destroy data: the input file
-   !> itself (under any name: same device and inode), an existing file at the output path that
-   !> is not a beamstops output (an HDF5 file with the root attributes `version` and `status`),
-   !> or a file at the partial path that is neither empty nor HDF5 (an empty or HDF5 file there
-   !> is taken for the partial output of an earlier run, which a kill may have left empty and a
-   !> failed write unreadable). The message names the file and says why.
-   subroutine check_output_path(output, input, error)
+   !> Refuse, before anything is written, an output the run cannot write or that would destroy
+   !> data: a name ending in '/' (a folder's, not a file's); the input file itself (under any
+   !> name: same device and inode); an existing file at the output path that is not a beamstops
+   !> output (an HDF5 file with the root attributes `version` and `status`); a file at the partial
+   !> path that is neither empty nor HDF5 (an empty or HDF5 file there is taken for the partial
+   !> output of an earlier run, which a kill may have left empty and a failed write unreadable);
+   !> a partial file the system will not let the run create (the message gives its reason:
+   !> name too long, no such folder, permission denied, read-only file system, ...). The message
+   !> names the output and where its name came from (`origin`), and says why.
+   subroutine check_output_path(output, input, origin, error)
       !> Output file.
       character(len=*), intent(in) :: output
       !> Input file of the run.
       character(len=*), intent(in) :: input
+      !> Where the output's name came from, e.g. '-o' or '&output file of in.nml'.
+      character(len=*), intent(in) :: origin
       !> Set when the output must not be written.
       type(error_type), allocatable, intent(out) :: error
-      character(len=:), allocatable :: why
+      character(len=:), allocatable :: why, named, example
       if (len(output) == 0) then
          call fatal_error(error, input//': a namelist read from a pipe, a device or an open descriptor (/dev/stdin, '// &
             & '/dev/fd/N, <(...)) gives no output name; allowed: name the output, -o OUT.h5 or &output file = ''OUT.h5''')
          return
       end if
+      named = output//' ('//origin//'): '
+      if (output(len(output):) == '/') then
+         example = output(:verify(output, '/', back=.true.))
+         if (len(example) == 0) example = 'out.h5'
+         call fatal_error(error, named//'ends with /, the name of a folder, not of a file; allowed: the name of '// &
+            & 'the HDF5 file to write, e.g. '//example)
+         return
+      end if
       if (same_file(output, input)) then
-         call fatal_error(error, output//': is the input file '//input//'; writing the output there would '// &
+         call fatal_error(error, named//'is the input file '//input//'; writing the output there would '// &
             & 'destroy it (name another output: -o OUT.h5, or &output file)')
          return
       end if
       why = not_an_output(output, strict=.true.)
       if (len(why) > 0) then
-         call fatal_error(error, output//': exists and is not a beamstops output ('//why//'); refusing to '// &
+         call fatal_error(error, named//'exists and is not a beamstops output ('//why//'); refusing to '// &
             & 'overwrite it (name another output: -o OUT.h5, or &output file)')
          return
       end if
       why = not_an_output(partial_path(output), strict=.false.)
-      if (len(why) > 0) call fatal_error(error, partial_path(output)//': exists and is not the partial output '// &
-         & 'of a beamstops run ('//why//'); refusing to overwrite it (move it away)')
+      if (len(why) > 0) then
+         call fatal_error(error, named//partial_path(output)//', where the run writes until it is done, exists '// &
+            & 'and is not the partial output of a beamstops run ('//why//'); refusing to overwrite it (move it away)')
+         return
+      end if
+      why = creation_error(partial_path(output))
+      if (len(why) > 0) call fatal_error(error, named//'cannot create '//partial_path(output)//', where the run '// &
+         & 'writes until it is done: '//why)
    end subroutine check_output_path
 
    !> Why an existing `path` is not a beamstops output ('' when it is one, or does not exist);
@@ -742,6 +762,14 @@ contains
       if (.not. self%failed) self%message = self%path//': '//what
       self%failed = .true.
    end subroutine fail
+
+   !> Why a file could not be created: the system's reason, or HDF5's when the system has none.
+   function creation_failure(path) result(why)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: why
+      why = creation_error(path)
+      if (len(why) == 0) why = 'HDF5 could not create it'
+   end function creation_failure
 
    !> What a failed write says.
    function write_failure(self) result(what)

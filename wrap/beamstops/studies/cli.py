@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Optional
 
+from ..arguments import OneLineParser
 from .common import out_dir
 
 
@@ -47,7 +48,7 @@ class StudyCommand:
 
     def main(self, argv: Optional[Sequence[str]] = None) -> int:
         """The study's script: parse ``argv`` (default sys.argv[1:]), run, print the file."""
-        parser = argparse.ArgumentParser(prog=self.prog, description=self.script_description)
+        parser = OneLineParser(prog=self.prog, description=self.script_description)
         self.arguments(parser)
         return self.handler(parser.parse_args(argv))
 

@@ -15,9 +15,10 @@ examples:
   mpiexec -n 9 python -m mpi4py.futures -m beamstops sweep SPEC -o DIR                # 8 MPI workers
 Running the same command again resumes: finished points are skipped. A folder holds one
 specification only. Summary: DIR/summary.csv (and summary.json); outputs: DIR/points/.
-exit status: 0 every point complete; 3 some point failed (refused, timed out, crashed) or
-diverged (the summary says which; running the same command again retries the failed ones);
-1 a bad specification (--set values included), no -o, a folder that cannot be used (another
+exit status: 0 every point complete; 3 some point failed (timed out, crashed, its output could
+not be written) or diverged (the summary says which; running the same command again retries the
+failed ones); 1 a bad specification (--set values included; a point whose scene the engine
+refuses: a value out of range, a time step beyond the stability limit), no -o, a folder that cannot be used (another
 specification's, not a sweep's, or locked by a running sweep), no program, or MPI that cannot
 start its workers; 2 a bad command-line option (unknown, or a value
 out of range: -j, --timeout, --interval, --executor), refused before anything is written;
@@ -53,8 +54,6 @@ def _sweep(args: argparse.Namespace) -> int:
 
 
 def _dry_run(spec, args: argparse.Namespace) -> int:  # type: ignore[no-untyped-def]
-    from ..engine import validate
-
     points = spec.points
     shape = " × ".join(f"{'+'.join(g)} {len(spec.axes[g[0]])}" for g in spec.zip_groups)
     steps = sum(round(p.scene.t_end / p.scene.dt) for p in points)
@@ -63,14 +62,9 @@ def _dry_run(spec, args: argparse.Namespace) -> int:  # type: ignore[no-untyped-
         if point is None:
             print("  ...")
             continue
-        try:
-            validate(point.scene, f"point {point.index}")
-            verdict = ""
-        except ValueError as exc:
-            verdict = f"  REFUSED: {exc}"
         params = ", ".join(f"{k}={v!r}" for k, v in point.params.items())
         print(f"  {point.name}: {params}  (dt={point.scene.dt!r}, t_end={point.scene.t_end!r}, "
-              f"record_every={point.scene.record_every}){verdict}")
+              f"record_every={point.scene.record_every})")
     return 0
 
 

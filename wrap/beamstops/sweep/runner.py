@@ -578,20 +578,6 @@ def _on_term(signum: int, frame: Any) -> None:
     raise _Stop()
 
 
-def _refusals(spec: Spec) -> tuple[int, str]:
-    """How many points the engine refuses (they will fail with the program's message), and the first message."""
-    from ..engine import validate
-
-    count, first = 0, ""
-    for point in spec.points:
-        try:
-            validate(point.scene, f"point {point.index}")
-        except ValueError as exc:
-            count += 1
-            first = first or str(exc)
-    return count, first
-
-
 def run_sweep(spec: Spec, out: str | os.PathLike[str], *, executor: str = "auto", jobs: Optional[int] = None,
               program: Optional[str] = None, timeout: Optional[float] = None, stream: Optional[TextIO] = sys.stderr,
               interval: float = 10.0) -> Outcome:
@@ -633,7 +619,6 @@ def _run_sweep(spec: Spec, out: Path, *, executor: str, jobs: Optional[int], pro
     in_lockstep = 0
     if tasks:
         pool, description, workers = make_executor(executor, jobs)
-        refused, first = _refusals(spec)
         work = batches(tasks, spec.lockstep, workers)
         grouped = (f" in {len(work)} batches of up to {max(len(b) for b in work)} (lockstep = {spec.lockstep})"
                    if len(work) < len(tasks) else "")
@@ -641,9 +626,6 @@ def _run_sweep(spec: Spec, out: Path, *, executor: str, jobs: Optional[int], pro
             f"{len(tasks)} to run on {description}{grouped}")
         if note:
             say(f"sweep: note: {note}")
-        if refused:
-            say(f"sweep: note: the engine refuses {refused} point{'s' if refused > 1 else ''}, which will be "
-                f"recorded as failed ({first})")
         progress = Progress(len(spec.points), len(done), sum(costs[t["index"]] for t in tasks), stream, interval)
         progress.show(force=True)
         previous = None

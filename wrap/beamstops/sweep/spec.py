@@ -58,7 +58,10 @@ identical to the point run alone. ``lockstep = 1`` runs one process per point.
 
 Any mistake ends in :class:`SpecError`, a ValueError whose message starts with the
 file's name: unknown tables or keys, unknown scene keys, empty axes, zip axes of
-different lengths, values of the wrong type, non-finite numbers, too many points.
+different lengths, values of the wrong type, non-finite numbers, too many points, and a
+point whose scene the engine refuses — its reader (a value out of range) or the check of
+``beamstops run`` (a time step beyond the stability limit of the model the point steps),
+with the engine's message.
 """
 
 from __future__ import annotations
@@ -313,6 +316,7 @@ def _parse(data: Mapping[str, Any], path: str, base_dir: Path, text: str, overri
                 what = "[periods]" if periods is not None else "a reduction in forcing periods"
                 raise fail(f"{what} needs omega > 0; point {point.index} ({_params(point.params)}) "
                            f"has omega = {point.scene.omega!r}")
+    _check_runs(points, fail)
     digest = hashlib.sha256(json.dumps(_resolved(points, reductions), sort_keys=True,
                                        allow_nan=False).encode()).hexdigest()
     return Spec(path=path, text=text, data=data, base=base_path, axes=axes, mode=mode, zip_groups=groups,
@@ -603,6 +607,24 @@ def _scene(base: Scene, fixed: dict[str, Any], params: dict[str, Any], periods: 
         changes["dt"] = period / (records * every)
         changes["record_every"] = every
     return dataclasses.replace(scene, **changes)
+
+
+def _check_runs(points: list[Point], fail: Any) -> None:
+    """Refuse a point the engine would refuse to run, with its message: the check of ``beamstops
+    run`` and ``beamstops info`` (engine.validate: the stability limit of the model the point
+    steps), asked once for each distinct scene of the sweep."""
+    from ..engine import validate
+
+    asked: set[str] = set()
+    for point in points:
+        text = point.scene.to_text()
+        if text in asked:
+            continue
+        asked.add(text)
+        try:
+            validate(point.scene)
+        except ValueError as exc:
+            raise fail(f"point {point.index} ({_params(point.params)}): {exc}") from None
 
 
 def _params(params: dict[str, Any]) -> str:
