@@ -173,6 +173,8 @@ int beamstops_read_file(const char *path, int64_t limit, char **data, int64_t *s
     }
     *size = *regular ? (int64_t)used : -1;
     return 3;
+}
+
 /* 0 when a run can write the file `path` and rename it in its folder, else the errno that says
    why not (ENAMETOOLONG, ENOENT, ENOTDIR, EACCES, EROFS, ...). A new file is created and removed
    again (O_EXCL: only what this call created is removed); an existing one is not opened, only
