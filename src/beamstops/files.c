@@ -1,6 +1,7 @@
 /* What standard Fortran cannot ask of the file system (used by src/beamstops/files.f90). */
 #include <errno.h>
 #include <fcntl.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -86,6 +87,92 @@ int beamstops_replace_file(const char *from, const char *to)
     if (lstat(to, &s) == 0 && S_ISREG(s.st_mode))
         unlink(to); /* a failure shows in the rename, which then replaces it */
     return rename(from, to) == 0 ? 0 : -1;
+}
+
+/* The whole content of the file at path, read to its end in chunks: a regular file, or a pipe,
+   a FIFO or a device, whose size is known only at its end (their stat size is 0). On success
+   (0) *data holds *size bytes (to be released with free) and *regular says whether it is a
+   regular file. Otherwise nothing is kept and the return says why: 1 no such file, 2 a folder,
+   3 more than limit bytes (*size then the size a regular file reports, -1 for a stream, which is
+   read no further than limit + 1 bytes), 4 it cannot be opened, 5 it cannot be read (the system's
+   words in message, of message_size bytes). */
+int beamstops_read_file(const char *path, int64_t limit, char **data, int64_t *size, int *regular,
+                        char *message, int message_size)
+{
+    struct stat s;
+    size_t capacity, used = 0;
+    char *buffer, *grown;
+    ssize_t n;
+    int fd, failure = 0;
+    *data = NULL;
+    *size = 0;
+    *regular = 0;
+    do
+        fd = open(path, O_RDONLY | O_CLOEXEC);
+    while (fd < 0 && errno == EINTR);
+    if (fd < 0 && errno == ENOENT)
+        return 1;
+    if (fd >= 0 && fstat(fd, &s) != 0) {
+        failure = errno;
+        close(fd);
+        fd = -1;
+        errno = failure;
+    }
+    if (fd < 0) {
+        snprintf(message, (size_t)message_size, "%s", strerror(errno));
+        return 4;
+    }
+    if (S_ISDIR(s.st_mode)) {
+        close(fd);
+        return 2;
+    }
+    *regular = S_ISREG(s.st_mode);
+    if (*regular && s.st_size > limit) {
+        *size = (int64_t)s.st_size;
+        close(fd);
+        return 3;
+    }
+    capacity = (*regular && s.st_size > 0 ? (size_t)s.st_size : 65536) + 1;
+    buffer = malloc(capacity);
+    if (buffer == NULL) {
+        close(fd);
+        snprintf(message, (size_t)message_size, "%s", strerror(ENOMEM));
+        return 5;
+    }
+    while ((int64_t)used <= limit) {
+        if (used == capacity) {
+            capacity = 2 * capacity > (size_t)limit + 1 ? (size_t)limit + 1 : 2 * capacity;
+            grown = realloc(buffer, capacity);
+            if (grown == NULL) {
+                failure = ENOMEM;
+                break;
+            }
+            buffer = grown;
+        }
+        n = read(fd, buffer + used, capacity - used);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n < 0) {
+            failure = errno;
+            break;
+        }
+        if (n == 0)
+            break;
+        used += (size_t)n;
+    }
+    close(fd);
+    if (failure == 0 && (int64_t)used <= limit) {
+        *data = buffer;
+        *size = (int64_t)used;
+        return 0;
+    }
+    free(buffer);
+    if (failure != 0) {
+        snprintf(message, (size_t)message_size, "%s", strerror(failure));
+        return 5;
+    }
+    *size = *regular ? (int64_t)used : -1;
+    return 3;
 }
 
 /* 0 when a run can write the file `path` and rename it in its folder, else the errno that says

@@ -1,10 +1,17 @@
 !> Files as the engine handles them: existence, identity (same file under two names),
 !> atomic replacement by rename, removal. The C library and src/beamstops/files.c do the work.
 module beamstops_files
-   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char, c_size_t
+   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_int64_t, c_null_char, c_ptr, c_f_pointer, c_associated, &
+      & c_size_t
    implicit none
    private
    public :: file_exists, is_directory, same_file, same_path, rename_file, replace_file, remove_file, creation_error
+   public :: read_whole_file, read_ok, read_missing, read_folder, read_too_big, read_unopened, read_failed
+
+   !> Outcomes of read_whole_file: read, no such file, a folder, more bytes than allowed, not
+   !> opened, not read (the last two with the system's words).
+   integer, parameter :: read_ok = 0, read_missing = 1, read_folder = 2, read_too_big = 3, read_unopened = 4, &
+      & read_failed = 5
 
    interface
       function c_rename(from, to) bind(c, name='rename') result(status)
@@ -37,6 +44,22 @@ module beamstops_files
          character(kind=c_char), intent(in) :: path(*)
          integer(c_int) :: directory
       end function c_is_directory
+      function c_read_file(path, limit, data, size, regular, message, message_size) &
+         & bind(c, name='beamstops_read_file') result(outcome)
+         import :: c_char, c_int, c_int64_t, c_ptr
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int64_t), value :: limit
+         type(c_ptr), intent(out) :: data
+         integer(c_int64_t), intent(out) :: size
+         integer(c_int), intent(out) :: regular
+         character(kind=c_char), intent(inout) :: message(*)
+         integer(c_int), value :: message_size
+         integer(c_int) :: outcome
+      end function c_read_file
+      subroutine c_free(pointer) bind(c, name='free')
+         import :: c_ptr
+         type(c_ptr), value :: pointer
+      end subroutine c_free
       function c_creation_errno(path) bind(c, name='beamstops_creation_errno') result(code)
          import :: c_char, c_int
          character(kind=c_char), intent(in) :: path(*)
@@ -51,6 +74,46 @@ module beamstops_files
    end interface
 
 contains
+
+   !> The whole content of a file, read to its end: a regular file, or a pipe, a FIFO or a
+   !> device (`beamstops run <(...)`, /dev/stdin), whose size is known only once read.
+   subroutine read_whole_file(path, limit, text, outcome, bytes, regular, why)
+      !> File.
+      character(len=*), intent(in) :: path
+      !> Most bytes read.
+      integer(c_int64_t), intent(in) :: limit
+      !> Its content ('' unless read).
+      character(len=:), allocatable, intent(out) :: text
+      !> read_ok, or why it was not read: read_missing, read_folder, read_too_big, read_unopened,
+      !> read_failed.
+      integer, intent(out) :: outcome
+      !> Bytes read; with read_too_big, the size a regular file reports (-1 for a stream).
+      integer(c_int64_t), intent(out) :: bytes
+      !> Whether the file is a regular file (not a pipe, a FIFO or a device).
+      logical, intent(out) :: regular
+      !> With read_unopened and read_failed, the system's words.
+      character(len=:), allocatable, intent(out) :: why
+      character(kind=c_char) :: message(256)
+      character(kind=c_char), pointer :: chars(:)
+      type(c_ptr) :: data
+      integer(c_int) :: is_regular
+      integer(c_int64_t) :: i
+      message = c_null_char
+      outcome = c_read_file(path//c_null_char, limit, data, bytes, is_regular, message, size(message, kind=c_int))
+      regular = is_regular /= 0
+      why = ''
+      do i = 1, size(message)
+         if (message(i) == c_null_char) exit
+         why = why//message(i)
+      end do
+      allocate (character(len=max(0_c_int64_t, merge(bytes, 0_c_int64_t, outcome == read_ok))) :: text)
+      if (.not. c_associated(data)) return
+      call c_f_pointer(data, chars, [bytes])
+      do i = 1, bytes
+         text(i:i) = chars(i)
+      end do
+      call c_free(data)
+   end subroutine read_whole_file
 
    !> Whether `path` exists (a file or a directory).
    function file_exists(path) result(exists)

@@ -349,8 +349,8 @@ contains
       if (scene%allow_unstable .or. scene%beta >= 0.25_wp) return
       if (scene%dt < model%dt_newmark) return
       call fatal_error(error, source//': &time dt = '//fmt_real(scene%dt)//' is out of range; allowed: dt < '// &
-         & fmt_real(model%dt_newmark, 6)//' s, the linear stability limit 2/sqrt((1-4 beta) kappa_h) for beta = '// &
-         & fmt_real(scene%beta)//' (kappa_h = '//fmt_real(model%kappa_contact, 6)//' 1/s^2); set &time allow_unstable=.true.'// &
+         & fmt_real(model%dt_newmark, 6, 'down')//' s, the linear stability limit 2/sqrt((1-4 beta) kappa_h) for '// &
+         & 'beta = '//fmt_real(scene%beta)//' (kappa_h = '//fmt_real(model%kappa_contact, 6)//' 1/s^2); set &time allow_unstable=.true.'// &
          & ' to run it anyway')
    end subroutine check_stability
 end module beamstops_model

@@ -4,13 +4,14 @@
 !> group, unknown keys, malformed and out-of-range values all end in one message naming the
 !> source, the group and the key.
 module beamstops_namelist
-   use, intrinsic :: iso_fortran_env, only: iostat_end
+   use, intrinsic :: iso_fortran_env, only: iostat_end, int64
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
+   use beamstops_files, only: read_whole_file, read_missing, read_folder, read_too_big, read_unopened, read_failed
    use beamstops_scene, only: scene_type, validate_scene, tube_beam, law_code, law_compliance, max_stops, stop_count, &
       & steps_of, min_stiffness_per_mass, max_stiffness_per_mass, k2_range, mass_per_length_range
-   use beamstops_strings, only: fmt_real, itoa, lower, squeeze
+   use beamstops_strings, only: fmt_real, fmt_int, itoa, lower, squeeze
    use beamstops_physics_checks, only: validate_physics
    use beamstops_observe_statistics, only: validate_statistics, validate_ensemble
    use beamstops_reduced, only: validate_reduced, stop_unknowns
@@ -35,7 +36,10 @@ module beamstops_namelist
 contains
 
    !> Read, derive and validate a scene from a namelist file; missing groups and keys keep
-   !> the paper's values. The output file defaults to the file's base name with '.h5'.
+   !> the paper's values. The output file defaults to the file's base name with '.h5'; a file
+   !> named by an open descriptor (/dev/stdin, /dev/fd/N, /proc/.../fd/N: a pipe, `<(...)`) or that
+   !> is not a regular file gives no name (the output file is then '', refused by the program's
+   !> check_output_path unless named by -o or &output file).
    subroutine read_scene(path, scene, error)
       !> Namelist file.
       character(len=*), intent(in) :: path
@@ -44,52 +48,60 @@ contains
       !> Set on any bad input.
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: text
-      call read_text_file(path, text, error)
+      logical :: regular
+      call read_text_file(path, text, error, regular)
       if (allocated(error)) return
-      call scene_from_text(text, path, scene, error, default_output(path))
+      if (regular .and. .not. descriptor_path(path)) then
+         call scene_from_text(text, path, scene, error, default_output(path))
+      else
+         call scene_from_text(text, path, scene, error, '')
+      end if
    end subroutine read_scene
 
-   !> The whole of a text file (lines separated by new_line('a')).
-   subroutine read_text_file(path, text, error)
+   !> Whether a path names an open file descriptor rather than a file: /dev/stdin, /dev/fd/N,
+   !> /proc/self/fd/N or /proc/PID/fd/N (what a shell's `<(...)` gives).
+   pure logical function descriptor_path(path)
+      !> Path.
+      character(len=*), intent(in) :: path
+      descriptor_path = path == '/dev/stdin' .or. index(path, '/dev/fd/') == 1 .or. &
+         & (index(path, '/proc/') == 1 .and. index(path, '/fd/') > 0)
+   end function descriptor_path
+
+   !> The whole of a text file (lines separated by new_line('a')), at most 64 MB: a regular file,
+   !> or a pipe, a FIFO or a device read to its end.
+   subroutine read_text_file(path, text, error, regular)
       !> File.
       character(len=*), intent(in) :: path
       !> Its content.
       character(len=:), allocatable, intent(out) :: text
       !> Set when the file cannot be read.
       type(error_type), allocatable, intent(out) :: error
-      integer :: unit, stat, size_bytes
-      character(len=512) :: msg
-      logical :: exists, is_dir
-      text = ''
-      inquire (file=path, exist=exists)
-      if (.not. exists) then
+      !> Whether it is a regular file (not a pipe, a FIFO or a device).
+      logical, intent(out), optional :: regular
+      integer(int64), parameter :: max_bytes = 64*1024*1024_int64
+      character(len=:), allocatable :: why
+      integer(int64) :: bytes
+      integer :: outcome
+      logical :: is_regular
+      call read_whole_file(path, max_bytes, text, outcome, bytes, is_regular, why)
+      if (present(regular)) regular = is_regular
+      select case (outcome)
+      case (read_missing)
          call fatal_error(error, path//': cannot open: no such file')
-         return
-      end if
-      inquire (file=path//'/.', exist=is_dir)
-      if (is_dir) then
+      case (read_folder)
          call fatal_error(error, path//': cannot open: a directory, not a namelist file')
-         return
-      end if
-      open (newunit=unit, file=path, status='old', action='read', access='stream', form='unformatted', &
-         & iostat=stat, iomsg=msg)
-      if (stat /= 0) then
-         call fatal_error(error, path//': cannot open: '//trim(msg))
-         return
-      end if
-      inquire (unit=unit, size=size_bytes)
-      if (size_bytes > 64*1024*1024) then
-         call fatal_error(error, path//': '//itoa(size_bytes)//' bytes; allowed: a namelist file of at most 64 MB')
-         close (unit)
-         return
-      end if
-      if (size_bytes > 0) then
-         deallocate (text)
-         allocate (character(len=size_bytes) :: text)
-         read (unit, iostat=stat, iomsg=msg) text
-         if (stat /= 0) call fatal_error(error, path//': cannot read: '//trim(msg))
-      end if
-      close (unit)
+      case (read_too_big)
+         if (bytes >= 0) then
+            call fatal_error(error, path//': '//fmt_int(bytes)//' bytes; allowed: a namelist file of at most 64 MB')
+         else
+            call fatal_error(error, path//': more than 64 MB read (a pipe or a device); allowed: a namelist file of '// &
+               & 'at most 64 MB')
+         end if
+      case (read_unopened)
+         call fatal_error(error, path//': cannot open: '//why)
+      case (read_failed)
+         call fatal_error(error, path//': cannot read: '//why)
+      end select
    end subroutine read_text_file
 
    !> Read, derive and validate a scene from namelist text; `source` (a file name, or 'scene'
@@ -212,7 +224,12 @@ contains
          return
       end if
       if (scene%law == law_compliance) then
-         if ((stiffness == unset) .eqv. (stiffness_per_mass == unset)) then
+         if (stiffness /= unset .and. stiffness_per_mass /= unset) then
+            call fatal_error(error, source//": &stops stiffness and stiffness_per_mass are both given; allowed: "// &
+               & "one of them, the spring of law = 'compliance' (stiffness in N/m or stiffness_per_mass in 1/s^2)")
+            return
+         end if
+         if (stiffness == unset .and. stiffness_per_mass == unset) then
             call fatal_error(error, source//": &stops law = 'compliance' needs a spring; allowed: exactly one "// &
                & 'of stiffness (N/m) or stiffness_per_mass (1/s^2), > 0')
             return
@@ -837,9 +854,10 @@ contains
       real(wp), intent(in) :: length, k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness
       type(scene_type), intent(inout) :: scene
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: material(4)
+      real(wp) :: material(4), low(4), high(4)
       character(len=*), parameter :: names(4) = ['youngs_modulus', 'density       ', 'outer_diameter', &
-         & 'wall_thickness']
+         & 'wall_thickness'], units(4) = ['Pa    ', 'kg/m^3', 'm     ', 'm     ']
+      character(len=:), allocatable :: low_text, high_text
       integer :: i
       scene%length = length
       material = [youngs_modulus, density, outer_diameter, wall_thickness]
@@ -854,22 +872,30 @@ contains
                & 'youngs_modulus, density, outer_diameter, wall_thickness, or none of them (then k2)')
             return
          end if
-         if (.not. (material(i) > 0 .and. material(i) < huge(1.0_wp))) then
-            call fatal_error(error, path//': &beam '//trim(names(i))//' = '//fmt_real(material(i))// &
-               & ' is out of range; allowed: '//trim(names(i))//' > 0')
-            return
-         end if
       end do
       if (k2 /= unset .or. mass_per_length /= unset) then
          call fatal_error(error, path//': &beam gives k2 or mass_per_length together with the material; '// &
             & 'allowed: either k2 (and mass_per_length) or youngs_modulus, density, outer_diameter, wall_thickness')
          return
       end if
-      if (.not. wall_thickness <= outer_diameter/2) then
-         call fatal_error(error, path//': &beam wall_thickness = '//fmt_real(wall_thickness)// &
-            & ' is out of range; allowed: 0 < wall_thickness <= outer_diameter/2 = '//fmt_real(outer_diameter/2))
+      ! Beyond any real material (Young's modulus ten times diamond's, density four times
+      ! osmium's, lighter than air), and sections whose area and second moment are computed
+      ! without underflow or cancellation (k2 came out 0, NaN or -Inf).
+      low = [0.0_wp, 1.0e-3_wp, 1.0e-9_wp, 1.0e-6_wp*outer_diameter]
+      high = [1.0e13_wp, 1.0e5_wp, 1.0e3_wp, outer_diameter/2]
+      do i = 1, 4
+         if (material(i) > low(i) .or. (i > 1 .and. material(i) == low(i))) then
+            if (material(i) <= high(i)) cycle
+         end if
+         low_text = fmt_real(low(i))//' <= '
+         if (i == 1) low_text = '0 < '
+         if (i == 4) low_text = '1e-06*outer_diameter = '//low_text
+         high_text = fmt_real(high(i))
+         if (i == 4) high_text = 'outer_diameter/2 = '//high_text
+         call fatal_error(error, path//': &beam '//trim(names(i))//' = '//fmt_real(material(i))// &
+            & ' is out of range; allowed: '//low_text//trim(names(i))//' <= '//high_text//' '//trim(units(i)))
          return
-      end if
+      end do
       call tube_beam(youngs_modulus, density, outer_diameter, wall_thickness, scene%k2, scene%mass_per_length)
       ! What the material gives is told in the keys given (the file holds no k2 or mass_per_length).
       if (.not. (scene%k2 >= k2_range(1) .and. scene%k2 <= k2_range(2))) then

@@ -5,6 +5,7 @@ module beamstops_physics_checks
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
    use beamstops_scene, only: scene_type, law_signorini, law_name, stop_count, fmt_real, fmt_int
+   use beamstops_model, only: kappa_bound_constant
    implicit none
    private
    public :: validate_physics
@@ -12,6 +13,13 @@ module beamstops_physics_checks
    !> Namelist keys of the fields checked here.
    character(len=*), parameter :: key_mass = 'mass_coefficient', key_stiffness = 'stiffness_coefficient', &
       & key_ratio = 'ratio', key_modes = 'modes', key_restitution = 'restitution'
+   !> The most damping the Rayleigh coefficients may give, as the damping ratio of the mode each
+   !> damps least: a (zeta = a/(2 omega)) the mesh's highest mode, b (zeta = b omega/2) the
+   !> first. Every mode more than 100 times critical is far beyond any real structure (zeta of
+   !> 1e-3 to 0.1), and beyond what &damping ratio (zeta < 1 at two modes of the mesh) gives.
+   real(wp), parameter :: max_damping_ratio = 100
+   !> beta_1 L of the cantilever's first mode (1 + cos cosh = 0): omega_1 = beta_1^2 sqrt(k2)/L^2.
+   real(wp), parameter :: first_mode_root = 1.8751040687119611_wp
 
 contains
 
@@ -26,15 +34,26 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: n, i
       integer, allocatable :: nodes(:)
+      real(wp) :: omega_high, omega_1, mass_max, stiffness_max
 
       n = 2*scene%elements
-      ! &damping
-      if (.not. (scene%damping_mass >= 0)) then
-         call say('damping', key_mass, fmt_real(scene%damping_mass), key_mass//' >= 0 (1/s)')
+      ! &damping: the least damped mode at most max_damping_ratio times critical. a damps the
+      ! highest frequency of the mesh least, sqrt(kappa_h) <= sqrt(kappa_tilde) (the paper's
+      ! bound); b the first, omega_1 of the cantilever (the mesh's is above it).
+      omega_high = sqrt(kappa_bound_constant*scene%k2)*(scene%elements/scene%length)**2
+      omega_1 = first_mode_root**2*sqrt(scene%k2)/scene%length**2
+      mass_max = 2*max_damping_ratio*omega_high
+      stiffness_max = 2*max_damping_ratio/omega_1
+      if (.not. (scene%damping_mass >= 0 .and. scene%damping_mass <= mass_max)) then
+         call say('damping', key_mass, fmt_real(scene%damping_mass), '0 <= '//key_mass//' <= '// &
+            & fmt_real(mass_max, 3, 'down')//' 1/s (a damping ratio a/(2 omega) <= '//fmt_real(max_damping_ratio)// &
+            & ' at the highest frequency of the mesh, omega <= sqrt(kappa_tilde) = '//fmt_real(omega_high, 3)//' rad/s)')
          return
       end if
-      if (.not. (scene%damping_stiffness >= 0)) then
-         call say('damping', key_stiffness, fmt_real(scene%damping_stiffness), key_stiffness//' >= 0 (s)')
+      if (.not. (scene%damping_stiffness >= 0 .and. scene%damping_stiffness <= stiffness_max)) then
+         call say('damping', key_stiffness, fmt_real(scene%damping_stiffness), '0 <= '//key_stiffness//' <= '// &
+            & fmt_real(stiffness_max, 3, 'down')//' s (a damping ratio b omega/2 <= '//fmt_real(max_damping_ratio)// &
+            & ' at the first mode, omega_1 = 1.8751^2 sqrt(k2)/length^2 = '//fmt_real(omega_1, 3)//' rad/s)')
          return
       end if
       if (scene%damping_by_ratio) then

@@ -943,8 +943,8 @@ contains
       if (scene%allow_unstable .or. scene%beta >= 0.25_wp) return
       if (scene%dt < reduced%dt_newmark) return
       call fatal_error(error, source//': &time dt = '//fmt_real(scene%dt)//' is out of range; allowed: dt < '// &
-         & fmt_real(reduced%dt_newmark, 6)//' s, the linear stability limit 2/sqrt((1-4 beta) kappa) of the reduced '// &
-         & 'model with modes = '//fmt_int(int(reduced%r, ik))//' (kappa = '//fmt_real(reduced%kappa, 6)// &
+         & fmt_real(reduced%dt_newmark, 6, 'down')//' s, the linear stability limit 2/sqrt((1-4 beta) kappa) of the '// &
+         & 'reduced model with modes = '//fmt_int(int(reduced%r, ik))//' (kappa = '//fmt_real(reduced%kappa, 6)// &
          & ' 1/s^2); set &time allow_unstable=.true. to run it anyway')
    end subroutine check_stability_reduced
 end module beamstops_reduced

@@ -25,6 +25,11 @@ module beamstops_scene
    real(wp), parameter :: min_stiffness_per_mass = 1.0e-12_wp, max_stiffness_per_mass = 1.0e20_wp
    !> Ranges of k2 (m^4/s^2) and mass_per_length (kg/m), given or derived from a tube's material.
    real(wp), parameter :: k2_range(2) = [1.0e-12_wp, 1.0e15_wp], mass_per_length_range(2) = [1.0e-12_wp, 1.0e9_wp]
+   !> Shortest time step and final time (s): a femtosecond, 1/50,000 of the first period of the
+   !> stiffest real beam the lengths allow (E/rho <= 1e9 m^2/s^2 and a section narrower than
+   !> the length give k2 <= 1e9 length^2: omega_1 <= 1.1e11 rad/s at length = 1e-6 m); far
+   !> above the underflow of dt^2 (subnormal below 1.5e-154 s: runs diverged at t = 0).
+   real(wp), parameter :: min_dt = 1.0e-15_wp
 
    !> Every input of a run. Defaults reproduce the paper's scene (Figure 2).
    type :: scene_type
@@ -67,7 +72,8 @@ module beamstops_scene
       logical :: taylor_start = .true.
       !> &time: run even beyond the linear stability limit of beta < 1/4.
       logical :: allow_unstable = .false.
-      !> &output: HDF5 file written by the program (not used by the in-memory path).
+      !> &output: HDF5 file written by the program (not used by the in-memory path); '' when the
+      !> namelist came from a pipe or a device, which gives the file no default name.
       character(len=:), allocatable :: output_file
       !> &output: refuse a run whose output would exceed this many gigabytes (1e9 bytes).
       real(wp) :: max_output_gb = 4.0_wp
@@ -297,8 +303,11 @@ contains
       call list%add_text('time', 'load_rule', trim(merge('centered', 'paper   ', scene%centered_load)))
       call list%add_text('time', 'start', trim(merge('taylor', 'euler ', scene%taylor_start)))
       call list%add_logical('time', 'allow_unstable', scene%allow_unstable, signature=.false.)
-      if (allocated(scene%output_file)) call list%add_text('output', 'file', scene%output_file, attribute=.false., &
-         & signature=.false.)
+      ! ('' when the input, a pipe or /dev/fd/N, gave no name: none to write)
+      if (allocated(scene%output_file)) then
+         if (len(scene%output_file) > 0) call list%add_text('output', 'file', scene%output_file, attribute=.false., &
+            & signature=.false.)
+      end if
       call list%add_int('output', 'record_every', int(scene%record_every, ik))
       call list%add_int('output', 'snapshot_every', int(scene%snapshot_every, ik))
       call list%add_int('output', 'checkpoint_every', scene%checkpoint_every, attribute=.false.)
@@ -363,9 +372,10 @@ contains
          return
       end if
       call span_stops_valid(); if (allocated(error)) return
-      call within('time', 't_end', scene%t_end, tiny(1.0_wp), 1.0e9_wp, '0 < t_end <= 1e+09 s')
+      call within('time', 't_end', scene%t_end, min_dt, 1.0e9_wp, fmt_real(min_dt)//' <= t_end <= 1e+09 s')
       if (allocated(error)) return
-      call within('time', 'dt', scene%dt, tiny(1.0_wp), scene%t_end, '0 < dt <= t_end = '//fmt_real(scene%t_end)//' s')
+      call within('time', 'dt', scene%dt, min_dt, scene%t_end, fmt_real(min_dt)//' <= dt <= t_end = '// &
+         & fmt_real(scene%t_end)//' s')
       if (allocated(error)) return
       if (scene%t_end/scene%dt > 1.0e13_wp) then
          call say('time', 'dt', fmt_real(scene%dt), 't_end/dt <= 1e13 steps'); return

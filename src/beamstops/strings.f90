@@ -10,14 +10,19 @@ module beamstops_strings
 contains
 
    !> Shortest text that reads back as the same real (e.g. 2e-05, 0.25, 1.501, 2.6035e+10).
-   function fmt_real(x, digits) result(s)
+   function fmt_real(x, digits, round) result(s)
       !> Value.
       real(wp), intent(in) :: x
       !> At most this many significant digits (default: as many as needed to read back x).
       integer, intent(in), optional :: digits
+      !> With `digits`: 'down' or 'up' rounds the text toward minus or plus infinity (a bound
+      !> shown rounded stays on its side: a value beyond the bound is beyond its text too);
+      !> default: to the nearest.
+      character(len=*), intent(in), optional :: round
       character(len=:), allocatable :: s
       character(len=40) :: buf, fmt
       character(len=:), allocatable :: mantissa
+      character(len=3) :: mode
       real(wp) :: y
       integer :: p, e, stat
       if (.not. ieee_is_finite(x)) then
@@ -25,8 +30,13 @@ contains
          s = trim(adjustl(buf))
          return
       end if
+      mode = ''
+      if (present(round)) then
+         if (round == 'down') mode = 'rd,'
+         if (round == 'up') mode = 'ru,'
+      end if
       do p = 0, 16
-         write (fmt, '(a,i0,a)') '(es30.', p, 'e3)'
+         write (fmt, '(a,i0,a)') '('//trim(mode)//'es30.', p, 'e3)'
          write (buf, fmt) x
          read (buf, *, iostat=stat) y
          if (stat == 0 .and. y == x) exit
@@ -42,7 +52,7 @@ contains
          if (mantissa(len(mantissa):) == '.') mantissa = mantissa(:len(mantissa) - 1)
       end if
       if (e >= -4 .and. e < 6) then
-         write (fmt, '(a,i0,a)') '(f0.', max(0, p - e), ')'
+         write (fmt, '(a,i0,a)') '('//trim(mode)//'f0.', max(0, p - e), ')'
          write (buf, fmt) x
          s = trim(adjustl(buf))
          if (index(s, '.') > 0) then

@@ -3,7 +3,8 @@
 !> naming the file, the group and the key.
 module test_namelist
    use testing
-   use beamstops, only: scene_type, read_scene, law_signorini, law_compliance, scene_from_text, canonical_text
+   use beamstops, only: scene_type, read_scene, law_signorini, law_compliance, scene_from_text, canonical_text, &
+      & model_type, build_model, check_stability
    implicit none
    private
    public :: collect_namelist
@@ -50,7 +51,14 @@ contains
          & new_unittest('a group not closed by / is told so', test_unclosed_group), &
          & new_unittest('more values than a list holds are out of range', test_too_many_values), &
          & new_unittest('a bad value leaves no state: the next text is read whole', test_reader_state_after_bad_logical), &
-         & new_unittest('a carried key that does nothing is dropped, one given anew refused', test_carried_keys) &
+         & new_unittest('a carried key that does nothing is dropped, one given anew refused', test_carried_keys), &
+         & new_unittest('every real key refuses infinity and huge values, naming its range', test_real_keys_bounded), &
+         & new_unittest('a material beyond any real one is told in its own key', test_material_bounds), &
+         & new_unittest('dt and t_end below 1e-15 s refused; each message states a range the value violates', &
+         & test_tiny_time_step), &
+         & new_unittest('a dt refused for stability is beyond the limit as shown', test_stability_limit_shown), &
+         & new_unittest('both springs of the compliance law are told as both given', test_two_springs), &
+         & new_unittest('a FIFO is read to its end and gives no output name', test_fifo) &
          & ]
    end subroutine collect_namelist
 
@@ -344,17 +352,17 @@ contains
          & '1.1938e-13 <= stiffness <= 1.1938e+19 N/m'], error)
    end subroutine test_stiffness_range
 
-   !> youngs_modulus = 1e30 was refused as 'k2 = 1.4e+21', a key the file does not hold.
+   !> youngs_modulus = 1e13 with density = 0.01 was refused as 'k2 = 1e+16', a key the file does not hold.
    subroutine test_material_range(error)
       type(error_type), allocatable, intent(out) :: error
-      call expect_error('material.nml', [character(len=ll) :: '&beam youngs_modulus = 1e30, density = 8e3,', &
-         & '      outer_diameter = 0.01, wall_thickness = 5e-4 /'], &
-         & [character(len=48) :: '&beam youngs_modulus = 1e+30', 'give k2 = EI/(rho S)', &
+      call expect_error('material.nml', [character(len=ll) :: '&beam youngs_modulus = 1e13, density = 0.01,', &
+         & '      outer_diameter = 10, wall_thickness = 1 /'], &
+         & [character(len=48) :: '&beam youngs_modulus = 1e+13', 'give k2 = EI/(rho S)', &
          & '1e-12 <= k2 <= 1e+15 m^4/s^2'], error)
       if (allocated(error)) return
-      call expect_error('material.nml', [character(len=ll) :: '&beam youngs_modulus = 2e11, density = 1e20,', &
-         & '      outer_diameter = 1, wall_thickness = 0.5 /'], &
-         & [character(len=48) :: '&beam density = 1e+20', 'give mass_per_length = rho S', &
+      call expect_error('material.nml', [character(len=ll) :: '&beam youngs_modulus = 2e11, density = 1e5,', &
+         & '      outer_diameter = 1000, wall_thickness = 500 /'], &
+         & [character(len=48) :: '&beam density = 100000', 'give mass_per_length = rho S', &
          & '1e-12 <= mass_per_length <= 1e+09 kg/m'], error)
    end subroutine test_material_range
 
@@ -546,4 +554,170 @@ contains
       if (allocated(error)) return
       call check(error, scene%damping_modes(2), 3, 'the carried modes act with ratio')
    end subroutine test_carried_keys
+
+   !> The text `text` must be refused with a message holding each of `needles` (as words).
+   subroutine expect_text_error(text, needles, error)
+      character(len=*), intent(in) :: text
+      character(len=*), intent(in) :: needles(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(error_type), allocatable :: failure
+      integer :: i
+      call scene_from_text(text, 'in.nml', scene, failure)
+      if (.not. allocated(failure)) then
+         call test_failed(error, 'accepted: '//text)
+         return
+      end if
+      call note('message: '//failure%message)
+      do i = 1, size(needles)
+         call check(error, has_word(failure%message, trim(needles(i))), 'the message names '//trim(needles(i))// &
+            & ': '//failure%message)
+         if (allocated(error)) return
+      end do
+   end subroutine expect_text_error
+
+   !> The text must be read.
+   subroutine expect_read(text, error)
+      character(len=*), intent(in) :: text
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      call scene_from_text(text, 'in.nml', scene, error)
+   end subroutine expect_read
+
+   !> &damping mass_coefficient and stiffness_coefficient took Inf and 1e300 (the run diverged
+   !> at t = 0 and replaced an earlier output), &statistics rest_time and the histogram's range
+   !> any finite value; every real key of every group is finite and bounded.
+   subroutine test_real_keys_bounded(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: n = 27
+      character(len=100), parameter :: texts(n) = [character(len=100) :: &
+         & '&beam length = inf /', '&beam k2 = 1e300 /', '&beam mass_per_length = inf /', &
+         & '&support amplitude = -inf /', '&support omega = 1e300 /', '&stops lower = -inf /', '&stops upper = inf /', &
+         & '&stops x = inf /', '&stops law = ''compliance'', stiffness = inf /', &
+         & '&stops law = ''compliance'', stiffness_per_mass = 1e300 /', '&stops restitution = inf /', &
+         & '&damping mass_coefficient = inf /', '&damping mass_coefficient = 1e150 /', &
+         & '&damping stiffness_coefficient = inf /', '&damping stiffness_coefficient = 1e300 /', &
+         & '&damping ratio = inf /', '&time dt = inf /', '&time t_end = inf /', '&time beta = inf /', &
+         & '&output max_output_gb = inf /', '&statistics transient = inf /', '&statistics rest_time = inf /', &
+         & '&statistics rest_time = 1e300 /', '&statistics histogram_lower = -1e300 /', &
+         & '&statistics histogram_upper = inf /', '&ensemble perturbation = inf /', '&beam youngs_modulus = inf, '// &
+         & 'density = 8e3, outer_diameter = 0.01, wall_thickness = 5e-4 /']
+      character(len=32), parameter :: keys(n) = [character(len=32) :: 'length', 'k2', 'mass_per_length', 'amplitude', &
+         & 'omega', 'lower', 'upper', 'x(1)', 'stiffness', 'stiffness_per_mass', 'restitution', 'mass_coefficient', &
+         & 'mass_coefficient', 'stiffness_coefficient', 'stiffness_coefficient', 'ratio', 'dt', 't_end', 'beta', &
+         & 'max_output_gb', 'transient', 'rest_time', 'rest_time', 'histogram_lower', 'histogram_upper', 'perturbation', &
+         & 'youngs_modulus']
+      integer :: i
+      do i = 1, n
+         call expect_text_error(trim(texts(i)), [character(len=32) :: keys(i), 'is out of range'], error)
+         if (allocated(error)) return
+      end do
+      call expect_text_error('&damping mass_coefficient = 1e150 /', [character(len=64) :: &
+         & '&damping mass_coefficient = 1e+150 is out of range', 'allowed: 0 <= mass_coefficient <= 1.69e+08 1/s'], error)
+      if (allocated(error)) return
+      call expect_text_error('&damping stiffness_coefficient = inf /', [character(len=64) :: &
+         & '&damping stiffness_coefficient = Inf is out of range', 'allowed: 0 <= stiffness_coefficient <= 7.62 s'], &
+         & error)
+      if (allocated(error)) return
+      ! Within the bounds: read.
+      call expect_read('&damping mass_coefficient = 1e8, stiffness_coefficient = 7 /', error)
+      if (allocated(error)) return
+      call expect_read('&statistics rest_time = 1e9, histogram_lower = -1e9, histogram_upper = 1e9 /', error)
+   end subroutine test_real_keys_bounded
+
+   !> A tube's material and section: each key bounded beyond any real material and section (a
+   !> diameter of 1e100 gave k2 = -Inf, a wall of 1e-17 on a diameter of 1 k2 = NaN).
+   subroutine test_material_bounds(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: rest = ', density = 8e3, outer_diameter = 0.01, wall_thickness = 5e-4 /'
+      call expect_text_error('&beam youngs_modulus = 1e14'//rest, [character(len=64) :: &
+         & '&beam youngs_modulus = 1e+14 is out of range', 'allowed: 0 < youngs_modulus <= 1e+13 Pa'], error)
+      if (allocated(error)) return
+      call expect_text_error('&beam youngs_modulus = 2e11, density = 1e6, outer_diameter = 0.01, wall_thickness = 5e-4 /', &
+         & [character(len=64) :: '&beam density = 1e+06', 'allowed: 0.001 <= density <= 100000 kg/m^3'], error)
+      if (allocated(error)) return
+      call expect_text_error('&beam youngs_modulus = 2e11, density = 8e3, outer_diameter = 1e100, wall_thickness = 1e99 /', &
+         & [character(len=64) :: '&beam outer_diameter = 1e+100', 'allowed: 1e-09 <= outer_diameter <= 1000 m'], error)
+      if (allocated(error)) return
+      call expect_text_error('&beam youngs_modulus = 2e11, density = 8e3, outer_diameter = 1, wall_thickness = 1e-17 /', &
+         & [character(len=96) :: '&beam wall_thickness = 1e-17', &
+         & 'allowed: 1e-06*outer_diameter = 1e-06 <= wall_thickness <= outer_diameter/2 = 0.5 m'], error)
+   end subroutine test_material_bounds
+
+   !> dt = t_end = 1e-170 was accepted and diverged at t = 0 (dt^2 underflows); dt = 1e-310 with
+   !> t_end = 1e-300 was refused as out of 0 < dt <= t_end = 1e-300 s, a range it is in.
+   subroutine test_tiny_time_step(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_text_error('&time dt = 1e-170, t_end = 1e-170 /', [character(len=64) :: &
+         & '&time t_end = 1e-170 is out of range', 'allowed: 1e-15 <= t_end <= 1e+09 s'], error)
+      if (allocated(error)) return
+      call expect_text_error('&time dt = 1e-310, t_end = 1e-300 /', [character(len=64) :: &
+         & '&time t_end = 1e-300 is out of range', 'allowed: 1e-15 <= t_end <= 1e+09 s'], error)
+      if (allocated(error)) return
+      call expect_text_error('&time dt = 1e-310, t_end = 1e-3 /', [character(len=64) :: &
+         & '&time dt = 1e-310 is out of range', 'allowed: 1e-15 <= dt <= t_end = 0.001 s'], error)
+      if (allocated(error)) return
+      call expect_text_error('&time dt = 0.1, t_end = 1e-3 /', [character(len=64) :: &
+         & '&time dt = 0.1 is out of range', 'allowed: 1e-15 <= dt <= t_end = 0.001 s'], error)
+      if (allocated(error)) return
+      call expect_read('&time dt = 1e-15, t_end = 1e-15 /', error)
+   end subroutine test_tiny_time_step
+
+   !> The stability limit was shown rounded to the nearest: dt = the limit, refused, read as
+   !> within `dt < 1.23951e-05` (the limit is 1.2395061e-05).
+   subroutine test_stability_limit_shown(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(model_type) :: model
+      type(error_type), allocatable :: failure
+      real(wp) :: shown_limit
+      integer :: at, stat
+      call scene_from_text('&time dt = 1e-6, t_end = 1e-3, beta = 0 /', 'in.nml', scene, error)
+      if (allocated(error)) return
+      call build_model(scene, model, error)
+      if (allocated(error)) return
+      scene%dt = model%dt_newmark
+      call check_stability(scene, model, 'in.nml', failure)
+      call check(error, allocated(failure), 'dt at the limit refused')
+      if (allocated(error)) return
+      call note(failure%message)
+      at = index(failure%message, 'allowed: dt < ') + len('allowed: dt < ')
+      read (failure%message(at:index(failure%message(at:), ' ') + at - 2), *, iostat=stat) shown_limit
+      call check(error, stat == 0 .and. scene%dt >= shown_limit, 'dt = '//real_text(scene%dt)// &
+         & ' is beyond the limit shown: '//failure%message)
+   end subroutine test_stability_limit_shown
+
+   !> Both springs given with the compliance law was told as `needs a spring`.
+   subroutine test_two_springs(error)
+      type(error_type), allocatable, intent(out) :: error
+      call expect_text_error('&stops law = ''compliance'', stiffness = 1e5, stiffness_per_mass = 1e6 /', &
+         & [character(len=64) :: '&stops stiffness and stiffness_per_mass are both given', 'allowed: one of them'], error)
+   end subroutine test_two_springs
+
+   !> A FIFO (as a pipe, bash's `<(...)`) reports size 0: it was read as an empty text, 'no
+   !> namelist group'. It is read to its end, and gives no output name (its name, like /dev/fd/63,
+   !> says nothing of the scene); a regular file gives its own.
+   subroutine test_fifo(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      character(len=:), allocatable :: path
+      integer :: stat
+      path = temp_dir()//'/scene.fifo'
+      call execute_command_line('rm -f "'//path//'" && mkfifo "'//path//'" && '// &
+         & '(printf ''&time dt = 2e-5 /\n&mesh elements = 7 /\n'' > "'//path//'" &)', exitstat=stat)
+      call check(error, stat == 0, 'a FIFO with a writer')
+      if (allocated(error)) return
+      call read_scene(path, scene, error)
+      call remove(path)
+      if (allocated(error)) return
+      call check(error, scene%elements, 7, 'elements read from the FIFO')
+      if (allocated(error)) return
+      call check(error, scene%output_file == '', 'a FIFO gives no output name, got '//scene%output_file)
+      if (allocated(error)) return
+      path = write_file('named.nml', [character(len=ll) :: '&time dt = 1e-5 /'])
+      call read_scene(path, scene, error)
+      call remove(path)
+      if (allocated(error)) return
+      call check(error, scene%output_file == 'named.h5', 'named.nml gives named.h5, got '//scene%output_file)
+   end subroutine test_fifo
 end module test_namelist

@@ -4,7 +4,7 @@
 !> of the per-step updates (printed, never asserted).
 module test_statistics
    use, intrinsic :: iso_fortran_env, only: int64
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_value, ieee_quiet_nan
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_value, ieee_quiet_nan, ieee_positive_inf
    use testing
    use beamstops, only: ik
    use beamstops_observe_shocks, only: shock_log, shock_row, new_shock_log, shock_row_values
@@ -103,14 +103,29 @@ contains
          & ' the time the run reaches (t_end in whole steps of dt)')
       if (allocated(error)) return
       call validate_statistics(1.0_wp, 10.0_wp, 20, 10, -2.0e-3_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
-      call expect_message(error, 'in.nml: &statistics rest_time = -0.002 is out of range; allowed: rest_time >= 0 s')
+      call expect_message(error, 'in.nml: &statistics rest_time = -0.002 is out of range; allowed: 0 <= rest_time <= '// &
+         & '1e+09 s')
+      if (allocated(error)) return
+      ! Infinite or huge values were accepted: a rest time, the histogram's range (infinite bins).
+      call validate_statistics(1.0_wp, 10.0_wp, 20, 10, huge(1.0_wp), -0.1_wp, 0.1_wp, 'in.nml', error)
+      call expect_message(error, 'in.nml: &statistics rest_time = 1.7976931348623157e+308 is out of range; allowed: '// &
+         & '0 <= rest_time <= 1e+09 s')
+      if (allocated(error)) return
+      call validate_statistics(1.0_wp, 10.0_wp, 20, 10, 0.0_wp, -huge(1.0_wp), 0.1_wp, 'in.nml', error)
+      call expect_message(error, 'in.nml: &statistics histogram_lower = -1.7976931348623157e+308 is out of range; '// &
+         & 'allowed: -1e+09 <= histogram_lower < 1e+09 m')
+      if (allocated(error)) return
+      call validate_statistics(1.0_wp, 10.0_wp, 20, 10, 0.0_wp, -0.1_wp, ieee_value(1.0_wp, ieee_positive_inf), &
+         & 'in.nml', error)
+      call expect_message(error, 'in.nml: &statistics histogram_upper = Inf is out of range; allowed: '// &
+         & 'histogram_lower = -0.1 < histogram_upper <= 1e+09 m')
       if (allocated(error)) return
       call validate_statistics(1.0_wp, 10.0_wp, 20, 0, 0.0_wp, -0.1_wp, 0.1_wp, 'in.nml', error)
       call expect_message(error, 'in.nml: &statistics bins = 0 is out of range; allowed: 1 <= bins <= 1000000')
       if (allocated(error)) return
       call validate_statistics(1.0_wp, 10.0_wp, 20, 10, 0.0_wp, 0.1_wp, 0.1_wp, 'in.nml', error)
-      call expect_message(error, 'in.nml: &statistics histogram_upper = 0.1 is out of range; allowed: histogram_upper >'// &
-         & ' histogram_lower = 0.1 m')
+      call expect_message(error, 'in.nml: &statistics histogram_upper = 0.1 is out of range; allowed: histogram_lower = '// &
+         & '0.1 < histogram_upper <= 1e+09 m')
       if (allocated(error)) return
       call validate_ensemble(0, 'in.nml', error)
       call expect_message(error, 'in.nml: &ensemble members = 0 is out of range; allowed: 1 <= members <= 10000')

@@ -104,6 +104,19 @@ BAD = [
     ("half a material", "&beam youngs_modulus=2e11 /\n", ["&beam", "density"]),
     ("unstable explicit", "&time dt=2e-5, beta=0 /\n", ["&time", "dt", "stability limit", "allow_unstable"]),
     ("binary garbage", "&time dt=1e-5 /\n\x00\x01\x02\n", ["binary"]),
+    # infinite or huge damping ran and diverged at t = 0 (replacing an earlier output)
+    ("infinite mass damping", "&damping mass_coefficient=inf /\n",
+     ["&damping mass_coefficient = Inf is out of range", "allowed: 0 <= mass_coefficient <= 1.69e+08 1/s"]),
+    ("huge stiffness damping", "&damping stiffness_coefficient=1e100 /\n",
+     ["&damping stiffness_coefficient = 1e+100 is out of range", "allowed: 0 <= stiffness_coefficient <= 7.62 s"]),
+    ("infinite rest time", "&statistics rest_time=inf /\n", ["&statistics rest_time = Inf", "<= 1e+09 s"]),
+    # dt^2 underflowed: the run diverged at t = 0
+    ("tiny time step", "&time dt=1e-170, t_end=1e-170 /\n",
+     ["&time t_end = 1e-170 is out of range", "allowed: 1e-15 <= t_end <= 1e+09 s"]),
+    ("subnormal time step", "&time dt=1e-310, t_end=1e-3 /\n",
+     ["&time dt = 1e-310 is out of range", "allowed: 1e-15 <= dt <= t_end = 0.001 s"]),
+    ("two springs", "&stops law='compliance', stiffness=1e5, stiffness_per_mass=1e6 /\n",
+     ["&stops stiffness and stiffness_per_mass are both given"]),
 ]
 
 
@@ -575,6 +588,51 @@ def test_too_many_stops_along_the_span_are_refused_naming_the_limit(tmp_path: Pa
     assert "&stops nodes" in line and "at most 1000 stops" in line
 
 
+def test_bad_damping_leaves_an_earlier_output_and_info_refuses_it(tmp_path: Path) -> None:
+    kept, before = complete_output(tmp_path, "in.h5")
+    for value in ("inf", "1e150", "1e300"):
+        scene = write(tmp_path, SHORT + f"&damping mass_coefficient={value} /\n", name="in.nml")
+        line = one_error_line(done := beamstops("run", scene, cwd=tmp_path))
+        assert done.returncode == 1 and "&damping mass_coefficient" in line and "is out of range" in line
+        assert kept.read_bytes() == before
+        done = beamstops("info", scene, cwd=tmp_path)
+        assert done.returncode == 1 and "&damping mass_coefficient" in one_error_line(done)
+
+
+def test_a_namelist_from_a_pipe_is_read_whole_and_needs_an_output_name(tmp_path: Path) -> None:
+    text = "&time dt=5e-5, t_end=0.001 /\n"
+
+    def piped(*args: str) -> subprocess.CompletedProcess[str]:
+        return subprocess.run([PROGRAM, *args], cwd=tmp_path, input=text, capture_output=True, text=True,
+                              timeout=120)
+
+    # a pipe reports size 0: it was read as an empty text, 'no namelist group'
+    done = piped("info", "/dev/stdin")
+    assert done.returncode == 0, done.stderr
+    done = piped("run", "/dev/stdin", "-o", "piped.h5")
+    assert done.returncode == 0, done.stderr
+    with h5py.File(tmp_path / "piped.h5") as f:
+        assert f.attrs["status"] == b"complete" and f.attrs["steps"] == 20
+    # /dev/stdin or /dev/fd/63 (bash's <(...)) names no output: -o or &output file is needed
+    done = piped("run", "/dev/stdin")
+    assert done.returncode == 4
+    line = one_error_line(done)
+    assert "/dev/stdin: a namelist read from a pipe" in line and "-o OUT.h5 or &output file" in line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["piped.h5"]
+    text += "&output file='named.h5' /\n"
+    assert piped("run", "/dev/stdin").returncode == 0 and (tmp_path / "named.h5").exists()
+
+
+def test_a_pipe_beyond_64_mb_and_a_file_beyond_4_gib_are_refused_with_their_size(tmp_path: Path) -> None:
+    done = subprocess.run([PROGRAM, "info", "/dev/stdin"], cwd=tmp_path, input=b" " * (64 * 2**20 + 1),
+                          capture_output=True, timeout=120)
+    assert done.returncode == 1
+    assert "/dev/stdin: more than 64 MB read" in done.stderr.decode()
+    big = tmp_path / "big.nml"
+    with big.open("wb") as f:  # sparse: 5 GiB said 1073741824 bytes (an int32 size), 3 GiB 'no namelist group'
+        f.truncate(5 * 2**30)
+    line = one_error_line(beamstops("info", big, cwd=tmp_path))
+    assert "big.nml: 5368709120 bytes; allowed: a namelist file of at most 64 MB" in line
 # ---------------------------------------------------------------- info and run: one check (audit P6)
 
 
@@ -701,17 +759,21 @@ def test_repeated_or_unexpected_arguments_are_refused(args: list[str], needle: s
 def test_numbers_with_three_digit_exponents_are_printed_with_their_e(tmp_path: Path) -> None:
     import re
 
-    scene = write(tmp_path, "&time dt=1e-60, t_end=1e-60 /\n")
-    done = beamstops("run", scene, cwd=tmp_path)
+    # a support amplitude of 1e-60 m: the support's work is of order 1e-120 J
+    text = "&time dt=1e-5, t_end=1e-4 /\n&support amplitude=1e-60 /\n"
+    done = beamstops("run", write(tmp_path, text), cwd=tmp_path)
     assert done.returncode == 0, done.stderr
-    info = beamstops("info", write(tmp_path, "&time dt=1e-60, t_end=1e-60 /\n&stops lower=-1e-120, upper=1e-120 /\n",
-                                   "tiny.nml"), cwd=tmp_path)
+    info = beamstops("info", write(tmp_path, text + "&stops lower=-1e-120, upper=1e-120 /\n", "tiny.nml"),
+                     cwd=tmp_path)
     assert info.returncode == 0, info.stderr
-    for text in (done.stdout, info.stdout):
+    for shown_text in (done.stdout, info.stdout):
         # a mantissa followed by a signed exponent without its e (gfortran's ES of |exponent| > 99)
-        assert not re.search(r"\d[-+]\d{3}\b", text), text
-    assert "support work -2.142e-118" in done.stdout
+        assert not re.search(r"\d[-+]\d{3}\b", shown_text), shown_text
+    work = re.search(r"support work (\S+),", done.stdout)
+    assert work is not None, done.stdout
     shown = {line[:29].strip(): line[29:].split() for line in info.stdout.splitlines()}
-    assert float(shown["&time dt"][0]) == 1e-60 and float(shown["&stops lower"][0]) == -1e-120
-    with h5py.File(tmp_path / "scene.h5") as f:  # the text attributes: the scene's canonical text
-        assert "dt = 1e-60" in f.attrs["scene"].decode() and f.attrs["dt"] == 1e-60
+    assert float(shown["&support amplitude"][0]) == 1e-60 and float(shown["&stops lower"][0]) == -1e-120
+    with h5py.File(tmp_path / "scene.h5") as f:  # the summary's number is the file's, to its 4 digits
+        assert 0 < abs(f.attrs["work"]) < 1e-99
+        assert float(work.group(1)) == pytest.approx(f.attrs["work"], rel=1e-3)
+        assert "amplitude = 1e-60" in f.attrs["scene"].decode() and f.attrs["amplitude"] == 1e-60

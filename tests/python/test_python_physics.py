@@ -75,7 +75,7 @@ BAD = [
     ("&stops restitution = 1.5 /", "&stops restitution = 1.5 is out of range; allowed: 0 <= restitution <= 1"),
     ("&stops restitution = -0.1 /", "&stops restitution = -0.1 is out of range"),
     ("&damping ratio = 0.02, mass_coefficient = 1 /", "&damping gives ratio together with mass_coefficient"),
-    ("&damping mass_coefficient = -1 /", "&damping mass_coefficient = -1 is out of range; allowed: mass_coefficient >= 0"),
+    ("&damping mass_coefficient = -1 /", "&damping mass_coefficient = -1 is out of range; allowed: 0 <= mass_coefficient <= "),
     ("&damping stiffness_coefficient = -1e-4 /", "&damping stiffness_coefficient = -0.0001 is out of range"),
     ("&stops mass = 'redistributed' /\n&time beta = 0, dt = 1e-6 /", "&stops mass = 'redistributed' needs beta > 0"),
     ("&stops law = 'compliance', stiffness = 1e7, restitution = 0.5 /",

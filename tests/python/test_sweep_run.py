@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -494,7 +495,10 @@ def test_a_point_the_engine_refuses_refuses_the_specification_before_anything_is
     lines = done.stderr.splitlines()
     assert len(lines) == 1 and lines[0].startswith(
         f"beamstops: error: {tmp_path / 'spec.toml'}: point 0 (omega=5): scene: &time dt = 0.001 is out of range; "
-        "allowed: dt < 1.23951e-05 s, the linear stability limit"), done.stderr
+        "allowed: dt < "), done.stderr
+    # the full model's limit (SPEC 3: 1.2395e-5 s at beta = 0), rounded down as shown
+    shown = re.search(r"allowed: dt < (\S+) s, the linear stability limit", lines[0])
+    assert shown is not None and 1.2394e-5 < float(shown.group(1)) <= 1.2395060e-5, lines[0]
     assert not (tmp_path / "out").exists()
     # the limit is that of the model the point runs: a reduced model's (&mesh modes = 4) is 1.3e-3 s
     reduced = UNSTABLE.replace("beta = 0", "beta = 0\nmodes = 4")

@@ -214,7 +214,7 @@ def test_dry_run_lists_points_and_refuses_a_point_the_engine_refuses(capsys: pyt
     path = write_spec("[scene]\nt_end = 0.1\n[axes]\ndt = [1e-4, 0.5]\n")
     assert cli.main(["sweep", str(path), "--dry-run"]) == 1
     err = capsys.readouterr().err
-    assert "point 1 (dt=0.5): scene: &time dt = 0.5 is out of range; allowed: 0 < dt <= t_end" in err
+    assert "point 1 (dt=0.5): scene: &time dt = 0.5 is out of range; allowed: 1e-15 <= dt <= t_end" in err
 
 
 def _mutations(data: dict[str, Any], rng: random.Random) -> dict[str, Any]:

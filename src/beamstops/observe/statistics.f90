@@ -151,6 +151,12 @@ module beamstops_observe_statistics
    !> failed allocation ended the program with a backtrace).
    integer, parameter :: max_batches = 1000, max_bins = 1000000, max_members = 10000
    integer(ik), parameter :: max_batch_bins = 10000000_ik
+   !> Longest rest time (s): the longest run (t_end <= 1e9 s); beyond it every contact phase of
+   !> a stop is one shock anyway.
+   real(wp), parameter :: max_rest_time = 1.0e9_wp
+   !> Largest magnitude of the histogram's range (m): a thousand times the stops' (|lower|,
+   !> upper <= 1e6 m), finite so that its bins are.
+   real(wp), parameter :: max_histogram = 1.0e9_wp
 
    !> First two values of packed statistics: their tag and the version of the layout.
    real(wp), parameter :: pack_tag = 7302, pack_version = 1
@@ -188,18 +194,20 @@ contains
          call say('bins', fmt_int(int(bins, ik)), 'bins*batches <= '//fmt_int(max_batch_bins)//' (every batch keeps '// &
             & 'its histogram; batches = '//fmt_int(int(batches, ik))//')'); return
       end if
-      if (.not. (ieee_is_finite(rest_time) .and. rest_time >= 0)) then
-         call say('rest_time', fmt_real(rest_time), 'rest_time >= 0 s'); return
+      if (.not. (rest_time >= 0 .and. rest_time <= max_rest_time)) then
+         call say('rest_time', fmt_real(rest_time), '0 <= rest_time <= '//fmt_real(max_rest_time)//' s'); return
       end if
       if (.not. (ieee_is_finite(transient) .and. transient >= 0 .and. transient < t_last)) then
          call say('transient', fmt_real(transient), '0 <= transient < '//fmt_real(t_last)// &
             & ' s, the time the run reaches (t_end in whole steps of dt)'); return
       end if
-      if (.not. ieee_is_finite(lower)) then
-         call say('histogram_lower', fmt_real(lower), 'a finite value (m)'); return
+      if (.not. (lower >= -max_histogram .and. lower < max_histogram)) then
+         call say('histogram_lower', fmt_real(lower), fmt_real(-max_histogram)//' <= histogram_lower < '// &
+            & fmt_real(max_histogram)//' m'); return
       end if
-      if (.not. (ieee_is_finite(upper) .and. upper > lower)) then
-         call say('histogram_upper', fmt_real(upper), 'histogram_upper > histogram_lower = '//fmt_real(lower)//' m')
+      if (.not. (upper > lower .and. upper <= max_histogram)) then
+         call say('histogram_upper', fmt_real(upper), 'histogram_lower = '//fmt_real(lower)//' < histogram_upper <= '// &
+            & fmt_real(max_histogram)//' m')
          return
       end if
    contains

@@ -409,6 +409,11 @@ contains
       !> Set when the output must not be written.
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: why, named, example
+      if (len(output) == 0) then
+         call fatal_error(error, input//': a namelist read from a pipe, a device or an open descriptor (/dev/stdin, '// &
+            & '/dev/fd/N, <(...)) gives no output name; allowed: name the output, -o OUT.h5 or &output file = ''OUT.h5''')
+         return
+      end if
       named = output//' ('//origin//'): '
       if (output(len(output):) == '/') then
          example = output(:verify(output, '/', back=.true.))
