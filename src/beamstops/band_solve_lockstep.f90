@@ -6,6 +6,18 @@
 !> Each row is one loop over the lanes (a compile-time width, marked for vectorization), so that
 !> a row is a few whole-register operations with no loop of its own to pay.
 !>
+!> Registers: with AVX2 (16 ymm registers of four doubles, no AVX-512) a row of the eight lanes
+!> is two registers, so that a loop whose body keeps more than a handful of row values and
+!> coefficients live spills them to the stack and reloads them every row. The loops are cut to
+!> fit: one row per loop over the lanes in the substitutions (the vectorizer broadcasts a loop's
+!> coefficients at its start: three rows in one loop held twelve broadcasts and the six running
+!> values at once), the periodic product's two rows in loops of their own (seven coefficients
+!> each, not fourteen), the forward substitution after the product rather than interleaved with
+!> it (its six running values stayed live across the product's rows), and g.d after the back
+!> substitution rather than riding on it (its six partial sums were spilled). gfortran 12,
+!> -march=znver3: no spill in those loops; bench_lockstep K = 8, J = 19 and 100: see
+!> docs/lockstep.md.
+!>
 !> Bit for bit: every routine performs, for each lane, the floating-point operations of its
 !> one-member counterpart in beamstops_band_solve, in the same order, with the same expressions
 !> and the same multiply-adds. The one-member routines are what the compiler made of them, and
@@ -48,26 +60,43 @@ contains
       type(band_solver), intent(in) :: solver
       !> Right-hand sides (lanes, n), replaced by D^{-2} w.
       real(wp), intent(inout) :: b(lockstep_lanes, solver%n)
+      call forward_rows(solver%n, solver%off, solver%inv_d2, b)
+   end subroutine lockstep_forward
+
+   !> The rows of lockstep_forward in explicit-shape arrays (every array at a fixed stride: the
+   !> rows of a turn address the factor from one register). Three rows a turn, as
+   !> beamstops_band_solve's forward_rows, each row a loop over the lanes of its own: its four
+   !> coefficients are broadcast at its start, so that a turn keeps the six running values (xa,
+   !> xb, xc of eight lanes) and one row's coefficients live, not the twelve of three rows.
+   pure subroutine forward_rows(n, off, inv_d2, b)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: off(kd, n), inv_d2(n)
+      real(wp), intent(inout) :: b(lockstep_lanes, n)
       real(wp) :: xa(lockstep_lanes), xb(lockstep_lanes), xc(lockstep_lanes)
-      integer :: j, k, n
-      n = solver%n
-      associate (off => solver%off, inv_d2 => solver%inv_d2)
-         call forward_first_rows(off, inv_d2, n, b, xa, xb, xc)
-         do j = kd + 1, n - 2, 3
+      integer :: j, k
+      call forward_first_rows(off, inv_d2, n, b, xa, xb, xc)
+      do j = kd + 1, n - 2, 3
 !GCC$ ivdep
 !GCC$ vector
-            do k = 1, lockstep_lanes
-               xa(k) = b(k, j) - off(1, j)*xa(k) - off(2, j)*xb(k) - off(3, j)*xc(k)
-               b(k, j) = xa(k)*inv_d2(j)
-               xb(k) = b(k, j + 1) - off(1, j + 1)*xb(k) - off(2, j + 1)*xc(k) - off(3, j + 1)*xa(k)
-               b(k, j + 1) = xb(k)*inv_d2(j + 1)
-               xc(k) = b(k, j + 2) - off(1, j + 2)*xc(k) - off(2, j + 2)*xa(k) - off(3, j + 2)*xb(k)
-               b(k, j + 2) = xc(k)*inv_d2(j + 2)
-            end do
+         do k = 1, lockstep_lanes
+            xa(k) = b(k, j) - off(1, j)*xa(k) - off(2, j)*xb(k) - off(3, j)*xc(k)
+            b(k, j) = xa(k)*inv_d2(j)
          end do
-         call forward_last_rows(off, inv_d2, j, n, b, xa, xb, xc)
-      end associate
-   end subroutine lockstep_forward
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            xb(k) = b(k, j + 1) - off(1, j + 1)*xb(k) - off(2, j + 1)*xc(k) - off(3, j + 1)*xa(k)
+            b(k, j + 1) = xb(k)*inv_d2(j + 1)
+         end do
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            xc(k) = b(k, j + 2) - off(1, j + 2)*xc(k) - off(2, j + 2)*xa(k) - off(3, j + 2)*xb(k)
+            b(k, j + 2) = xc(k)*inv_d2(j + 2)
+         end do
+      end do
+      call forward_last_rows(off, inv_d2, j, n, b, xa, xb, xc)
+   end subroutine forward_rows
 
    !> The first three rows of the forward substitution of every lane: b(:, 1:3) replaced by
    !> D^{-2} w(:, 1:3), w(:, 1:3) returned in xa, xb, xc (beamstops_band_solve's first_rows).
@@ -184,49 +213,63 @@ contains
       type(band_solver), intent(in) :: solver
       !> D^{-2} w (lanes, n), replaced by x.
       real(wp), intent(inout) :: b(lockstep_lanes, solver%n)
+      call back_rows(solver%n, solver%off, b)
+   end subroutine lockstep_back
+
+   !> The rows of lockstep_back in explicit-shape arrays, one loop over the lanes a row (as
+   !> forward_rows).
+   pure subroutine back_rows(n, off, b)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: off(kd, n)
+      real(wp), intent(inout) :: b(lockstep_lanes, n)
       real(wp) :: xa(lockstep_lanes), xb(lockstep_lanes), xc(lockstep_lanes)
-      integer :: i, k, n
-      n = solver%n
-      associate (off => solver%off)
+      integer :: i, k
+!GCC$ ivdep
+!GCC$ vector
+      do k = 1, lockstep_lanes
          ! the edge rows, farthest value first (as back_rows)
-         b(:, n - 1) = b(:, n - 1) - off(3, n)*b(:, n)
-         b(:, n - 2) = b(:, n - 2) - off(2, n)*b(:, n) - off(3, n - 1)*b(:, n - 1)
+         b(k, n - 1) = b(k, n - 1) - off(3, n)*b(k, n)
+         b(k, n - 2) = b(k, n - 2) - off(2, n)*b(k, n) - off(3, n - 1)*b(k, n - 1)
+         xa(k) = b(k, n)
+         xb(k) = b(k, n - 1)
+         xc(k) = b(k, n - 2)
+      end do
+      do i = n - kd, 3, -3
 !GCC$ ivdep
 !GCC$ vector
          do k = 1, lockstep_lanes
-            xa(k) = b(k, n)
-            xb(k) = b(k, n - 1)
-            xc(k) = b(k, n - 2)
+            xa(k) = b(k, i) - off(1, i + 3)*xa(k) - off(2, i + 2)*xb(k) - off(3, i + 1)*xc(k)
+            b(k, i) = xa(k)
          end do
-         do i = n - kd, 3, -3
 !GCC$ ivdep
 !GCC$ vector
-            do k = 1, lockstep_lanes
-               xa(k) = b(k, i) - off(1, i + 3)*xa(k) - off(2, i + 2)*xb(k) - off(3, i + 1)*xc(k)
-               b(k, i) = xa(k)
-               xb(k) = b(k, i - 1) - off(1, i + 2)*xb(k) - off(2, i + 1)*xc(k) - off(3, i)*xa(k)
-               b(k, i - 1) = xb(k)
-               xc(k) = b(k, i - 2) - off(1, i + 1)*xc(k) - off(2, i)*xa(k) - off(3, i - 1)*xb(k)
-               b(k, i - 2) = xc(k)
-            end do
+         do k = 1, lockstep_lanes
+            xb(k) = b(k, i - 1) - off(1, i + 2)*xb(k) - off(2, i + 1)*xc(k) - off(3, i)*xa(k)
+            b(k, i - 1) = xb(k)
          end do
-         if (i >= 1) then
 !GCC$ ivdep
 !GCC$ vector
-            do k = 1, lockstep_lanes
-               xa(k) = b(k, i) - off(1, i + 3)*xa(k) - off(2, i + 2)*xb(k) - off(3, i + 1)*xc(k)
-               b(k, i) = xa(k)
-            end do
-         end if
-         if (i - 1 >= 1) then
+         do k = 1, lockstep_lanes
+            xc(k) = b(k, i - 2) - off(1, i + 1)*xc(k) - off(2, i)*xa(k) - off(3, i - 1)*xb(k)
+            b(k, i - 2) = xc(k)
+         end do
+      end do
+      if (i >= 1) then
 !GCC$ ivdep
 !GCC$ vector
-            do k = 1, lockstep_lanes
-               b(k, i - 1) = b(k, i - 1) - off(1, i + 2)*xb(k) - off(2, i + 1)*xc(k) - off(3, i)*xa(k)
-            end do
-         end if
-      end associate
-   end subroutine lockstep_back
+         do k = 1, lockstep_lanes
+            xa(k) = b(k, i) - off(1, i + 3)*xa(k) - off(2, i + 2)*xb(k) - off(3, i + 1)*xc(k)
+            b(k, i) = xa(k)
+         end do
+      end if
+      if (i - 1 >= 1) then
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            b(k, i - 1) = b(k, i - 1) - off(1, i + 2)*xb(k) - off(2, i + 1)*xc(k) - off(3, i)*xa(k)
+         end do
+      end if
+   end subroutine back_rows
 
    !> The first rows of lockstep_back, x_n, x_{n-1} and x_{n-2} of every lane (beamstops_band_solve's
    !> back_substitution_edge): the tip value x_{n-1} that the contact law needs before the rest
@@ -236,20 +279,26 @@ contains
       type(band_solver), intent(in) :: solver
       !> D^{-2} w (lanes, n); its last kd rows replaced by those of x.
       real(wp), intent(inout) :: b(lockstep_lanes, solver%n)
-      integer :: n
+      integer :: k, n
       n = solver%n
       associate (off => solver%off)
-         ! farthest value first (as back_rows)
-         b(:, n - 1) = b(:, n - 1) - off(3, n)*b(:, n)
-         b(:, n - 2) = b(:, n - 2) - off(2, n)*b(:, n) - off(3, n - 1)*b(:, n - 1)
+         ! farthest value first (as back_rows); a loop over the lanes (the sections b(:, n - 1)
+         ! were scalar code, a loop of their own each)
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
+            b(k, n - 1) = b(k, n - 1) - off(3, n)*b(k, n)
+            b(k, n - 2) = b(k, n - 2) - off(2, n)*b(k, n) - off(3, n - 1)*b(k, n - 1)
+         end do
       end associate
    end subroutine lockstep_back_edge
 
    !> The rest of lockstep_back after lockstep_back_edge, each row of x followed at once by its
    !> row of the update (lockstep_update: d = d + x + c z, u = u + d), so that the update rides in
    !> the shadow of the substitution's chain instead of a pass of its own, and x itself is not
-   !> stored (the update is its only use). Per lane the same operations as lockstep_back then
-   !> lockstep_update (the update of a row needs only that row).
+   !> stored (the update is its only use); then g.d^n (lockstep_load_work). Per lane the same
+   !> operations as lockstep_back, lockstep_update then lockstep_load_work (the update of a row
+   !> needs only that row).
    pure subroutine lockstep_back_update(solver, b, c, z, g, d, u, gd)
       !> Solver from prepare_solver.
       type(band_solver), intent(in) :: solver
@@ -265,17 +314,19 @@ contains
       real(wp), intent(inout) :: d(lockstep_lanes, solver%n), u(lockstep_lanes, solver%n)
       !> g.d^n of every lane (lanes; beamstops_band_solve's load_work_product).
       real(wp), intent(out) :: gd(lockstep_lanes)
-      call back_update_rows(solver%n, solver%off, b, c, z, g, d, u, gd)
+      call back_update_rows(solver%n, solver%off, b, c, z, d, u)
+      call lockstep_load_work(solver%n, g, d, gd)
    end subroutine lockstep_back_update
 
-   !> The rows of lockstep_back_update in explicit-shape arrays (as matvec_rhs_forward_rows).
-   pure subroutine back_update_rows(n, off, b, c, z, g, d, u, gd)
+   !> The rows of lockstep_back_update in explicit-shape arrays, one loop over the lanes a row (as
+   !> forward_rows). g.d is not taken here: its three partial sums of eight lanes beside the six
+   !> running values and c did not fit in the sixteen registers of AVX2 and were spilled and
+   !> reloaded every row; lockstep_load_work takes it after, in the same order.
+   pure subroutine back_update_rows(n, off, b, c, z, d, u)
       integer, intent(in) :: n
-      real(wp), intent(in) :: off(kd, n), b(lockstep_lanes, n), c(lockstep_lanes), z(n), g(lockstep_lanes, n)
+      real(wp), intent(in) :: off(kd, n), b(lockstep_lanes, n), c(lockstep_lanes), z(n)
       real(wp), intent(inout) :: d(lockstep_lanes, n), u(lockstep_lanes, n)
-      real(wp), intent(out) :: gd(lockstep_lanes)
       real(wp) :: xa(lockstep_lanes), xb(lockstep_lanes), xc(lockstep_lanes)
-      real(wp) :: ga(lockstep_lanes), gb(lockstep_lanes), gc(lockstep_lanes)
       integer :: i, k
 !GCC$ ivdep
 !GCC$ vector
@@ -285,13 +336,10 @@ contains
          xc(k) = b(k, n - 2)
          d(k, n) = d(k, n) + xa(k) + c(k)*z(n)
          u(k, n) = u(k, n) + d(k, n)
-         ga(k) = g(k, n)*d(k, n)
          d(k, n - 1) = d(k, n - 1) + xb(k) + c(k)*z(n - 1)
          u(k, n - 1) = u(k, n - 1) + d(k, n - 1)
-         gb(k) = g(k, n - 1)*d(k, n - 1)
          d(k, n - 2) = d(k, n - 2) + xc(k) + c(k)*z(n - 2)
          u(k, n - 2) = u(k, n - 2) + d(k, n - 2)
-         gc(k) = g(k, n - 2)*d(k, n - 2)
       end do
       do i = n - kd, 3, -3
 !GCC$ ivdep
@@ -300,15 +348,20 @@ contains
             xa(k) = b(k, i) - off(1, i + 3)*xa(k) - off(2, i + 2)*xb(k) - off(3, i + 1)*xc(k)
             d(k, i) = d(k, i) + xa(k) + c(k)*z(i)
             u(k, i) = u(k, i) + d(k, i)
-            ga(k) = ga(k) + g(k, i)*d(k, i)
+         end do
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
             xb(k) = b(k, i - 1) - off(1, i + 2)*xb(k) - off(2, i + 1)*xc(k) - off(3, i)*xa(k)
             d(k, i - 1) = d(k, i - 1) + xb(k) + c(k)*z(i - 1)
             u(k, i - 1) = u(k, i - 1) + d(k, i - 1)
-            gb(k) = gb(k) + g(k, i - 1)*d(k, i - 1)
+         end do
+!GCC$ ivdep
+!GCC$ vector
+         do k = 1, lockstep_lanes
             xc(k) = b(k, i - 2) - off(1, i + 1)*xc(k) - off(2, i)*xa(k) - off(3, i - 1)*xb(k)
             d(k, i - 2) = d(k, i - 2) + xc(k) + c(k)*z(i - 2)
             u(k, i - 2) = u(k, i - 2) + d(k, i - 2)
-            gc(k) = gc(k) + g(k, i - 2)*d(k, i - 2)
          end do
       end do
       if (i >= 1) then
@@ -318,7 +371,6 @@ contains
             xa(k) = b(k, i) - off(1, i + 3)*xa(k) - off(2, i + 2)*xb(k) - off(3, i + 1)*xc(k)
             d(k, i) = d(k, i) + xa(k) + c(k)*z(i)
             u(k, i) = u(k, i) + d(k, i)
-            ga(k) = ga(k) + g(k, i)*d(k, i)
          end do
       end if
       if (i - 1 >= 1) then
@@ -328,14 +380,8 @@ contains
             xb(k) = b(k, i - 1) - off(1, i + 2)*xb(k) - off(2, i + 1)*xc(k) - off(3, i)*xa(k)
             d(k, i - 1) = d(k, i - 1) + xb(k) + c(k)*z(i - 1)
             u(k, i - 1) = u(k, i - 1) + d(k, i - 1)
-            gb(k) = gb(k) + g(k, i - 1)*d(k, i - 1)
          end do
       end if
-!GCC$ ivdep
-!GCC$ vector
-      do k = 1, lockstep_lanes
-         gd(k) = (ga(k) + gb(k)) + gc(k)
-      end do
    end subroutine back_update_rows
 
    !> g.d of every lane in the order of beamstops_band_solve's load_work_product (row j in sum
@@ -523,7 +569,8 @@ contains
    end subroutine lockstep_matvec_rhs
 
    !> The interior rows kd+1 .. n-kd of lockstep_matvec_rhs with period-2 coefficients `rows`:
-   !> y = S x and rhs = a g - b y there.
+   !> y = S x and rhs = a g - b y there, the rows of each coefficient set in a loop of their own
+   !> (periodic_half).
    pure subroutine matvec_rhs_periodic_rows(n, rows, x, a, g, b, y, rhs)
       !> Unknowns.
       integer, intent(in) :: n
@@ -533,32 +580,40 @@ contains
       real(wp), intent(in) :: x(lockstep_lanes, n), a(lockstep_lanes), g(lockstep_lanes, n), b
       !> S x and the right-hand sides (lanes, n), their interior rows set.
       real(wp), intent(inout) :: y(lockstep_lanes, n), rhs(lockstep_lanes, n)
-      real(wp) :: p1, p2, p3, p4, p5, p6, p7, q1, q2, q3, q4, q5, q6, q7
+      ! n - 2 kd interior rows: n = 2J and 2 kd are even, so as many of each
+      call periodic_half(n, kd + 1, rows(:, 1), x, a, g, b, y, rhs)
+      call periodic_half(n, kd + 2, rows(:, 2), x, a, g, b, y, rhs)
+   end subroutine matvec_rhs_periodic_rows
+
+   !> The interior rows first, first + 2, .. <= n - kd of matvec_rhs_periodic_rows, all with the
+   !> coefficients p: seven coefficients, dt^2 and the eight load weights stay in registers for
+   !> the loop (ten of the sixteen of AVX2; both rows' fourteen coefficients in one loop did not
+   !> fit and were reloaded from the stack every row).
+   pure subroutine periodic_half(n, first, p, x, a, g, b, y, rhs)
+      integer, intent(in) :: n, first
+      real(wp), intent(in) :: p(2*kd + 1)
+      real(wp), intent(in) :: x(lockstep_lanes, n), a(lockstep_lanes), g(lockstep_lanes, n), b
+      real(wp), intent(inout) :: y(lockstep_lanes, n), rhs(lockstep_lanes, n)
+      real(wp) :: p1, p2, p3, p4, p5, p6, p7
       integer :: j, k
-      p1 = rows(1, 1); p2 = rows(2, 1); p3 = rows(3, 1); p4 = rows(4, 1); p5 = rows(5, 1); p6 = rows(6, 1)
-      p7 = rows(7, 1)
-      q1 = rows(1, 2); q2 = rows(2, 2); q3 = rows(3, 2); q4 = rows(4, 2); q5 = rows(5, 2); q6 = rows(6, 2)
-      q7 = rows(7, 2)
-      ! n - 2 kd interior rows: n = 2J and 2 kd are even, so whole pairs
-      do j = kd + 1, n - kd - 1, 2
+      p1 = p(1); p2 = p(2); p3 = p(3); p4 = p(4); p5 = p(5); p6 = p(6); p7 = p(7)
+      do j = first, n - kd, 2
 !GCC$ ivdep
 !GCC$ vector
          do k = 1, lockstep_lanes
             y(k, j) = p1*x(k, j - 3) + p2*x(k, j - 2) + p3*x(k, j - 1) + p4*x(k, j) + p5*x(k, j + 1) &
                & + p6*x(k, j + 2) + p7*x(k, j + 3)
             rhs(k, j) = a(k)*g(k, j) - b*y(k, j)
-            y(k, j + 1) = q1*x(k, j - 2) + q2*x(k, j - 1) + q3*x(k, j) + q4*x(k, j + 1) + q5*x(k, j + 2) &
-               & + q6*x(k, j + 3) + q7*x(k, j + 4)
-            rhs(k, j + 1) = a(k)*g(k, j + 1) - b*y(k, j + 1)
          end do
       end do
-   end subroutine matvec_rhs_periodic_rows
+   end subroutine periodic_half
 
-   !> lockstep_matvec_rhs with `rows` (a periodic S) then lockstep_forward, in one pass: the
-   !> forward substitution follows the product six rows at a time, so that its chain (one
-   !> multiply-add a row) runs while the product of the next six rows is computed instead of
-   !> after the whole product. Each row's expressions are those of the two routines (the same
-   !> bits); rhs is returned as lockstep_forward leaves it (D^{-2} w).
+   !> lockstep_matvec_rhs with `rows` (a periodic S) then lockstep_forward: rhs is returned as
+   !> lockstep_forward leaves it (D^{-2} w). The forward substitution follows the whole product
+   !> (it was interleaved with it, six rows at a time, so that its chain would run in the
+   !> product's shadow; with AVX2 its six running values then stayed live across the product's
+   !> rows and pushed the coefficients out of the registers: the product and the substitution
+   !> are both bound by the multiply-adds they issue, so the interleaving won nothing back).
    pure subroutine lockstep_matvec_rhs_forward(stiffness, solver, rows, u, a, g, b, spring, su, rhs)
       !> S by diagonals and the factor of A.
       type(band_diagonals), intent(in) :: stiffness
@@ -576,82 +631,18 @@ contains
       call matvec_rhs_forward_rows(stiffness%n, stiffness%a, solver%off, solver%inv_d2, rows, u, a, g, b, spring, su, rhs)
    end subroutine lockstep_matvec_rhs_forward
 
-   !> The rows of lockstep_matvec_rhs_forward, all in one routine of explicit-shape arrays (as
-   !> beamstops_band_solve's forward_rows): every array at a fixed stride, so that the rows of a
-   !> block address the factor from one register (through the descriptors of solver%off and
-   !> stiffness%a, gfortran 12 kept an address per row and coefficient, 24 a block, and spilled
-   !> them: about 20 % slower, bench_lockstep), and the edge routines inlined. The forward rows
-   !> are written out here as in lockstep_forward: taken from a helper shared by the two (three
-   !> rows a turn while j <= last), the pass was 12 % slower at J = 19 and 15 % at J = 100
-   !> (bench_lockstep, A/B).
+   !> The rows of lockstep_matvec_rhs_forward in explicit-shape arrays (as forward_rows): every
+   !> array at a fixed stride (through the descriptors of solver%off and stiffness%a, gfortran 12
+   !> kept an address per row and coefficient and spilled them).
    pure subroutine matvec_rhs_forward_rows(n, s, off, inv_d2, rows, x, a, g, b, spring, y, rhs)
       integer, intent(in) :: n
       real(wp), intent(in) :: s(n, 0:kd), off(kd, n), inv_d2(n), rows(2*kd + 1, 2)
       real(wp), intent(in) :: x(lockstep_lanes, n), a(lockstep_lanes), g(lockstep_lanes, n), b, spring(lockstep_lanes)
       real(wp), intent(out) :: y(lockstep_lanes, n), rhs(lockstep_lanes, n)
-      real(wp) :: p1, p2, p3, p4, p5, p6, p7, q1, q2, q3, q4, q5, q6, q7
-      real(wp) :: xa(lockstep_lanes), xb(lockstep_lanes), xc(lockstep_lanes)
-      integer :: i, j, k
-      p1 = rows(1, 1); p2 = rows(2, 1); p3 = rows(3, 1); p4 = rows(4, 1); p5 = rows(5, 1); p6 = rows(6, 1)
-      p7 = rows(7, 1)
-      q1 = rows(1, 2); q2 = rows(2, 2); q3 = rows(3, 2); q4 = rows(4, 2); q5 = rows(5, 2); q6 = rows(6, 2)
-      q7 = rows(7, 2)
       call matvec_rhs_first_rows(n, s, x, a, g, b, y, rhs)
-      call forward_first_rows(off, inv_d2, n, rhs, xa, xb, xc)
-      j = kd + 1
-      do while (j + 5 <= n - kd)
-         do i = j, j + 4, 2
-!GCC$ ivdep
-!GCC$ vector
-            do k = 1, lockstep_lanes
-               y(k, i) = p1*x(k, i - 3) + p2*x(k, i - 2) + p3*x(k, i - 1) + p4*x(k, i) + p5*x(k, i + 1) &
-                  & + p6*x(k, i + 2) + p7*x(k, i + 3)
-               rhs(k, i) = a(k)*g(k, i) - b*y(k, i)
-               y(k, i + 1) = q1*x(k, i - 2) + q2*x(k, i - 1) + q3*x(k, i) + q4*x(k, i + 1) + q5*x(k, i + 2) &
-                  & + q6*x(k, i + 3) + q7*x(k, i + 4)
-               rhs(k, i + 1) = a(k)*g(k, i + 1) - b*y(k, i + 1)
-            end do
-         end do
-         do i = j, j + 3, 3
-!GCC$ ivdep
-!GCC$ vector
-            do k = 1, lockstep_lanes
-               xa(k) = rhs(k, i) - off(1, i)*xa(k) - off(2, i)*xb(k) - off(3, i)*xc(k)
-               rhs(k, i) = xa(k)*inv_d2(i)
-               xb(k) = rhs(k, i + 1) - off(1, i + 1)*xb(k) - off(2, i + 1)*xc(k) - off(3, i + 1)*xa(k)
-               rhs(k, i + 1) = xb(k)*inv_d2(i + 1)
-               xc(k) = rhs(k, i + 2) - off(1, i + 2)*xc(k) - off(2, i + 2)*xa(k) - off(3, i + 2)*xb(k)
-               rhs(k, i + 2) = xc(k)*inv_d2(i + 2)
-            end do
-         end do
-         j = j + 6
-      end do
-      do i = j, n - kd - 1, 2
-!GCC$ ivdep
-!GCC$ vector
-         do k = 1, lockstep_lanes
-            y(k, i) = p1*x(k, i - 3) + p2*x(k, i - 2) + p3*x(k, i - 1) + p4*x(k, i) + p5*x(k, i + 1) &
-               & + p6*x(k, i + 2) + p7*x(k, i + 3)
-            rhs(k, i) = a(k)*g(k, i) - b*y(k, i)
-            y(k, i + 1) = q1*x(k, i - 2) + q2*x(k, i - 1) + q3*x(k, i) + q4*x(k, i + 1) + q5*x(k, i + 2) &
-               & + q6*x(k, i + 3) + q7*x(k, i + 4)
-            rhs(k, i + 1) = a(k)*g(k, i + 1) - b*y(k, i + 1)
-         end do
-      end do
+      call matvec_rhs_periodic_rows(n, rows, x, a, g, b, y, rhs)
       call matvec_rhs_last_rows(n, s, x, a, g, b, spring, y, rhs)
-      do j = j, n - 2, 3
-!GCC$ ivdep
-!GCC$ vector
-         do k = 1, lockstep_lanes
-            xa(k) = rhs(k, j) - off(1, j)*xa(k) - off(2, j)*xb(k) - off(3, j)*xc(k)
-            rhs(k, j) = xa(k)*inv_d2(j)
-            xb(k) = rhs(k, j + 1) - off(1, j + 1)*xb(k) - off(2, j + 1)*xc(k) - off(3, j + 1)*xa(k)
-            rhs(k, j + 1) = xb(k)*inv_d2(j + 1)
-            xc(k) = rhs(k, j + 2) - off(1, j + 2)*xc(k) - off(2, j + 2)*xa(k) - off(3, j + 2)*xb(k)
-            rhs(k, j + 2) = xc(k)*inv_d2(j + 2)
-         end do
-      end do
-      call forward_last_rows(off, inv_d2, j, n, rhs, xa, xb, xc)
+      call forward_rows(n, off, inv_d2, rhs)
    end subroutine matvec_rhs_forward_rows
 
    !> Whether the interior rows kd+1 .. n-kd of a band matrix repeat with period 2, and the

@@ -569,7 +569,10 @@ contains
       type(observer_lanes), allocatable :: watch(:)
       type(chunk_store) :: w
       integer(ik) :: step, next_record, next_snapshot, load_k
-      integer :: k, c, tip, law
+      integer :: k, c, tip, law, tip_row
+      !> The index in w%store of each chunk's vectors (first(part, c) = w%at(part, c)), for the
+      !> steps of the block: at is a type-bound function, called through the type's table.
+      integer, allocatable :: first(:, :)
       logical :: energy_wanted, pending, observing, restart
       real(wp) :: z_tip, sums(3)
 
@@ -587,6 +590,13 @@ contains
       allocate (lanes(ms%chunks))
       call gather_lanes(scenes, ms, lanes)
       call fill_store(w, ms%u, ms%d, ms%su, ms%g)
+      allocate (first(part_u:part_g, ms%chunks))
+      do c = 1, ms%chunks
+         do k = part_u, part_g
+            first(k, c) = w%at(k, c)
+         end do
+      end do
+      tip_row = (tip - 1)*lockstep_lanes
       if (observing) call gather_observers(watch, ms%observers, ms%active(:ms%k))
       load_k = start_lanes_loads(lanes, ms%step + 1, model%dt)
       do step = ms%step, last
@@ -596,17 +606,17 @@ contains
          do c = 1, ms%chunks
             call lanes_begin_step(lanes(c), law, model%beta, model%dt2, restart, load_k + 1, model%dt)
             if (ops%periodic) then
-               call lockstep_matvec_rhs_forward(ops%stiffness, ops%solver, ops%stiffness_rows, w%store(w%at(part_u, c)), &
-                  & lanes(c)%coef, w%store(w%at(part_g, c)), model%dt2, lanes(c)%spring, w%store(w%at(part_su, c)), &
-                  & w%store(w%at(part_rhs, c)))
+               call lockstep_matvec_rhs_forward(ops%stiffness, ops%solver, ops%stiffness_rows, w%store(first(part_u, c)), &
+                  & lanes(c)%coef, w%store(first(part_g, c)), model%dt2, lanes(c)%spring, w%store(first(part_su, c)), &
+                  & w%store(first(part_rhs, c)))
             else
-               call lockstep_matvec_rhs(ops%stiffness, w%store(w%at(part_u, c)), lanes(c)%coef, w%store(w%at(part_g, c)), &
-                  & model%dt2, lanes(c)%spring, w%store(w%at(part_su, c)), w%store(w%at(part_rhs, c)))
-               call lockstep_forward(ops%solver, w%store(w%at(part_rhs, c)))
+               call lockstep_matvec_rhs(ops%stiffness, w%store(first(part_u, c)), lanes(c)%coef, w%store(first(part_g, c)), &
+                  & model%dt2, lanes(c)%spring, w%store(first(part_su, c)), w%store(first(part_rhs, c)))
+               call lockstep_forward(ops%solver, w%store(first(part_rhs, c)))
             end if
             if (energy_wanted) then
-               call lockstep_energy_dots(ops%mass, w%store(w%at(part_u, c)), w%store(w%at(part_d, c)), &
-                  & w%store(w%at(part_su, c)), lanes(c)%usu, lanes(c)%dsu, lanes(c)%dmd)
+               call lockstep_energy_dots(ops%mass, w%store(first(part_u, c)), w%store(first(part_d, c)), &
+                  & w%store(first(part_su, c)), lanes(c)%usu, lanes(c)%dsu, lanes(c)%dmd)
             end if
          end do
          load_k = load_k + 1
@@ -630,12 +640,12 @@ contains
             else
                lanes(c)%u_old_su = 0
             end if
-            call lockstep_back_edge(ops%solver, w%store(w%at(part_rhs, c)))
-            call lanes_contact(lanes(c), law, w%store(w%row(part_u, c, tip)), w%store(w%row(part_d, c, tip)), &
-               & w%store(w%row(part_rhs, c, tip)), z_tip, model%dt2, model%beta)
-            call lockstep_back_update(ops%solver, w%store(w%at(part_rhs, c)), lanes(c)%c, model%z, &
-               & w%store(w%at(part_g, c)), w%store(w%at(part_d, c)), w%store(w%at(part_u, c)), lanes(c)%gd)
-            call lanes_close(lanes(c), law, w%store(w%row(part_u, c, tip)), w%store(w%row(part_d, c, tip)))
+            call lockstep_back_edge(ops%solver, w%store(first(part_rhs, c)))
+            call lanes_contact(lanes(c), law, w%store(first(part_u, c) + tip_row), w%store(first(part_d, c) + tip_row), &
+               & w%store(first(part_rhs, c) + tip_row), z_tip, model%dt2, model%beta)
+            call lockstep_back_update(ops%solver, w%store(first(part_rhs, c)), lanes(c)%c, model%z, &
+               & w%store(first(part_g, c)), w%store(first(part_d, c)), w%store(first(part_u, c)), lanes(c)%gd)
+            call lanes_close(lanes(c), law, w%store(first(part_u, c) + tip_row), w%store(first(part_d, c) + tip_row))
          end do
          ! the shock log and statistics of each member that keeps them (its quiet samples lane by
          ! lane, beamstops_observe_lanes)

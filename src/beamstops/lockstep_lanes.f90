@@ -50,6 +50,9 @@ module beamstops_lockstep_lanes
       real(wp) :: u_tip_prev(lockstep_lanes) = 0, d_tip_prev(lockstep_lanes) = 0, trial(lockstep_lanes) = 0, &
          & c(lockstep_lanes) = 0, tip_value(lockstep_lanes) = 0, r_step(lockstep_lanes) = 0, &
          & r_prev(lockstep_lanes) = 0, gd(lockstep_lanes) = 0, u_tip(lockstep_lanes) = 0
+      !> The step (Signorini): d^n_tip on the stop, the tip value less u^n_tip (taken where the
+      !> stops act).
+      real(wp) :: d_stop(lockstep_lanes) = 0
       !> The step: whether the stops act.
       logical :: contact(lockstep_lanes) = .false.
       !> The energy sums of the step (u.S u, d.S u, d.M d) and u^{n-1}.S u^{n-1} (0 when not wanted).
@@ -161,6 +164,7 @@ contains
             lanes%c(i) = (lanes%tip_value(i) - lanes%trial(i))/z_tip
             lanes%contact(i) = lanes%c(i) /= 0
             lanes%r_step(i) = lanes%c(i)/dt2
+            lanes%d_stop(i) = lanes%tip_value(i) - lanes%u_tip_prev(i)
          end do
       case (law_compliance)
          do i = 1, lockstep_lanes
@@ -192,10 +196,11 @@ contains
 !GCC$ ivdep
 !GCC$ vector
          do i = 1, lockstep_lanes
-            if (lanes%contact(i)) then
-               u_tip(i) = lanes%tip_value(i)
-               d_tip(i) = lanes%tip_value(i) - lanes%u_tip_prev(i)
-            end if
+            ! selects, not a branch per lane: d_stop was taken in lanes_contact for every lane
+            ! (a subtraction under the condition is not if-converted: it may trap), and the
+            ! condition is contact's own, c /= 0, a compare of doubles beside the doubles it selects
+            u_tip(i) = merge(lanes%tip_value(i), u_tip(i), lanes%c(i) /= 0)
+            d_tip(i) = merge(lanes%d_stop(i), d_tip(i), lanes%c(i) /= 0)
          end do
       end if
       if (law /= law_none) then

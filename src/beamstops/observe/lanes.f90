@@ -25,8 +25,10 @@ module beamstops_observe_lanes
    public :: observer_lanes, gather_observers, scatter_observers, observe_lanes, quiet_pass, count_quiet
 
    !> The values quiet samples read and change, per lane of a chunk. Each test of a quiet sample is
-   !> a compare of doubles (so that the chunk's test is a few whole-register compares): the lane's
-   !> last sample time is -huge when it takes none, the histogram's current bin is the interval
+   !> a compare of doubles (so that the chunk's test is a few whole-register compares): a lane
+   !> without a live observer passes every test (gather_observers: no deadline, batch end or last
+   !> sample time, at rest in bin 0), so that a chunk whose live lanes are quiet is counted in one
+   !> pass over all its lanes; the histogram's current bin is the interval
    !> [bin_low, bin_low + 1) of (u - lower) scale, and the shock log's deadline is counted down
    !> in `left` = deadline - k - 1, the quiet samples still allowed (exact below 2^53; a deadline
    !> of huge stays above 0).
@@ -35,8 +37,8 @@ module beamstops_observe_lanes
       !> (the member runs and observes).
       integer :: member(lockstep_lanes) = 0
       logical :: live(lockstep_lanes) = .false.
-      !> The observer's last sample time (s; -huge: none) and the stops' energy it has seen (per
-      !> unit mass).
+      !> The observer's last sample time (s; huge for a lane without a live observer) and the
+      !> stops' energy it has seen (per unit mass).
       real(wp) :: t_stop(lockstep_lanes) = -huge(1.0_wp), seen(lockstep_lanes) = 0
       !> The shock log: samples seen; quiet samples left before the deadline; the tip's last two
       !> values.
@@ -52,7 +54,9 @@ module beamstops_observe_lanes
 contains
 
    !> The lanes of every chunk (lockstep_lanes members each, in order) from the members'
-   !> observers, live for the members that run and observe.
+   !> observers, live for the members that run and observe; the other lanes (and the padding
+   !> lanes of the last chunk) are made to pass quiet_fails' tests at rest (observe_lanes counts
+   !> their samples in values no observer takes back).
    subroutine gather_observers(lanes, observers, running)
       !> The chunks' lanes, one per chunk.
       type(observer_lanes), allocatable, intent(out) :: lanes(:)
@@ -63,6 +67,9 @@ contains
       integer :: c, i, k
       allocate (lanes((size(observers) + lockstep_lanes - 1)/lockstep_lanes))
       do c = 1, size(lanes)
+         lanes(c)%t_stop = huge(1.0_wp)
+         lanes(c)%left = huge(1.0_wp)
+         lanes(c)%next_edge = huge(1.0_wp)
          do i = 1, lockstep_lanes
             k = (c - 1)*lockstep_lanes + i
             if (k > size(observers)) exit
@@ -98,32 +105,36 @@ contains
       real(wp), intent(in) :: t
       !> Tip displacement (m), reaction and energy taken so far per unit mass, of every lane.
       real(wp), intent(in) :: u_tip(lockstep_lanes), reaction(lockstep_lanes), dissipated(lockstep_lanes)
-      logical :: quiet(lockstep_lanes), other(lockstep_lanes)
-      real(wp) :: pass(lockstep_lanes)
+      integer(ik) :: fails(lockstep_lanes), total
       integer :: i
-      ! quiet_pass and count_quiet lane by lane: whole-register compares, selects and adds
+      ! quiet_fails lane by lane: whole-register compares, masks and adds
+      total = 0
 !GCC$ ivdep
 !GCC$ vector
       do i = 1, lockstep_lanes
-         pass(i) = quiet_pass(t, u_tip(i), reaction(i), dissipated(i), lanes%seen(i), lanes%left(i), &
+         fails(i) = quiet_fails(t, u_tip(i), reaction(i), dissipated(i), lanes%seen(i), lanes%left(i), &
             & lanes%next_edge(i), lanes%lower(i), lanes%scale(i), lanes%top(i), lanes%bin_low(i), lanes%t_stop(i))
-         quiet(i) = pass(i) > 0
-         other(i) = t <= lanes%t_stop(i) .neqv. quiet(i)
+         total = total + fails(i)
       end do
-!GCC$ ivdep
-!GCC$ vector
+      if (total == 0) then
+         ! every lane quiet (most steps): count_quiet over all the lanes, whole-register operations
+         ! with no select (a select of the counts by lane is not vectorized by gfortran 12: the
+         ! arithmetic of the lanes that keep their values would be speculated, and it may trap)
+         call count_quiet(u_tip, lanes%k, lanes%left, lanes%u1, lanes%u2, lanes%su, lanes%suu, lanes%umin, lanes%umax, &
+            & lanes%n)
+         return
+      end if
       do i = 1, lockstep_lanes
-         if (quiet(i)) call count_quiet(u_tip(i), lanes%k(i), lanes%left(i), lanes%u1(i), lanes%u2(i), lanes%su(i), &
-            & lanes%suu(i), lanes%umin(i), lanes%umax(i), lanes%n(i))
-      end do
-      if (.not. any(other)) return
-      do i = 1, lockstep_lanes
-         if (.not. other(i)) cycle
-         associate (observer => observers(lanes%member(i)))
-            call give(lanes, i, observer)
-            call observer%tip(t, u_tip(i), reaction(i), dissipated(i))
-            call take(lanes, i, observer)
-         end associate
+         if (fails(i) == 0) then
+            call count_quiet(u_tip(i), lanes%k(i), lanes%left(i), lanes%u1(i), lanes%u2(i), lanes%su(i), lanes%suu(i), &
+               & lanes%umin(i), lanes%umax(i), lanes%n(i))
+         else if (lanes%live(i) .and. t <= lanes%t_stop(i)) then
+            associate (observer => observers(lanes%member(i)))
+               call give(lanes, i, observer)
+               call observer%tip(t, u_tip(i), reaction(i), dissipated(i))
+               call take(lanes, i, observer)
+            end associate
+         end if
       end do
    end subroutine observe_lanes
 
@@ -147,6 +158,25 @@ contains
          & *merge(1.0_wp, 0.0_wp, x >= bin_low)*merge(1.0_wp, 0.0_wp, x < bin_low + 1) &
          & *merge(1.0_wp, 0.0_wp, abs(u_tip) <= huge(1.0_wp))*merge(1.0_wp, 0.0_wp, t <= t_stop)
    end function quiet_pass
+
+   !> The number of quiet_pass's tests the sample fails (0: quiet), each test 0 or 1 by an integer
+   !> merge and the results added: whole-register compares, masks and integer adds for a chunk's
+   !> lanes (observe_lanes). quiet_pass's product of real merges is branches per lane and test with
+   !> gfortran 12: an operation on a merge's result is folded into both arms of a select, and a
+   !> floating-point operation in an arm may trap, so the select is not if-converted.
+   elemental integer(ik) function quiet_fails(t, u_tip, reaction, dissipated, seen, left, next_edge, lower, scale, &
+      & top, bin_low, t_stop) result(fails)
+      !> The sample: t (s), tip (m), reaction and energy taken so far (per unit mass).
+      real(wp), intent(in) :: t, u_tip, reaction, dissipated
+      !> The observer's values (observer_lanes).
+      real(wp), intent(in) :: seen, left, next_edge, lower, scale, top, bin_low, t_stop
+      real(wp) :: x
+      x = min(max((u_tip - lower)*scale, 0.0_wp), top)
+      fails = merge(0_ik, 1_ik, reaction == 0) + merge(0_ik, 1_ik, dissipated == seen) &
+         & + merge(0_ik, 1_ik, left > 0) + merge(0_ik, 1_ik, t < next_edge) &
+         & + merge(0_ik, 1_ik, x >= bin_low) + merge(0_ik, 1_ik, x < bin_low + 1) &
+         & + merge(0_ik, 1_ik, abs(u_tip) <= huge(1.0_wp)) + merge(0_ik, 1_ik, t <= t_stop)
+   end function quiet_fails
 
    !> A quiet sample u_tip: what the shock log's step_tip and the statistics' tip_sample do with it
    !> (count it, shift the tip's last two values, add to the sums and extremes), in their order.
