@@ -138,31 +138,26 @@ contains
       end do
    end subroutine observe_lanes
 
-   !> 1 when the sample of t (tip u_tip, the reaction, the stops' energy so far) is quiet for an
-   !> observer with these values (observer_lanes' components), else 0: taken (t <= t_stop), no
-   !> reaction, no energy (dissipated == seen), before the deadline and the batch's end, in the
-   !> run's bin (tip_sample's bin is int(x), x clamped to [0, bins - 1/2]), finite. Each test gives
-   !> 1 or 0 by merge and the tests are multiplied: whole-register compares and selects, where tests
-   !> joined by .and. become a branch per lane and test (a compare may trap, so the compiler keeps
-   !> them in order). beamstops_observe_quiet uses it for one scene.
+   !> 1 when the sample of t is quiet for an observer with these values (observer_lanes'
+   !> components), else 0: quiet_fails finds no failed test. beamstops_observe_quiet uses it for
+   !> one scene.
    elemental real(wp) function quiet_pass(t, u_tip, reaction, dissipated, seen, left, next_edge, lower, scale, top, &
       & bin_low, t_stop) result(pass)
       !> The sample: t (s), tip (m), reaction and energy taken so far (per unit mass).
       real(wp), intent(in) :: t, u_tip, reaction, dissipated
       !> The observer's values (observer_lanes).
       real(wp), intent(in) :: seen, left, next_edge, lower, scale, top, bin_low, t_stop
-      real(wp) :: x
-      x = min(max((u_tip - lower)*scale, 0.0_wp), top)
-      pass = merge(1.0_wp, 0.0_wp, reaction == 0)*merge(1.0_wp, 0.0_wp, dissipated == seen) &
-         & *merge(1.0_wp, 0.0_wp, left > 0)*merge(1.0_wp, 0.0_wp, t < next_edge) &
-         & *merge(1.0_wp, 0.0_wp, x >= bin_low)*merge(1.0_wp, 0.0_wp, x < bin_low + 1) &
-         & *merge(1.0_wp, 0.0_wp, abs(u_tip) <= huge(1.0_wp))*merge(1.0_wp, 0.0_wp, t <= t_stop)
+      pass = merge(1.0_wp, 0.0_wp, quiet_fails(t, u_tip, reaction, dissipated, seen, left, next_edge, lower, scale, &
+         & top, bin_low, t_stop) == 0)
    end function quiet_pass
 
-   !> The number of quiet_pass's tests the sample fails (0: quiet), each test 0 or 1 by an integer
-   !> merge and the results added: whole-register compares, masks and integer adds for a chunk's
-   !> lanes (observe_lanes). quiet_pass's product of real merges is branches per lane and test with
-   !> gfortran 12: an operation on a merge's result is folded into both arms of a select, and a
+   !> The number of tests the sample of t (tip u_tip, the reaction, the stops' energy so far) fails
+   !> for an observer with these values (0: quiet): taken (t <= t_stop), no reaction, no energy
+   !> (dissipated == seen), before the deadline and the batch's end, in the run's bin (tip_sample's
+   !> bin is int(x), x clamped to [0, bins - 1/2]), finite. Each test is 0 or 1 by an integer merge
+   !> and the results are added: whole-register compares, masks and integer adds for a chunk's
+   !> lanes (observe_lanes). A product of real merges is branches per lane and test with gfortran
+   !> 12: an operation on a merge's result is folded into both arms of a select, and a
    !> floating-point operation in an arm may trap, so the select is not if-converted.
    elemental integer(ik) function quiet_fails(t, u_tip, reaction, dissipated, seen, left, next_edge, lower, scale, &
       & top, bin_low, t_stop) result(fails)
