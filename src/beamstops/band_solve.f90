@@ -503,7 +503,13 @@ contains
    end function diagonal_row
 
    !> x . y with eight partial sums: the products vectorize and the dependency chain is
-   !> n/8 additions long instead of n (a fixed order, so the result is reproducible).
+   !> n/8 additions long instead of n (a fixed order, so the result is reproducible). Row j goes
+   !> into sum mod(j - 1, 8) + 1, the rows after the last eight too, each as sum + x y (one
+   !> multiply-add where the machine has them), then ((s1 + s5) + (s2 + s6)) + ((s3 + s7) + (s4 +
+   !> s8)). No running sum over the rows is left for the compiler to vectorize: it would add
+   !> them in order from a vector of products rounded first, or not, as its tuning decides
+   !> (gfortran 12 did for -march=x86-64-v3 and not for -march=znver3), and the lockstep lanes
+   !> (lockstep_dot) could not follow.
    pure function dot(x, y) result(s)
       !> Vectors of the same length.
       real(wp), intent(in), contiguous :: x(:), y(:)
@@ -515,9 +521,7 @@ contains
       do j = 1, n - 7, 8
          partial = partial + x(j:j + 7)*y(j:j + 7)
       end do
+      partial(:n - j + 1) = partial(:n - j + 1) + x(j:n)*y(j:n)
       s = ((partial(1) + partial(5)) + (partial(2) + partial(6))) + ((partial(3) + partial(7)) + (partial(4) + partial(8)))
-      do j = j, n
-         s = s + x(j)*y(j)
-      end do
    end function dot
 end module beamstops_band_solve

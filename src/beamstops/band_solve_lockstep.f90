@@ -20,16 +20,13 @@
 !>
 !> Bit for bit: every routine performs, for each lane, the floating-point operations of its
 !> one-member counterpart in beamstops_band_solve, in the same order, with the same expressions
-!> and the same multiply-adds. The one-member routines are what the compiler made of them, and
-!> in one place it rounds a product before adding it (gfortran 12, -O3, znver3: a running sum
-!> it vectorizes in order): dot's rows after the last eight, when four or more: the next four
-!> products rounded and added in order, the rest by multiply-adds. (The energy sums keep
-!> partial sums per row lane, energy_dots, so that no such place arises there.)
-!> Here that place rounds explicitly (add_rounded); everywhere else the
-!> multiply-adds are the compiler's, as in the one-member routines. tests/fortran/test_lockstep.f90
+!> and the same multiply-adds. The one-member routines are written so that the compiler has no
+!> choice of rounding to make: no running sum over rows that it could vectorize in order (the
+!> dot and energy sums keep partial sums per row lane), so that every product met by an addition
+!> is a multiply-add in both, whatever the vector width and tuning. tests/fortran/test_lockstep.f90
 !> checks every kernel lane by lane against its one-member counterpart (J = 4..13, 19, 20, 100,
-!> 101), and whole runs against the one-scene path: a change of compiler, flags or of
-!> beamstops_band_solve shows there first.
+!> 101), and whole runs against the one-scene path:
+!> a change of compiler, flags or of beamstops_band_solve shows there first.
 !>
 !> n >= 2 kd + 2 (J >= 4) is assumed; beamstops_lockstep refuses smaller meshes.
 module beamstops_band_solve_lockstep
@@ -473,8 +470,9 @@ contains
       end associate
    end subroutine lockstep_matvec
 
-   !> s_k = x_k . y_k of every lane with the eight partial sums of beamstops_band_solve's dot.
-   pure subroutine lockstep_dot(n, x, y, partial, s, positive)
+   !> s_k = x_k . y_k of every lane with the eight partial sums of beamstops_band_solve's dot
+   !> (row j in sum mod(j - 1, 8) + 1, the rows after the last eight too).
+   pure subroutine lockstep_dot(n, x, y, partial, s)
       !> Length of the vectors.
       integer, intent(in) :: n
       !> Vectors (lanes, n).
@@ -483,43 +481,35 @@ contains
       real(wp), intent(out) :: partial(lockstep_lanes, lockstep_work_columns)
       !> The dot products (lanes).
       real(wp), intent(out) :: s(lockstep_lanes)
-      !> Any positive number the compiler cannot see (add_rounded); the loop passes dt^2.
-      real(wp), intent(in) :: positive
-      integer :: j, k
-      if (n < 8) then
-         partial(:, 1:8) = 0
-         j = 1
-      else
-         ! the first eight rows start the partial sums from zero (0 + x y, no store of zeros
-         ! before them)
+      integer :: j, k, l
+      partial(:, 1:8) = 0
+      do j = 1, n - 7, 8
 !GCC$ ivdep
 !GCC$ vector
          do k = 1, lockstep_lanes
-            partial(k, 1) = 0.0_wp + x(k, 1)*y(k, 1)
-            partial(k, 2) = 0.0_wp + x(k, 2)*y(k, 2)
-            partial(k, 3) = 0.0_wp + x(k, 3)*y(k, 3)
-            partial(k, 4) = 0.0_wp + x(k, 4)*y(k, 4)
-            partial(k, 5) = 0.0_wp + x(k, 5)*y(k, 5)
-            partial(k, 6) = 0.0_wp + x(k, 6)*y(k, 6)
-            partial(k, 7) = 0.0_wp + x(k, 7)*y(k, 7)
-            partial(k, 8) = 0.0_wp + x(k, 8)*y(k, 8)
+            partial(k, 1) = partial(k, 1) + x(k, j)*y(k, j)
+            partial(k, 2) = partial(k, 2) + x(k, j + 1)*y(k, j + 1)
+            partial(k, 3) = partial(k, 3) + x(k, j + 2)*y(k, j + 2)
+            partial(k, 4) = partial(k, 4) + x(k, j + 3)*y(k, j + 3)
+            partial(k, 5) = partial(k, 5) + x(k, j + 4)*y(k, j + 4)
+            partial(k, 6) = partial(k, 6) + x(k, j + 5)*y(k, j + 5)
+            partial(k, 7) = partial(k, 7) + x(k, j + 6)*y(k, j + 6)
+            partial(k, 8) = partial(k, 8) + x(k, j + 7)*y(k, j + 7)
          end do
-         do j = 9, n - 7, 8
+      end do
+      do l = 1, n - j + 1
 !GCC$ ivdep
 !GCC$ vector
-            do k = 1, lockstep_lanes
-               partial(k, 1) = partial(k, 1) + x(k, j)*y(k, j)
-               partial(k, 2) = partial(k, 2) + x(k, j + 1)*y(k, j + 1)
-               partial(k, 3) = partial(k, 3) + x(k, j + 2)*y(k, j + 2)
-               partial(k, 4) = partial(k, 4) + x(k, j + 3)*y(k, j + 3)
-               partial(k, 5) = partial(k, 5) + x(k, j + 4)*y(k, j + 4)
-               partial(k, 6) = partial(k, 6) + x(k, j + 5)*y(k, j + 5)
-               partial(k, 7) = partial(k, 7) + x(k, j + 6)*y(k, j + 6)
-               partial(k, 8) = partial(k, 8) + x(k, j + 7)*y(k, j + 7)
-            end do
+         do k = 1, lockstep_lanes
+            partial(k, l) = partial(k, l) + x(k, j + l - 1)*y(k, j + l - 1)
          end do
-      end if
-      call dot_tail(n, j, x, y, partial, s, positive)
+      end do
+!GCC$ ivdep
+!GCC$ vector
+      do k = 1, lockstep_lanes
+         s(k) = ((partial(k, 1) + partial(k, 5)) + (partial(k, 2) + partial(k, 6))) &
+            & + ((partial(k, 3) + partial(k, 7)) + (partial(k, 4) + partial(k, 8)))
+      end do
    end subroutine lockstep_dot
 
    !> lockstep_matvec (S u) and lockstep_rhs (rhs = a g - b S u + spring e_{n-1}) in one pass. With
@@ -716,44 +706,6 @@ contains
          end do
    end subroutine matvec_rhs_last_rows
 
-   !> The end of a dot product from the eight partial sums and the rows j..n after them
-   !> (lockstep_dot).
-   pure subroutine dot_tail(n, first, x, y, partial, s, positive)
-      integer, intent(in) :: n, first
-      real(wp), intent(in) :: x(lockstep_lanes, n), y(lockstep_lanes, n)
-      real(wp), intent(in) :: partial(lockstep_lanes, lockstep_work_columns)
-      real(wp), intent(out) :: s(lockstep_lanes)
-      real(wp), intent(in) :: positive
-      real(wp) :: t(lockstep_lanes), p(lockstep_lanes, 4)
-      integer :: j, k
-      j = first
-!GCC$ ivdep
-!GCC$ vector
-      do k = 1, lockstep_lanes
-         t(k) = ((partial(k, 1) + partial(k, 5)) + (partial(k, 2) + partial(k, 6))) &
-            & + ((partial(k, 3) + partial(k, 7)) + (partial(k, 4) + partial(k, 8)))
-      end do
-      ! the rows after the last eight: four or more, the next four products rounded and added
-      ! in order; then the rest (at most three) by multiply-adds (t local: the sums stay in
-      ! registers)
-      if (n - j + 1 >= 4) then
-         p = x(:, j:j + 3)*y(:, j:j + 3)
-         call add_rounded(t, p(:, 1), positive)
-         call add_rounded(t, p(:, 2), positive)
-         call add_rounded(t, p(:, 3), positive)
-         call add_rounded(t, p(:, 4), positive)
-         j = j + 4
-      end if
-      do j = j, n
-!GCC$ ivdep
-!GCC$ vector
-         do k = 1, lockstep_lanes
-            t(k) = t(k) + x(k, j)*y(k, j)
-         end do
-      end do
-      s = t
-   end subroutine dot_tail
-
    !> The right-hand sides of a step, rhs = a g - b S u plus `spring` in the tip row n-1 (the
    !> forward pass of beamstops_scheme), of every lane.
    pure subroutine lockstep_rhs(n, a, g, b, su, spring, rhs)
@@ -808,20 +760,4 @@ contains
          end do
       end do
    end subroutine lockstep_update
-
-   !> s = s + p with p already rounded: never contracted with the product that gave p. The
-   !> addition sits in a branch of its own (a multiply-add is formed only within one basic
-   !> block), on a condition the compiler cannot decide (positive > 0, always true: a value
-   !> read at run time), outside any loop (which could be unswitched on it), and p is used on
-   !> the other branch too, so that the product is not moved into it.
-   pure subroutine add_rounded(s, p, positive)
-      real(wp), intent(inout) :: s(lockstep_lanes)
-      real(wp), intent(in) :: p(lockstep_lanes)
-      real(wp), intent(in) :: positive
-      if (positive > 0) then
-         s = s + p
-      else
-         s = p
-      end if
-   end subroutine add_rounded
 end module beamstops_band_solve_lockstep

@@ -227,11 +227,9 @@ contains
             do c = 1, ms%chunks
                lo = (c - 1)*lockstep_lanes + 1
                hi = c*lockstep_lanes
-               call lockstep_dot(n, w%store(w%at(part_d, c)), w%store(w%at(part_cd, c)), ms%partial, ms%cross(lo:hi), &
-                  & model%dt2)
+               call lockstep_dot(n, w%store(w%at(part_d, c)), w%store(w%at(part_cd, c)), ms%partial, ms%cross(lo:hi))
                call lockstep_matvec(ops%damping, w%store(w%at(part_d, c)), w%store(w%at(part_cd, c)))
-               call lockstep_dot(n, w%store(w%at(part_d, c)), w%store(w%at(part_cd, c)), ms%partial, ms%dcd(lo:hi), &
-                  & model%dt2)
+               call lockstep_dot(n, w%store(w%at(part_d, c)), w%store(w%at(part_cd, c)), ms%partial, ms%dcd(lo:hi))
             end do
             call damping_lanes(model%dt, ms%cross, ms%dcd, ms%dcd_prev, ms%damped)
          end if

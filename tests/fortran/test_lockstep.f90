@@ -424,9 +424,11 @@ contains
                if (any(abs(f - e) > 4*n*epsilon(1.0_wp)*g)) call test_failed(error, where//'energy sums against '// &
                   & 'dot products, lane '//int_text(k))
             end do
-            call lockstep_dot(n, u, d, work, dd, 1.0_wp)
+            call lockstep_dot(n, u, d, work, dd)
             do k = 1, lanes
                if (.not. same_bits(dot(u(k, :), d(k, :)), dd(k))) call test_failed(error, where//'dot, lane '//int_text(k))
+               if (abs(dd(k) - sum(u(k, :)*d(k, :))) > n*epsilon(1.0_wp)*sum(abs(u(k, :)*d(k, :)))) &
+                  & call test_failed(error, where//'dot against the sum of its terms, lane '//int_text(k))
             end do
             b = d
             y = u
