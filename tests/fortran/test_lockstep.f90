@@ -25,6 +25,11 @@ module test_lockstep
    use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_work_columns, lockstep_matvec, &
       & lockstep_forward, lockstep_energy_dots, lockstep_back, lockstep_dot, lockstep_update, lockstep_back_edge, &
       & lockstep_back_update, lockstep_matvec_rhs, lockstep_periodic_rows, lockstep_matvec_rhs_forward, lockstep_load_work
+   use beamstops_band_solve_lockstep_narrow, only: narrow_forward_rows, narrow_back_rows, narrow_back_update_rows, &
+      & narrow_periodic_rows, narrow_matvec_rhs_forward_rows
+   use beamstops_band_solve_lockstep_wide, only: wide_forward_rows, wide_back_rows, wide_back_update_rows, &
+      & wide_periodic_rows, wide_matvec_rhs_forward_rows
+   use beamstops_machine, only: vector_registers
    use beamstops_contact_tip_contact, only: update
    use test_support, only: base_scene
    implicit none
@@ -35,6 +40,10 @@ module test_lockstep
       & same_bits, same_summary, same_records
    ! and of the suite lockstep_span (stops along the span)
    public :: compare_members
+
+   !> The meshes (J) of the kernel tests: every J from the smallest lockstep handles to 13 (each
+   !> remainder of the three-row turns and of the eight-row sums), the paper's 19, 20, 100, 101.
+   integer, parameter :: kernel_meshes(14) = [4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 19, 20, 100, 101]
 
    !> Columns of a record, for messages.
    character(len=10), parameter :: column_names(n_columns) = [character(len=10) :: 't', 'u', 'v', 'reaction', &
@@ -49,6 +58,8 @@ contains
       tests = [ &
          & new_unittest('kernels: each lane equals the one-member kernel to the bit, J = 4..13, 19, 20, 100, 101', &
          & test_kernels), &
+         & new_unittest('kernel shapes: the wide rows (32 vector registers) and the narrow ones (16) give the same '// &
+         & 'bits, J = 4..13, 19, 20, 100, 101', test_kernel_shapes), &
          & new_unittest('energy sums: each lane equals energy_dots to the bit and the dot products to round-off, '// &
          & 'n = 1..25, a band of random values', test_energy_sums), &
          & new_unittest('K = 1, Signorini, beta = 1/2', test_one), &
@@ -343,7 +354,7 @@ contains
    !> one-member kernels round (see the notes of beamstops_band_solve_lockstep).
    subroutine test_kernels(error)
       type(error_type), allocatable, intent(out) :: error
-      integer, parameter :: meshes(14) = [4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 19, 20, 100, 101]
+      integer, parameter :: meshes(14) = kernel_meshes
       integer, parameter :: lanes = lockstep_lanes
       type(scene_type) :: scene
       type(model_type) :: model
@@ -488,6 +499,97 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_kernels
+
+   !> The two shapes of the lockstep kernels' inner rows (beamstops_band_solve_lockstep_wide for 32
+   !> vector registers, beamstops_band_solve_lockstep_narrow for 16) on the same random inputs: the
+   !> same bits, every output. The build runs one of them (beamstops_machine); test_kernels and
+   !> the whole runs check that one against the one-scene path, and this test carries the check
+   !> over to the other.
+   subroutine test_kernel_shapes(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: lanes = lockstep_lanes
+      type(scene_type) :: scene
+      type(model_type) :: model
+      type(band_solver) :: solver
+      type(band_diagonals) :: s
+      real(wp), allocatable :: x(:, :), g(:, :), d(:, :), u(:, :), y(:, :, :), b(:, :, :), dd(:, :, :), uu(:, :, :)
+      real(wp) :: c(lanes), a(lanes), spring(lanes), gd(lanes, 2), rows(7, 2)
+      logical :: periodic
+      integer :: m, rep, n
+      character(len=:), allocatable :: where
+      call check(error, vector_registers == 16 .or. vector_registers == 32, 'vector registers: 16 or 32, not '// &
+         & int_text(vector_registers))
+      if (allocated(error)) return
+      do m = 1, size(kernel_meshes)
+         scene%elements = kernel_meshes(m)
+         scene%dt = 1.0e-5_wp
+         call build_model(scene, model, error)
+         if (allocated(error)) return
+         call prepare_solver(model%factor, solver)
+         call prepare_diagonals(model%stiffness, s)
+         call lockstep_periodic_rows(s, periodic, rows)
+         n = model%n
+         if (allocated(x)) deallocate (x, g, d, u, y, b, dd, uu)
+         allocate (x(lanes, n), g(lanes, n), d(lanes, n), u(lanes, n), y(lanes, n, 2), b(lanes, n, 2), &
+            & dd(lanes, n, 2), uu(lanes, n, 2))
+         where = 'J = '//int_text(kernel_meshes(m))//': '
+         do rep = 1, 10
+            call random_number(x)
+            call random_number(g)
+            call random_number(d)
+            call random_number(u)
+            call random_number(c)
+            call random_number(a)
+            call random_number(spring)
+            x = x - 0.5_wp
+            d = d - 0.5_wp
+            u = u - 0.5_wp
+            b(:, :, 1) = x
+            b(:, :, 2) = x
+            call wide_forward_rows(n, solver%off, solver%inv_d2, b(:, :, 1))
+            call narrow_forward_rows(n, solver%off, solver%inv_d2, b(:, :, 2))
+            call same_shapes(b, where//'forward substitution', error)
+            b(:, :, 1) = x
+            b(:, :, 2) = x
+            call wide_back_rows(n, solver%off, b(:, :, 1))
+            call narrow_back_rows(n, solver%off, b(:, :, 2))
+            call same_shapes(b, where//'back substitution', error)
+            dd(:, :, 1) = d
+            dd(:, :, 2) = d
+            uu(:, :, 1) = u
+            uu(:, :, 2) = u
+            call wide_back_update_rows(n, solver%off, x, c, model%z, g, dd(:, :, 1), uu(:, :, 1), gd(:, 1))
+            call narrow_back_update_rows(n, solver%off, x, c, model%z, g, dd(:, :, 2), uu(:, :, 2), gd(:, 2))
+            call same_shapes(dd, where//'back substitution with the update, d', error)
+            call same_shapes(uu, where//'back substitution with the update, u', error)
+            call check(error, all(same_bits(gd(:, 1), gd(:, 2))), where//'g.d taken with the back substitution')
+            if (allocated(error)) return
+            y = 0
+            b = 0
+            call wide_periodic_rows(n, rows, x, a, g, 1.0e-10_wp, y(:, :, 1), b(:, :, 1))
+            call narrow_periodic_rows(n, rows, x, a, g, 1.0e-10_wp, y(:, :, 2), b(:, :, 2))
+            call same_shapes(y, where//'S x, period-2 rows', error)
+            call same_shapes(b, where//'the right-hand side, period-2 rows', error)
+            call wide_matvec_rhs_forward_rows(n, s%a, solver%off, solver%inv_d2, rows, x, a, g, 1.0e-10_wp, spring, &
+               & y(:, :, 1), b(:, :, 1))
+            call narrow_matvec_rhs_forward_rows(n, s%a, solver%off, solver%inv_d2, rows, x, a, g, 1.0e-10_wp, spring, &
+               & y(:, :, 2), b(:, :, 2))
+            call same_shapes(y, where//'S x of the product with the forward substitution', error)
+            call same_shapes(b, where//'the product with the forward substitution', error)
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine test_kernel_shapes
+
+   !> Fails unless the two shapes' outputs v(:, :, 1) and v(:, :, 2) are the same bits.
+   subroutine same_shapes(v, what, error)
+      real(wp), intent(in) :: v(:, :, :)
+      character(len=*), intent(in) :: what
+      type(error_type), allocatable, intent(inout) :: error
+      if (allocated(error)) return
+      if (.not. all(same_bits(v(:, :, 1), v(:, :, 2)))) call test_failed(error, what//': the wide and narrow '// &
+         & 'shapes differ')
+   end subroutine same_shapes
 
    !> back_substitution_edge then back_substitution_update (x not stored, the update riding on
    !> the substitution) against back_substitution then update: d and u to the bit, and g.d^n
