@@ -13,7 +13,7 @@
  * about 190 instructions at n = 38 by its code (57 for the first eight rows, 18 a whole turn, 31
  * for the last rows, 30 for the three sums) where the Fortran rows took 283 (callgrind), the
  * largest part of the books of a recorded step (a record costs the step about in proportion to
- * its instructions: the README's "The Figure 4 run against its targets"). Without AVX-512 but with
+ * its instructions: docs/performance_notes.md, "The Figure 4 run against its targets"). Without AVX-512 but with
  * AVX2 and FMA, the same operations four rows a vector operation (the row-at-a-time loop took 1,426
  * instructions a step at n = 38 on such a machine, callgrind: the recorded step twice the plain
  * one). Without either, the same operations a row at a time. */

@@ -483,8 +483,9 @@ contains
 
    !> forward_pass without its options (no massless rows, no damping), for advance_fused: arrays
    !> of explicit shape, so that a call passes addresses only (forward_pass builds and unpacks five
-   !> array descriptors and five optional arguments at every call; the README's "The Figure 4 run
-   !> against its targets" has the instruction counts). The same operations: the same bits.
+   !> array descriptors and five optional arguments at every call; docs/performance_notes.md, "The
+   !> Figure 4 run against its targets", has the instruction counts). The same operations: the
+   !> same bits.
    subroutine plain_forward_pass(stiffness, mass, solver, n, g, u, d, a, b, spring, energy, su, rhs, usu, dsu, dmd)
       !> S and M by diagonals.
       type(band_diagonals), intent(in) :: stiffness, mass
