@@ -13,7 +13,9 @@ contains
    function fmt_real(x, digits, round) result(s)
       !> Value.
       real(wp), intent(in) :: x
-      !> At most this many significant digits (default: as many as needed to read back x).
+      !> At most this many significant digits (default: as many as needed to read back x); a
+      !> number written in fixed notation (below 1e6) keeps its digits before the point (4717
+      !> with two digits).
       integer, intent(in), optional :: digits
       !> With `digits`: 'down' or 'up' rounds the text toward minus or plus infinity (a bound
       !> shown rounded stays on its side: a value beyond the bound is beyond its text too);
@@ -23,8 +25,7 @@ contains
       character(len=40) :: buf, fmt
       character(len=:), allocatable :: mantissa
       character(len=3) :: mode
-      real(wp) :: y
-      integer :: p, e, stat
+      integer :: p, e, lo, hi
       if (.not. ieee_is_finite(x)) then
          write (buf, '(g0)') x
          s = trim(adjustl(buf))
@@ -35,15 +36,22 @@ contains
          if (round == 'down') mode = 'rd,'
          if (round == 'up') mode = 'ru,'
       end if
-      do p = 0, 16
-         write (fmt, '(a,i0,a)') '('//trim(mode)//'es30.', p, 'e3)'
-         write (buf, fmt) x
-         read (buf, *, iostat=stat) y
-         if (stat == 0 .and. y == x) exit
-         if (present(digits)) then
-            if (p + 1 >= digits) exit
+      ! the fewest digits after the point (p) that read back as x: a binary search, since a text
+      ! that reads back as x still does with more digits (it only comes nearer x); at most
+      ! `digits` significant digits (p <= digits - 1), 17 always read back (p = 16)
+      lo = 0
+      hi = 16
+      if (present(digits)) hi = max(0, min(hi, digits - 1))
+      do while (lo < hi)
+         p = (lo + hi)/2
+         if (reads_back(p)) then
+            hi = p
+         else
+            lo = p + 1
          end if
       end do
+      p = lo
+      write (buf, es_format(mode, p)) x
       buf = adjustl(buf)
       mantissa = buf(:index(buf, 'E') - 1)
       read (buf(index(buf, 'E') + 1:), *) e
@@ -66,7 +74,28 @@ contains
          write (buf, '(sp,i5.2)') e
          s = mantissa//'e'//trim(adjustl(buf))
       end if
+   contains
+      !> Whether x written with p digits after the point (es30.p, in `mode`) reads back as x.
+      logical function reads_back(p)
+         integer, intent(in) :: p
+         character(len=40) :: text
+         real(wp) :: y
+         integer :: stat
+         write (text, es_format(mode, p)) x
+         read (text, *, iostat=stat) y
+         reads_back = stat == 0 .and. y == x
+      end function reads_back
    end function fmt_real
+
+   !> The edit format (mode es30.p e3): mode '' (to the nearest), 'rd,' or 'ru,'.
+   pure function es_format(mode, p) result(f)
+      character(len=*), intent(in) :: mode
+      integer, intent(in) :: p
+      character(len=:), allocatable :: f
+      character(len=2) :: digits
+      write (digits, '(i2)') p
+      f = '('//trim(mode)//'es30.'//trim(adjustl(digits))//'e3)'
+   end function es_format
 
    !> Text of an integer.
    pure function fmt_int(i) result(s)

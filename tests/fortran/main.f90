@@ -31,6 +31,7 @@ program tester
    use test_reduced, only: collect_reduced
    use test_reduced_physics, only: collect_reduced_physics
    use test_writer, only: collect_writer
+   use test_strings, only: collect_strings
    implicit none
 
    abstract interface
@@ -64,6 +65,7 @@ program tester
       & new_testsuite('order', collect_order), &
       & new_testsuite('scheme', collect_scheme), &
       & new_testsuite('namelist', collect_namelist), &
+      & new_testsuite('strings', collect_strings), &
       & new_testsuite('box_qp', collect_box_qp), &
       & new_testsuite('stops', collect_stops), &
       & new_testsuite('run', collect_run), &
