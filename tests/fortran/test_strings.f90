@@ -37,11 +37,11 @@ contains
          ! a few values of few digits too (input-like)
          if (mod(k, 10) == 0) x = real(nint(1000*r(1)), wp)/8
          s = fmt_real(x)
-         call check(error, value_of(s) == x, 'fmt_real('//fmt_es(x)//') = '//s//' reads back as the same double')
+         call check(error, value_of(s) == x, 'fmt_real('//real_text(x)//') = '//s//' reads back as the same double')
          if (allocated(error)) return
          digits = significant_digits(s)
          if (digits > 1) then
-            call check(error, value_of(rounded_text(x, digits - 1)) /= x, 'fmt_real('//fmt_es(x)//') = '//s// &
+            call check(error, value_of(rounded_text(x, digits - 1)) /= x, 'fmt_real('//real_text(x)//') = '//s// &
                & ': one digit fewer does not read back')
             if (allocated(error)) return
          end if
@@ -75,12 +75,12 @@ contains
          d = 1 + mod(k, 6)
          down = fmt_real(x, d, 'down')
          up = fmt_real(x, d, 'up')
-         call check(error, value_of(down) <= x .and. x <= value_of(up), fmt_es(x)//' lies between '//down// &
+         call check(error, value_of(down) <= x .and. x <= value_of(up), real_text(x)//' lies between '//down// &
             & ' and '//up)
          if (allocated(error)) return
          call check(error, significant_digits(down) <= max(d, whole_digits(x)) .and. &
             & significant_digits(up) <= max(d, whole_digits(x) + 1), down//' and '//up//' have at most '// &
-            & fmt_es(real(d, wp))//' significant digits, or the digits before the point')
+            & int_text(d)//' significant digits, or the digits before the point')
          if (allocated(error)) return
       end do
    end subroutine test_rounded
@@ -132,14 +132,5 @@ contains
       whole_digits = 0
       if (abs(x) >= 1 .and. abs(x) < 1.0e6_wp) whole_digits = 1 + int(log10(abs(x)))
    end function whole_digits
-
-   !> x in es25.17 (messages).
-   function fmt_es(x) result(s)
-      real(wp), intent(in) :: x
-      character(len=:), allocatable :: s
-      character(len=30) :: buf
-      write (buf, '(es25.17)') x
-      s = trim(adjustl(buf))
-   end function fmt_es
 
 end module test_strings
