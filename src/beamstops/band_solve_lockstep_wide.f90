@@ -117,26 +117,11 @@ contains
             gc(k) = gc(k) + g(k, i - 2)*d(k, i - 2)
          end do
       end do
-      if (i >= 1) then
-!GCC$ ivdep
-!GCC$ vector
-         do k = 1, lockstep_lanes
-            xa(k) = b(k, i) - off(1, i + 3)*xa(k) - off(2, i + 2)*xb(k) - off(3, i + 1)*xc(k)
-            d(k, i) = d(k, i) + xa(k) + c(k)*z(i)
-            u(k, i) = u(k, i) + d(k, i)
-            ga(k) = ga(k) + g(k, i)*d(k, i)
-         end do
-      end if
-      if (i - 1 >= 1) then
-!GCC$ ivdep
-!GCC$ vector
-         do k = 1, lockstep_lanes
-            xb(k) = b(k, i - 1) - off(1, i + 2)*xb(k) - off(2, i + 1)*xc(k) - off(3, i)*xa(k)
-            d(k, i - 1) = d(k, i - 1) + xb(k) + c(k)*z(i - 1)
-            u(k, i - 1) = u(k, i - 1) + d(k, i - 1)
-            gb(k) = gb(k) + g(k, i - 1)*d(k, i - 1)
-         end do
-      end if
+      ! the rows left (fewer than three), then their terms of g.d (each row's term needs only
+      ! its own d)
+      call back_update_last_rows(off, i, n, b, c, z, d, u, xa, xb, xc)
+      if (i >= 1) ga = ga + g(:, i)*d(:, i)
+      if (i - 1 >= 1) gb = gb + g(:, i - 1)*d(:, i - 1)
 !GCC$ ivdep
 !GCC$ vector
       do k = 1, lockstep_lanes
