@@ -15,15 +15,15 @@ the run's figures and the reductions) is written next to its HDF5 file as ``NAME
 
 from __future__ import annotations
 
-import functools
 import json
 import math
 import os
 import re
+import signal
 import subprocess
 import time
 from pathlib import Path
-from typing import Any, Callable, Optional
+from typing import Any, Optional
 
 __all__ = ["run_point", "run_batch", "read_status", "FINISHED"]
 
@@ -53,8 +53,6 @@ def _message(stderr: str, stdout: str, code: int) -> str:
         lines = [line.strip() for line in (stdout or "").splitlines() if line.strip()]
     text = lines[-1] if lines else ""
     if code < 0:
-        import signal
-
         try:
             name = signal.Signals(-code).name
         except ValueError:
@@ -76,30 +74,41 @@ def _clean(value: Any) -> Any:
 
 
 _ARMED = False
-_BUSY = 0  # run_batch / run_point calls under way in this worker
+_PROGRAM: Optional[subprocess.Popen[str]] = None  # the program this worker is running, if any
 
 
 def _on_term(signum: int, frame: Any) -> None:
-    if _BUSY:
-        raise SystemExit(128 + signum)  # subprocess.run kills the running program on the way out
-    # idle (waiting for work, or shutting down): an exception raised here would surface as an
-    # "Exception ignored" traceback from the pool's machinery; nothing of ours needs cleaning
+    # Stop the running program (as subprocess.run does when it is left by an exception), then
+    # this worker. Nothing is raised: the handler runs between any two bytecodes, inside a
+    # weakref callback or the pool's machinery too, where an exception surfaces as an
+    # "Exception ignored" traceback and the worker goes on; nothing of ours needs cleaning (a
+    # point's record is written atomically, and an unfinished point runs again on resume).
+    program = _PROGRAM
+    if program is not None and program.returncode is None:
+        try:
+            os.kill(program.pid, signal.SIGKILL)
+        except OSError:
+            pass
     os._exit(128 + signum)
 
 
-def _busy(function: Callable[[Any], dict[str, Any]]) -> Callable[[Any], dict[str, Any]]:
-    """Count the call as work under way, for _on_term."""
-
-    @functools.wraps(function)
-    def counted(argument: Any) -> dict[str, Any]:
-        global _BUSY
-        _BUSY += 1
+def _run(command: list[str], *, timeout: Optional[float],
+         cwd: Optional[str] = None) -> subprocess.CompletedProcess[str]:
+    """subprocess.run(command, capture_output=True, text=True, stdin=DEVNULL, timeout=...), the
+    running program known to _on_term."""
+    global _PROGRAM
+    with subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
+                          text=True, cwd=cwd) as process:
+        _PROGRAM = process
         try:
-            return function(argument)
+            stdout, stderr = process.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.communicate()
+            raise
         finally:
-            _BUSY -= 1
-
-    return counted
+            _PROGRAM = None
+    return subprocess.CompletedProcess(command, process.returncode, stdout, stderr)
 
 
 def _arm() -> None:
@@ -108,7 +117,6 @@ def _arm() -> None:
     if _ARMED:
         return
     import multiprocessing
-    import signal
     import threading
 
     # only in a worker process of a local pool (never in the caller's own process)
@@ -117,7 +125,6 @@ def _arm() -> None:
     _ARMED = True
 
 
-@_busy
 def run_point(task: dict[str, Any]) -> dict[str, Any]:
     """Run (or, with ``task['reduce_only']``, only reduce) one point; never raises an Exception."""
     _arm()
@@ -156,8 +163,7 @@ def _run_program(task: dict[str, Any], nml: Path, h5: Path, record: dict[str, An
     command = [task["program"], "run", str(nml), "-o", str(h5)]
     start = time.perf_counter()
     try:
-        done = subprocess.run(command, capture_output=True, text=True, timeout=task.get("timeout"),
-                              stdin=subprocess.DEVNULL)
+        done = _run(command, timeout=task.get("timeout"))
     except subprocess.TimeoutExpired:
         record["wall_seconds"] = time.perf_counter() - start
         record["message"] = f"timed out after {task['timeout']:g} s (the run was stopped)"
@@ -189,7 +195,6 @@ def _base_record(task: dict[str, Any], folder: Path, h5: Path) -> dict[str, Any]
 _GROUPS = re.compile(r"^beamstops: (\d+) scenes: (\d+) in (\d+) lockstep group")
 
 
-@_busy
 def run_batch(tasks: list[dict[str, Any]]) -> dict[str, Any]:
     """Run points together as one ``beamstops run P1.nml P2.nml ...`` (the engine runs those
     that share A in lockstep), then reduce each; the points that did not end with a finished
@@ -217,9 +222,8 @@ def run_batch(tasks: list[dict[str, Any]]) -> dict[str, Any]:
             paths.append(nml.name)
         timeout = tasks[0].get("timeout")
         try:
-            done = subprocess.run([tasks[0]["program"], "run", *paths], capture_output=True, text=True,
-                                  cwd=tasks[0]["folder"],
-                                  timeout=timeout * len(tasks) if timeout else None, stdin=subprocess.DEVNULL)
+            done = _run([tasks[0]["program"], "run", *paths], cwd=tasks[0]["folder"],
+                        timeout=timeout * len(tasks) if timeout else None)
             for line in done.stderr.splitlines():
                 match = _GROUPS.match(line)
                 if match:
