@@ -174,7 +174,8 @@ lockstep = 2
 [scene]
 elements = 10
 dt = 2e-5
-t_end = 12.0
+t_end = 80.0
+record_every = 10
 [axes]
 amplitude = { start = 0.10, stop = 0.15, step = 0.01 }
 """
