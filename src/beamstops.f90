@@ -12,7 +12,7 @@ module beamstops
    use beamstops_recorder, only: recorder_type, n_columns
    use beamstops_recorder_array, only: array_recorder
    use beamstops_recorder_hdf5, only: hdf5_recorder
-   use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed
+   use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_interrupted
    use beamstops_run, only: prepare_run, check_run, simulate, run_limit_type, run_limit
    use beamstops_lockstep, only: check_lockstep, prepare_lockstep, simulate_lockstep
    use beamstops_version, only: version
@@ -29,7 +29,7 @@ module beamstops
    public :: read_scene, model_type, build_model, check_stability
    public :: state_type, start_state, run_scheme
    public :: recorder_type, n_columns, array_recorder, hdf5_recorder
-   public :: run_summary, status_complete, status_diverged, status_failed
+   public :: run_summary, status_complete, status_diverged, status_failed, status_interrupted
    public :: prepare_run, check_run, simulate, run_limit_type, run_limit, record_count, snapshot_count, output_bytes, version
    public :: run_three_level
    public :: check_lockstep, prepare_lockstep, simulate_lockstep

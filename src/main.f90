@@ -16,6 +16,7 @@ program beamstops_main
    use beamstops_namelist, only: default_output
    use beamstops_recorder_hdf5, only: partial_path, check_output_path
    use beamstops_run, only: continue_run, continue_reduced
+   use beamstops_stop_signals, only: stop_signal
    use beamstops_writer_thread, only: writer_thread, start_writer, stop_writer
    use beamstops_batch, only: lockstep_groups, simulate_group, min_group_members
    use beamstops_reduced, only: reduced_model_type, reduce_model
@@ -107,7 +108,7 @@ program beamstops_main
    integer(c_int), parameter :: sigxfsz = 25_c_int
    integer(c_intptr_t), parameter :: sig_ign = 1_c_intptr_t
 
-   integer, parameter :: exit_input = 1, exit_usage = 2, exit_diverged = 3, exit_output = 4
+   integer, parameter :: exit_input = 1, exit_usage = 2, exit_diverged = 3, exit_output = 4, exit_signal = 128
    character(len=:), allocatable :: command, path, out
    type(path_type), allocatable :: paths(:)
    logical :: restart = .false.
@@ -229,7 +230,9 @@ contains
       end do
       write (output_unit, '(a)') '  --version       print the version', &
          & 'exit statuses: 0 success, 1 bad input, 2 bad command line (or no Python for its commands),', &
-         & '  3 the run diverged or failed, 4 the output could not be written or would destroy a file'
+         & '  3 the run diverged or failed, 4 the output could not be written or would destroy a file,', &
+         & '  128 + N when SIGINT (N = 2) or SIGTERM (N = 15) stopped the run (records flushed, a checkpoint', &
+         & '  saved: run again with --restart to continue)'
       stop
    end subroutine usage
 
@@ -436,12 +439,12 @@ contains
          summary%status = status_failed
          summary%message = error%message
       else if (scene%modes > 0) then
-         call continue_reduced(scene, reduced, reduced_state, recorder, summary, write_error, checkpoint)
+         call continue_reduced(scene, reduced, reduced_state, recorder, summary, write_error, checkpoint, .true.)
       else
-         call continue_run(scene, model, state, recorder, summary, write_error, checkpoint)
+         call continue_run(scene, model, state, recorder, summary, write_error, checkpoint, .true.)
       end if
       call recorder%finish(summary, finish_error)
-      status = run_outcome(scene, summary, error, write_error, finish_error)
+      status = run_outcome(scene, input, summary, error, write_error, finish_error)
    end function run_to_file
 
    !> Refuse, before anything is written, the output of a scene that the run cannot write or that
@@ -485,8 +488,9 @@ contains
 
    !> The end of a run whose recorder is finished: the messages, the summary line and the exit
    !> status (0 complete, 1 the run could not start, 3 diverged or failed, 4 a write failed).
-   integer function run_outcome(scene, summary, start_error, write_error, finish_error) result(status)
+   integer function run_outcome(scene, input, summary, start_error, write_error, finish_error) result(status)
       type(scene_type), intent(in) :: scene
+      character(len=*), intent(in) :: input
       type(run_summary), intent(in) :: summary
       type(error_type), allocatable, intent(in) :: start_error, write_error, finish_error
       character(len=:), allocatable :: output
@@ -507,6 +511,11 @@ contains
       if (summary%status == status_diverged) then
          write (error_unit, '(a)') 'beamstops: error: '//output//': run diverged: '//summary%message
          status = exit_diverged
+      else if (summary%status == status_interrupted) then
+         write (error_unit, '(a)') 'beamstops: '//output//': run interrupted: '//summary%message//'; '//output// &
+            & ' is left as it was, the run so far is in '//partial_path(output)//'; beamstops run '//input// &
+            & ' --restart continues it'
+         status = exit_signal + stop_signal()
       else if (summary%status /= status_complete) then
          write (error_unit, '(a)') 'beamstops: error: '//output//': run '//summary%status//': '// &
             & summary%message//'; '//output//' is left as it was, the run so far is in '//partial_path(output)
@@ -697,7 +706,7 @@ contains
          if (allocated(write_error)) deallocate (write_error)
          if (allocated(failures(k)%message)) call fatal_error(write_error, failures(k)%message)
          call recorders(k)%finish(summaries(k), finish_error)
-         status(i) = run_outcome(scenes(i), summaries(k), start_error, write_error, finish_error)
+         status(i) = run_outcome(scenes(i), paths(i)%text, summaries(k), start_error, write_error, finish_error)
       end do
    end subroutine run_group_to_files
 

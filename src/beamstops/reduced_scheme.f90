@@ -36,6 +36,7 @@ module beamstops_reduced_scheme
    use beamstops_observe_observer, only: observer_type, observe_scene
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
       & col_work, col_dissipated, col_damped
+   use beamstops_stop_signals, only: stop_signal
    use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running, &
       & check_divergence
    implicit none
@@ -258,8 +259,9 @@ contains
    end subroutine start_span
 
    !> Run from the state's step to the scene's last step (or to step `until`) in blocks; between
-   !> blocks the divergence check and progress. Fills the summary; a call that ends at `until`
-   !> before the last step leaves the status 'running' (the caller saves a checkpoint and
+   !> blocks the divergence check, progress and a look for a stop signal (beamstops_stop_signals;
+   !> the loop stops there). Fills the summary; a call that ends before the last step (at `until`,
+   !> or on a stop signal) leaves the status 'running' (the caller saves a checkpoint and
    !> continues with another call).
    subroutine run_reduced(scene, reduced, state, recorder, summary, until)
       !> Scene.
@@ -302,6 +304,7 @@ contains
          if (summary%status == status_diverged) exit
          if (state%observer%active) call state%observer%drain()
          call recorder%progress(state%step - 1, steps)
+         if (stop_signal() /= 0) exit
       end do
       summary%cpu_seconds = state%cpu_seconds
       summary%steps = state%step - 1

@@ -7,13 +7,15 @@
 module beamstops_run
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
-   use beamstops_strings, only: fmt_int
+   use, intrinsic :: iso_c_binding, only: c_int
+   use beamstops_strings, only: fmt_int, fmt_real
+   use beamstops_stop_signals, only: catch_stop_signals, release_stop_signals, stop_signal, signal_name
    use beamstops_scene, only: scene_type, steps_of
    use beamstops_model, only: model_type, build_model, check_stability
    use beamstops_scheme, only: state_type, start_state, run_scheme
    use beamstops_recorder, only: recorder_type
    use beamstops_checkpoint, only: write_checkpoint
-   use beamstops_summary, only: run_summary, status_running, status_failed, status_complete
+   use beamstops_summary, only: run_summary, status_running, status_failed, status_complete, status_interrupted
    use beamstops_ensemble, only: run_members
    use beamstops_reduced, only: reduced_model_type, reduce_model
    use beamstops_reduced_scheme, only: simulate_reduced, reduced_state_type, run_reduced
@@ -139,7 +141,9 @@ contains
    !> Run from the state's step (start_state's, or a checkpoint's) to t_end. With `checkpoint`
    !> and scene%checkpoint_every > 0, every checkpoint_every steps: flush the recorder, then
    !> save the state with the records and snapshots stored so far to `checkpoint` (atomically).
-   subroutine continue_run(scene, model, state, recorder, summary, error, checkpoint)
+   !> A stop signal noted (beamstops_stop_signals: the program catches SIGINT and SIGTERM) stops
+   !> the loop between two of its blocks: flushed, a checkpoint saved, status 'interrupted'.
+   subroutine continue_run(scene, model, state, recorder, summary, error, checkpoint, stop_signals)
       !> Validated scene.
       type(scene_type), intent(in) :: scene
       !> Its model (from prepare_run).
@@ -148,15 +152,22 @@ contains
       type(state_type), intent(inout) :: state
       !> Receives records and snapshots.
       class(recorder_type), intent(inout) :: recorder
-      !> Outcome: 'complete', 'diverged' or 'failed' (with a message).
+      !> Outcome: 'complete', 'diverged', 'failed' or 'interrupted' (with a message).
       type(run_summary), intent(inout) :: summary
       !> Set when the recorder or a checkpoint could not be written (the run stopped there,
       !> with status 'failed' and the same message in the summary).
       type(error_type), allocatable, intent(out) :: error
       !> Checkpoint file (none without it).
       character(len=*), intent(in), optional :: checkpoint
+      !> Catch SIGINT and SIGTERM while the time loop runs, to stop it politely (`beamstops run`;
+      !> default: a signal has its usual effect).
+      logical, intent(in), optional :: stop_signals
       integer(ik) :: steps, every, until, records, snapshots
+      integer(c_int) :: signum
       steps = steps_of(scene)
+      if (present(stop_signals)) then
+         if (stop_signals) call catch_stop_signals()
+      end if
       every = 0
       if (present(checkpoint)) every = scene%checkpoint_every
       do
@@ -164,15 +175,26 @@ contains
          if (every > 0) until = min(steps, ((state%step - 1)/every + 1)*every)
          call run_scheme(scene, model, state, recorder, summary, until)
          if (summary%status /= status_running .or. recorder%failed) exit
+         ! a checkpoint step, or a stop signal noted (the loop stops between two of its blocks)
+         signum = stop_signal()
          call recorder%flush(records, snapshots)
          if (recorder%failed) exit
-         call write_checkpoint(checkpoint, scene, state, records, snapshots, error)
-         if (allocated(error)) then
-            summary%status = status_failed
-            summary%message = error%message
-            return
+         if (present(checkpoint)) then
+            call write_checkpoint(checkpoint, scene, state, records, snapshots, error)
+            if (allocated(error)) then
+               summary%status = status_failed
+               summary%message = error%message
+               call release_stop_signals()
+               return
+            end if
+         end if
+         if (signum /= 0) then
+            call interrupted(scene, summary%steps, signum, present(checkpoint), summary)
+            exit
          end if
       end do
+      ! the members of an ensemble and the file's end take a signal's usual effect
+      call release_stop_signals()
       call close_run(scene, model, recorder, summary, error)
    end subroutine continue_run
 
@@ -201,7 +223,7 @@ contains
    !> continue_run for a reduced model (scene%modes > 0): from the state's step (start_reduced's,
    !> or a checkpoint's) to t_end, with `checkpoint` every checkpoint_every steps (the recorder
    !> flushed, then the state saved atomically).
-   subroutine continue_reduced(scene, reduced, state, recorder, summary, error, checkpoint)
+   subroutine continue_reduced(scene, reduced, state, recorder, summary, error, checkpoint, stop_signals)
       !> Validated scene.
       type(scene_type), intent(in) :: scene
       !> Its reduced model.
@@ -210,15 +232,22 @@ contains
       type(reduced_state_type), intent(inout) :: state
       !> Receives records and snapshots.
       class(recorder_type), intent(inout) :: recorder
-      !> Outcome: 'complete', 'diverged' or 'failed' (with a message).
+      !> Outcome: 'complete', 'diverged', 'failed' or 'interrupted' (with a message).
       type(run_summary), intent(inout) :: summary
       !> Set when the recorder or a checkpoint could not be written (the run stopped there,
       !> with status 'failed' and the same message in the summary).
       type(error_type), allocatable, intent(out) :: error
       !> Checkpoint file (none without it).
       character(len=*), intent(in), optional :: checkpoint
+      !> Catch SIGINT and SIGTERM while the time loop runs, to stop it politely (`beamstops run`;
+      !> default: a signal has its usual effect).
+      logical, intent(in), optional :: stop_signals
       integer(ik) :: steps, every, until, records, snapshots
+      integer(c_int) :: signum
       steps = steps_of(scene)
+      if (present(stop_signals)) then
+         if (stop_signals) call catch_stop_signals()
+      end if
       every = 0
       if (present(checkpoint)) every = scene%checkpoint_every
       do
@@ -226,17 +255,41 @@ contains
          if (every > 0) until = min(steps, ((state%step - 1)/every + 1)*every)
          call run_reduced(scene, reduced, state, recorder, summary, until)
          if (summary%status /= status_running .or. recorder%failed) exit
+         ! a checkpoint step, or a stop signal noted (the loop stops between two of its blocks)
+         signum = stop_signal()
          call recorder%flush(records, snapshots)
          if (recorder%failed) exit
-         call write_reduced_checkpoint(checkpoint, scene, state, records, snapshots, error)
-         if (allocated(error)) then
-            summary%status = status_failed
-            summary%message = error%message
-            return
+         if (present(checkpoint)) then
+            call write_reduced_checkpoint(checkpoint, scene, state, records, snapshots, error)
+            if (allocated(error)) then
+               summary%status = status_failed
+               summary%message = error%message
+               call release_stop_signals()
+               return
+            end if
+         end if
+         if (signum /= 0) then
+            call interrupted(scene, summary%steps, signum, present(checkpoint), summary)
+            exit
          end if
       end do
+      call release_stop_signals()
       call recorder_outcome(recorder, summary, error)
    end subroutine continue_reduced
+
+   !> Status 'interrupted', and where: the loop stopped after step `done` on `signum` (with a
+   !> checkpoint `saved`).
+   subroutine interrupted(scene, done, signum, saved, summary)
+      type(scene_type), intent(in) :: scene
+      integer(ik), intent(in) :: done
+      integer(c_int), intent(in) :: signum
+      logical, intent(in) :: saved
+      type(run_summary), intent(inout) :: summary
+      summary%status = status_interrupted
+      summary%message = 'stopped by '//signal_name(signum)//' at t = '//fmt_real(real(done, wp)*scene%dt)// &
+         & ' s (step '//fmt_int(done)//' of '//fmt_int(steps_of(scene))//'), its records flushed'
+      if (saved) summary%message = summary%message//' and a checkpoint saved'
+   end subroutine interrupted
 
    !> A recorder that could not write makes the run 'failed' with the recorder's message.
    subroutine recorder_outcome(recorder, summary, error)

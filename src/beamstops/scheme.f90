@@ -29,6 +29,7 @@ module beamstops_scheme
    use beamstops_start, only: start_state
    use beamstops_span_step, only: span_loop_type, start_span_block, next_span_step, span_step, end_span_block
    use beamstops_observe_quiet, only: quiet_observer, take_quiet, give_quiet, observe_quiet
+   use beamstops_stop_signals, only: stop_signal
    use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running, &
       & check_divergence
    implicit none
@@ -41,8 +42,10 @@ module beamstops_scheme
 contains
 
    !> Run from the state's step to the scene's last step (or to step `until`), in blocks; fills
-   !> the summary. Between blocks: the divergence check and progress. A call that ends at `until`
-   !> before the last step leaves the status 'running': the caller continues with another call.
+   !> the summary. Between blocks: the divergence check, progress and a look for a stop signal
+   !> (beamstops_stop_signals; the loop stops there). A call that ends before the last step
+   !> (at `until`, or on a stop signal) leaves the status 'running': the caller continues with
+   !> another call.
    subroutine run_scheme(scene, model, state, recorder, summary, until)
       !> Scene.
       type(scene_type), intent(in) :: scene
@@ -85,6 +88,7 @@ contains
          if (summary%status == status_diverged) exit
          if (state%observer%active) call state%observer%drain()
          call recorder%progress(state%step - 1, steps)
+         if (stop_signal() /= 0) exit
       end do
       summary%cpu_seconds = state%cpu_seconds
       summary%steps = state%step - 1

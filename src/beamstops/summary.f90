@@ -7,15 +7,17 @@ module beamstops_summary
    use beamstops_strings, only: fmt_real
    implicit none
    private
-   public :: run_summary, status_complete, status_diverged, status_running, status_failed, check_divergence
+   public :: run_summary, status_complete, status_diverged, status_running, status_failed, status_interrupted, &
+      & check_divergence
 
    !> Status texts written to the output's `status` attribute.
    character(len=*), parameter :: status_complete = 'complete', status_diverged = 'diverged', &
-      & status_running = 'running', status_failed = 'failed'
+      & status_running = 'running', status_failed = 'failed', status_interrupted = 'interrupted'
 
    !> Summary of a run.
    type :: run_summary
-      !> 'complete', 'diverged', 'failed' or 'running' (interrupted).
+      !> 'complete', 'diverged', 'failed', 'interrupted' (stopped by SIGINT or SIGTERM, a checkpoint
+      !> saved) or 'running' (still running, or killed).
       character(len=:), allocatable :: status
       !> Explanation when the status is not 'complete'.
       character(len=:), allocatable :: message

@@ -118,7 +118,8 @@ class Result:
 
     @property
     def status(self) -> str:
-        """'complete', 'diverged', 'failed' or 'running' (an interrupted program)."""
+        """'complete', 'diverged', 'failed', 'interrupted' (stopped by SIGINT or SIGTERM, a
+        checkpoint saved) or 'running' (a program still running, or killed)."""
         return str(self.attrs.get("status", "unknown"))
 
     @property

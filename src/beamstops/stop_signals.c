@@ -1,0 +1,48 @@
+/* A polite stop for `beamstops run` (used by src/beamstops/stop_signals.f90): while the time
+ * loop runs, SIGINT and SIGTERM (Ctrl-C, a batch system's time limit, `kill`) only note the
+ * signal; the loop looks at the note between two of its blocks and stops there with its records
+ * flushed and a checkpoint saved. The note is the one piece of process-wide mutable state of the
+ * engine: a signal handler can set nothing else (async-signal-safe, volatile sig_atomic_t). A
+ * second signal takes the default action (SA_RESETHAND): a user who presses Ctrl-C twice is not
+ * kept waiting. SA_RESTART: the writer thread's writes, if the signal lands on it, go on. */
+#include <signal.h>
+#include <string.h>
+
+static volatile sig_atomic_t caught = 0;
+static struct sigaction previous_int, previous_term;
+static int catching = 0;
+
+static void note(int signum) { caught = signum; }
+
+/* Note SIGINT and SIGTERM from now on (instead of their default action). */
+void beamstops_catch_stop_signals(void)
+{
+    struct sigaction action;
+    if (catching) return;
+    memset(&action, 0, sizeof action);
+    action.sa_handler = note;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = SA_RESETHAND | SA_RESTART;
+    caught = 0;
+    sigaction(SIGINT, &action, &previous_int);
+    sigaction(SIGTERM, &action, &previous_term);
+    catching = 1;
+}
+
+/* The actions SIGINT and SIGTERM had before beamstops_catch_stop_signals. */
+void beamstops_release_stop_signals(void)
+{
+    if (!catching) return;
+    sigaction(SIGINT, &previous_int, NULL);
+    sigaction(SIGTERM, &previous_term, NULL);
+    catching = 0;
+}
+
+/* The signal noted since beamstops_catch_stop_signals (0: none). */
+int beamstops_stop_signal(void) { return caught; }
+
+/* The name of a signal the loop stops on ("SIGINT", "SIGTERM"; "signal" otherwise). */
+const char *beamstops_stop_signal_name(int signum)
+{
+    return signum == SIGINT ? "SIGINT" : signum == SIGTERM ? "SIGTERM" : "signal";
+}

@@ -1,0 +1,48 @@
+!> A polite stop for `beamstops run` (C side: stop_signals.c). The program catches SIGINT and
+!> SIGTERM around its time loop (catch_stop_signals, release_stop_signals); a signal then only
+!> leaves a note, which the loop reads between two of its blocks (stop_signal): the run stops
+!> there with its records flushed and a checkpoint saved, and `--restart` continues it bit for
+!> bit. Without catch_stop_signals (the Python layer, lockstep groups) stop_signal is 0 and a
+!> signal has its usual effect.
+module beamstops_stop_signals
+   use, intrinsic :: iso_c_binding, only: c_int, c_ptr, c_char, c_f_pointer
+   implicit none
+   private
+   public :: catch_stop_signals, release_stop_signals, stop_signal, signal_name
+
+   interface
+      !> Note SIGINT and SIGTERM from now on instead of their default action (a second one takes it).
+      subroutine catch_stop_signals() bind(c, name='beamstops_catch_stop_signals')
+      end subroutine catch_stop_signals
+      !> Give SIGINT and SIGTERM back the actions they had before catch_stop_signals.
+      subroutine release_stop_signals() bind(c, name='beamstops_release_stop_signals')
+      end subroutine release_stop_signals
+      !> The signal noted since catch_stop_signals (0: none).
+      function stop_signal() bind(c, name='beamstops_stop_signal') result(signum)
+         import :: c_int
+         integer(c_int) :: signum
+      end function stop_signal
+      function c_signal_name(signum) bind(c, name='beamstops_stop_signal_name') result(name)
+         import :: c_int, c_ptr
+         integer(c_int), value :: signum
+         type(c_ptr) :: name
+      end function c_signal_name
+   end interface
+
+contains
+
+   !> 'SIGINT', 'SIGTERM' (or 'signal') for a number stop_signal gave.
+   function signal_name(signum) result(name)
+      !> Signal number.
+      integer(c_int), intent(in) :: signum
+      character(len=:), allocatable :: name
+      character(kind=c_char), pointer :: text(:)
+      integer :: k
+      call c_f_pointer(c_signal_name(signum), text, [8])
+      name = ''
+      do k = 1, 8
+         if (text(k) == char(0)) exit
+         name = name//text(k)
+      end do
+   end function signal_name
+end module beamstops_stop_signals

@@ -1,0 +1,73 @@
+"""A run stopped by SIGTERM or SIGINT stops politely: records flushed, a checkpoint saved, its
+partial file closed with status 'interrupted', one line on stderr, exit status 128 + the signal,
+and `--restart` continues it to the uninterrupted run's output bit for bit."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+import beamstops
+from test_reliability_restart import PROGRAM, REDUCED, assert_identical, run
+
+pytestmark = pytest.mark.skipif(PROGRAM is None, reason="the beamstops program is not on PATH")
+
+PLAIN = """&time dt=1e-6, t_end=1.0 /
+&output file='{file}', record_every=1, snapshot_every=997 /
+"""
+
+
+def write(folder: Path, name: str, extra: str = "") -> Path:
+    path = folder / f"{name}.nml"
+    path.write_text(PLAIN.format(file=f"{name}.h5") + extra)
+    return path
+
+
+def stop_while_running(scene: Path, signum: int) -> subprocess.CompletedProcess[str]:
+    """Run `scene`, send `signum` once its time loop has written records (the partial file past
+    2 MB: the first buffers of 16,384 rows), and return how the program ended."""
+    partial = scene.with_suffix(".h5.partial")
+    process = subprocess.Popen([PROGRAM, "run", str(scene)], cwd=scene.parent, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    deadline = time.time() + 60
+    while process.poll() is None and time.time() < deadline and \
+            (not partial.exists() or partial.stat().st_size < 2_000_000):
+        time.sleep(0.001)
+    if process.poll() is None:
+        process.send_signal(signum)
+    out, err = process.communicate(timeout=120)
+    if process.returncode == 0:
+        pytest.skip("the run ended before the signal")
+    return subprocess.CompletedProcess(process.args, process.returncode, out, err)
+
+
+@pytest.mark.parametrize(("signum", "extra"), [(signal.SIGTERM, ""), (signal.SIGINT, REDUCED)],
+                         ids=["SIGTERM, full model, no checkpoint_every", "SIGINT, reduced model"])
+def test_a_signal_stops_the_run_politely_and_restart_continues_bit_for_bit(tmp_path: Path, signum: int,
+                                                                           extra: str) -> None:
+    reference = write(tmp_path, "reference", extra)
+    assert run("run", reference, cwd=tmp_path).returncode == 0
+    scene = write(tmp_path, "stopped", extra)
+    done = stop_while_running(scene, signum)
+    assert done.returncode == 128 + signum, done.stderr
+    name = signal.Signals(signum).name
+    assert done.stderr.count("\n") == 1, done.stderr
+    assert f"run interrupted: stopped by {name} at t = " in done.stderr
+    assert "stopped.nml --restart continues it" in done.stderr
+    assert not (tmp_path / "stopped.h5").exists()
+    assert (tmp_path / "stopped.h5.checkpoint").exists()
+    with pytest.raises(beamstops.IncompleteRunError, match="run interrupted"):
+        beamstops.load(tmp_path / "stopped.h5.partial")
+    partial = beamstops.load(tmp_path / "stopped.h5.partial", allow_incomplete=True)
+    assert partial.status == "interrupted"
+    # every record the loop made is in the file: one a step up to where it stopped
+    assert partial.t.size == int(partial.attrs["steps"]) + 1 > 0
+    resumed = run("run", scene, "--restart", cwd=tmp_path)
+    assert resumed.returncode == 0, resumed.stderr
+    assert not (tmp_path / "stopped.h5.checkpoint").exists()
+    assert not (tmp_path / "stopped.h5.partial").exists()
+    assert_identical(tmp_path / "stopped.h5", tmp_path / "reference.h5")
