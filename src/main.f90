@@ -597,6 +597,12 @@ contains
             do j = 1, size(members)
                i = members(j)
                status(i) = run_to_file(scenes(i), models(i), paths(i)%text, restart, progress)
+               if (status(i) > exit_signal) then
+                  ! stopped by SIGINT or SIGTERM: the scenes after it are not started
+                  if (count(group > g) + size(members) > j) write (error_unit, '(a,i0,a,i0,a)') 'beamstops: ', &
+                     & count(group > g) + size(members) - j, ' of the ', n, ' scenes were not started'
+                  call quit(status(i))
+               end if
             end do
          else
             call run_group_to_files(scenes, models, paths, members, progress, status)

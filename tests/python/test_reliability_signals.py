@@ -71,3 +71,26 @@ def test_a_signal_stops_the_run_politely_and_restart_continues_bit_for_bit(tmp_p
     assert not (tmp_path / "stopped.h5.checkpoint").exists()
     assert not (tmp_path / "stopped.h5.partial").exists()
     assert_identical(tmp_path / "stopped.h5", tmp_path / "reference.h5")
+
+
+def test_a_signal_stops_several_scenes_after_the_one_it_stopped(tmp_path: Path) -> None:
+    """`beamstops run A.nml B.nml C.nml` (each alone: different meshes): SIGTERM during A stops A
+    politely and starts neither B nor C."""
+    scenes = [write(tmp_path, name, f"&mesh elements={elements} /\n") for name, elements in
+              (("a", 19), ("b", 18), ("c", 17))]
+    partial = tmp_path / "a.h5.partial"
+    process = subprocess.Popen([PROGRAM, "run", *map(str, scenes)], cwd=tmp_path, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    deadline = time.time() + 60
+    while process.poll() is None and time.time() < deadline and \
+            (not partial.exists() or partial.stat().st_size < 2_000_000):
+        time.sleep(0.001)
+    process.send_signal(signal.SIGTERM)
+    _, err = process.communicate(timeout=120)
+    if (tmp_path / "a.h5").exists():
+        pytest.skip("the first scene ended before the signal")
+    assert process.returncode == 128 + signal.SIGTERM, err
+    assert "a.h5: run interrupted: stopped by SIGTERM" in err
+    assert err.rstrip("\n").splitlines()[-1] == "beamstops: 2 of the 3 scenes were not started", err
+    assert beamstops.load(partial, allow_incomplete=True).status == "interrupted"
+    assert not any((tmp_path / name).exists() for name in ("b.h5", "b.h5.partial", "c.h5", "c.h5.partial"))
