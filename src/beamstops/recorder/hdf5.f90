@@ -60,6 +60,8 @@ module beamstops_recorder_hdf5
       integer :: snap_fill = 0, snapshot_rows = 0
       !> Print a progress line on stderr.
       logical :: show_progress = .false.
+      !> Whether the progress line is left without its end (finish ends it: a run that stops early).
+      logical :: progress_open = .false.
       !> Stops along the span m, their two series (records x m) and buffers (m, stops_rows).
       integer :: stops = 0
       real(wp), allocatable :: stops_u_buffer(:, :), stops_r_buffer(:, :)
@@ -213,6 +215,7 @@ contains
       if (.not. self%show_progress) return
       write (0, '(a,a,f6.2,a,i0,a,i0,a)', advance='no') cr, 'beamstops: ', 100.0_wp*step/steps, '% (', step, &
          & ' of ', steps, ' steps)'
+      self%progress_open = step /= steps
       if (step == steps) write (0, '(a)') ''
       flush (0)
    end subroutine progress
@@ -230,6 +233,8 @@ contains
       integer :: hdferr
       logical :: ok
       if (self%file < 0) return
+      if (self%progress_open) write (0, '(a)') ''
+      self%progress_open = .false.
       call store(self)
       if (allocated(summary%shocks) .and. .not. self%failed) then
          call write_observations(self%file, summary%shocks, summary%statistics, self%scene%transient, &
