@@ -15,6 +15,14 @@ subroutine bs_version(text)
    text = version
 end subroutine bs_version
 
+!> The signal that stopped the last run of bs_run with interruptible = 1 (0: none).
+subroutine bs_stop_signal(signum)
+   use beamstops_stop_signals, only: stop_signal
+   implicit none
+   integer, intent(out) :: signum
+   signum = stop_signal()
+end subroutine bs_stop_signal
+
 !> Groups and keys the reader accepts, one group a line: `group: key key ...`.
 subroutine bs_keys(text)
    use beamstops_namelist, only: group_names, group_keys
@@ -159,7 +167,7 @@ end subroutine bs_stability
 !> output file's root attributes as lines `name = value` (the same list the HDF5 writer writes,
 !> status last; the quoted `scene` text spans lines); status/message report errors that
 !> prevent the run.
-subroutine bs_run(text, source, records, snapshots, nodes, stops, shock_capacity, stat_width, t, tip_u, tip_v, &
+subroutine bs_run(text, source, records, snapshots, nodes, stops, shock_capacity, stat_width, interruptible, t, tip_u, tip_v, &
    & reaction, energy, work, dissipated, damped, snapshot_t, snapshot_x, snapshot_u, stops_x, stops_u, &
    & stops_reaction, filled, snaps, shocks, shock_count, shock_labels, stat_value, stat_half, stat_entries, stat_labels, &
    & attributes, status, message)
@@ -178,6 +186,9 @@ subroutine bs_run(text, source, records, snapshots, nodes, stops, shock_capacity
    !> Columns of `shocks` (shock_count may exceed it: then call again with shock_count) and entries
    !> per quantity of the statistics (max(stops, bins + 1) from bs_sizes).
    integer(8), intent(in) :: shock_capacity, stat_width
+   !> 1: SIGINT and SIGTERM stop the time loop between two blocks (status 'interrupted'; the
+   !> caller raises the signal again, bs_stop_signal); 0: they keep their handlers meanwhile.
+   integer, intent(in) :: interruptible
    real(8), intent(out) :: t(records), tip_u(records), tip_v(records), reaction(records)
    real(8), intent(out) :: energy(records), work(records), dissipated(records), damped(records)
    real(8), intent(out) :: snapshot_t(snapshots), snapshot_x(nodes), snapshot_u(nodes, snapshots)
@@ -234,7 +245,7 @@ subroutine bs_run(text, source, records, snapshots, nodes, stops, shock_capacity
       recorder%snaps = 0
       recorder%stops_filled = 0
    end if
-   if (.not. allocated(error)) call simulate(scene, model, recorder, summary, error, reduced)
+   if (.not. allocated(error)) call simulate(scene, model, recorder, summary, error, reduced, interruptible /= 0)
    if (allocated(error)) then
       call report(error, status, message)
       return

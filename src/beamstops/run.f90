@@ -18,7 +18,7 @@ module beamstops_run
    use beamstops_summary, only: run_summary, status_running, status_failed, status_complete, status_interrupted
    use beamstops_ensemble, only: run_members
    use beamstops_reduced, only: reduced_model_type, reduce_model
-   use beamstops_reduced_scheme, only: simulate_reduced, reduced_state_type, run_reduced
+   use beamstops_reduced_scheme, only: start_reduced, reduced_state_type, run_reduced
    use beamstops_reduced_checkpoint, only: write_reduced_checkpoint
    implicit none
    private
@@ -107,7 +107,7 @@ contains
    !> Run a prepared scene from t = 0 to t_end, feeding `recorder` (no checkpoints); a scene with
    !> &mesh modes > 0 runs its reduced (Craig-Bampton) model. A recorder
    !> that cannot write ends the run with status 'failed' and its message in the summary.
-   subroutine simulate(scene, model, recorder, summary, error, reduced)
+   recursive subroutine simulate(scene, model, recorder, summary, error, reduced, stop_signals)
       !> Validated scene.
       type(scene_type), intent(in) :: scene
       !> Its model (from prepare_run).
@@ -120,22 +120,30 @@ contains
       type(error_type), allocatable, intent(out) :: error
       !> With &mesh modes > 0, its reduced model (from prepare_run; built here when absent).
       type(reduced_model_type), intent(in), optional :: reduced
+      !> Catch SIGINT and SIGTERM while the time loop runs (continue_run): a signal stops it
+      !> between two blocks with status 'interrupted' (the Python layer then raises the signal
+      !> again for its own handler).
+      logical, intent(in), optional :: stop_signals
       type(state_type) :: state
+      type(reduced_state_type) :: reduced_state
       type(error_type), allocatable :: write_error
       type(reduced_model_type) :: built
       if (scene%modes > 0) then
-         if (present(reduced)) then
-            call simulate_reduced(scene, reduced, recorder, summary, error)
+         if (.not. present(reduced)) then
+            call reduce_model(scene, model, 'scene', built, error)
+            if (allocated(error)) return
+            call simulate(scene, model, recorder, summary, error, built, stop_signals)
             return
          end if
-         call reduce_model(scene, model, 'scene', built, error)
+         call start_reduced(scene, reduced, reduced_state, recorder, error)
          if (allocated(error)) return
-         call simulate_reduced(scene, built, recorder, summary, error)
+         call continue_reduced(scene, reduced, reduced_state, recorder, summary, write_error, &
+            & stop_signals=stop_signals)
          return
       end if
       call start_state(scene, model, state, recorder, error)
       if (allocated(error)) return
-      call continue_run(scene, model, state, recorder, summary, write_error)
+      call continue_run(scene, model, state, recorder, summary, write_error, stop_signals=stop_signals)
    end subroutine simulate
 
    !> Run from the state's step (start_state's, or a checkpoint's) to t_end. With `checkpoint`

@@ -14,7 +14,7 @@ static int catching = 0;
 
 static void note(int signum) { caught = signum; }
 
-/* Note SIGINT and SIGTERM from now on (instead of their default action). */
+/* Note SIGINT and SIGTERM from now on (instead of their action; those ignored stay ignored). */
 void beamstops_catch_stop_signals(void)
 {
     struct sigaction action;
@@ -24,8 +24,11 @@ void beamstops_catch_stop_signals(void)
     sigemptyset(&action.sa_mask);
     action.sa_flags = SA_RESETHAND | SA_RESTART;
     caught = 0;
-    sigaction(SIGINT, &action, &previous_int);
-    sigaction(SIGTERM, &action, &previous_term);
+    /* a signal the process ignores (a background job's SIGINT, nohup) stays ignored */
+    sigaction(SIGINT, NULL, &previous_int);
+    sigaction(SIGTERM, NULL, &previous_term);
+    if (previous_int.sa_handler != SIG_IGN) sigaction(SIGINT, &action, NULL);
+    if (previous_term.sa_handler != SIG_IGN) sigaction(SIGTERM, &action, NULL);
     catching = 1;
 }
 

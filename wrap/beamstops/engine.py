@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import os
 import re
+import signal
+import threading
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Callable, Iterable, Optional
 
@@ -201,17 +203,26 @@ def run(scene: Scene, *, allow_incomplete: bool = False, shock_capacity: int = 4
     records, snapshots, nodes, stops = sizes(scene)
     width = max(stops, 1, scene.bins + 1)
     capacity = max(int(shock_capacity), 1)
+    # In the main thread, Ctrl-C (SIGINT) or SIGTERM stops the engine's loop within a block (a few
+    # ms) instead of waiting for its end; the signal is then raised again, for Python's own
+    # handler (KeyboardInterrupt for Ctrl-C). Other threads leave the signals alone.
+    interruptible = int(threading.current_thread() is threading.main_thread())
     while True:
         (t, tip_u, tip_v, reaction, energy, work, dissipated, damped, snapshot_t, snapshot_x, snapshot_u, stops_x,
          stops_u, stops_reaction, filled, snaps, shocks, shock_count, shock_labels, stat_value, stat_half, stat_entries,
          stat_labels, attribute_text, status, message) = engine_call(
-            _engine.bs_run, text, b"scene", records, snapshots, nodes, stops, capacity, width)
+            _engine.bs_run, text, b"scene", records, snapshots, nodes, stops, capacity, width, interruptible)
         _check(status, message)
+        attrs = attributes_of(_text(attribute_text))
+        if attrs.get("status") == "interrupted":
+            signum = int(engine_call(_engine.bs_stop_signal))
+            if signum:
+                signal.raise_signal(signum)
+            break  # a handler that returned: the records so far (status 'interrupted')
         if int(shock_count) <= capacity:
             break
         capacity = int(shock_count)  # the same deterministic run again, with room for every shock
     filled, snaps = int(filled), int(snaps)
-    attrs = attributes_of(_text(attribute_text))
     cut: Callable[[np.ndarray], np.ndarray] = (lambda a: a) if filled == records else (lambda a: a[:filled].copy())
     result = Result(
         t=cut(t), tip_u=cut(tip_u), tip_v=cut(tip_v), reaction=cut(reaction), energy=cut(energy),
