@@ -170,39 +170,8 @@ contains
       !> Catch SIGINT and SIGTERM while the time loop runs, to stop it politely (`beamstops run`;
       !> default: a signal has its usual effect).
       logical, intent(in), optional :: stop_signals
-      integer(ik) :: steps, every, until, records, snapshots
-      integer(c_int) :: signum
-      steps = steps_of(scene)
-      if (present(stop_signals)) then
-         if (stop_signals) call catch_stop_signals()
-      end if
-      every = 0
-      if (present(checkpoint)) every = scene%checkpoint_every
-      do
-         until = steps
-         if (every > 0) until = min(steps, ((state%step - 1)/every + 1)*every)
-         call run_scheme(scene, model, state, recorder, summary, until)
-         if (summary%status /= status_running .or. recorder%failed) exit
-         ! a checkpoint step, or a stop signal noted (the loop stops between two of its blocks)
-         signum = stop_signal()
-         call recorder%flush(records, snapshots)
-         if (recorder%failed) exit
-         if (present(checkpoint)) then
-            call write_checkpoint(checkpoint, scene, state, records, snapshots, error)
-            if (allocated(error)) then
-               summary%status = status_failed
-               summary%message = error%message
-               call release_stop_signals()
-               return
-            end if
-         end if
-         if (signum /= 0) then
-            call interrupted(scene, summary%steps, signum, present(checkpoint), summary)
-            exit
-         end if
-      end do
-      ! the members of an ensemble and the file's end take a signal's usual effect
-      call release_stop_signals()
+      call run_blocks(scene, recorder, summary, error, checkpoint, stop_signals, model=model, state=state)
+      if (allocated(error)) return
       call close_run(scene, model, recorder, summary, error)
    end subroutine continue_run
 
@@ -230,7 +199,7 @@ contains
 
    !> continue_run for a reduced model (scene%modes > 0): from the state's step (start_reduced's,
    !> or a checkpoint's) to t_end, with `checkpoint` every checkpoint_every steps (the recorder
-   !> flushed, then the state saved atomically).
+   !> flushed, then the state saved atomically), and the same stop on a signal.
    subroutine continue_reduced(scene, reduced, state, recorder, summary, error, checkpoint, stop_signals)
       !> Validated scene.
       type(scene_type), intent(in) :: scene
@@ -250,7 +219,29 @@ contains
       !> Catch SIGINT and SIGTERM while the time loop runs, to stop it politely (`beamstops run`;
       !> default: a signal has its usual effect).
       logical, intent(in), optional :: stop_signals
-      integer(ik) :: steps, every, until, records, snapshots
+      call run_blocks(scene, recorder, summary, error, checkpoint, stop_signals, reduced=reduced, &
+         & reduced_state=state)
+      if (allocated(error)) return
+      call recorder_outcome(recorder, summary, error)
+   end subroutine continue_reduced
+
+   !> The time loop of continue_run (model and state) or continue_reduced (reduced and
+   !> reduced_state), in blocks that end on checkpoint steps or on a stop signal. Signals are
+   !> caught (stop_signals) for the loop only: the members of an ensemble and the file's end take
+   !> a signal's usual effect.
+   subroutine run_blocks(scene, recorder, summary, error, checkpoint, stop_signals, model, state, reduced, &
+      & reduced_state)
+      type(scene_type), intent(in) :: scene
+      class(recorder_type), intent(inout) :: recorder
+      type(run_summary), intent(inout) :: summary
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), intent(in), optional :: checkpoint
+      logical, intent(in), optional :: stop_signals
+      type(model_type), intent(in), optional :: model
+      type(state_type), intent(inout), optional :: state
+      type(reduced_model_type), intent(in), optional :: reduced
+      type(reduced_state_type), intent(inout), optional :: reduced_state
+      integer(ik) :: steps, every, until, records, snapshots, first
       integer(c_int) :: signum
       steps = steps_of(scene)
       if (present(stop_signals)) then
@@ -259,22 +250,32 @@ contains
       every = 0
       if (present(checkpoint)) every = scene%checkpoint_every
       do
+         if (present(state)) then
+            first = state%step
+         else
+            first = reduced_state%step
+         end if
          until = steps
-         if (every > 0) until = min(steps, ((state%step - 1)/every + 1)*every)
-         call run_reduced(scene, reduced, state, recorder, summary, until)
+         if (every > 0) until = min(steps, ((first - 1)/every + 1)*every)
+         if (present(state)) then
+            call run_scheme(scene, model, state, recorder, summary, until)
+         else
+            call run_reduced(scene, reduced, reduced_state, recorder, summary, until)
+         end if
          if (summary%status /= status_running .or. recorder%failed) exit
          ! a checkpoint step, or a stop signal noted (the loop stops between two of its blocks)
          signum = stop_signal()
          call recorder%flush(records, snapshots)
          if (recorder%failed) exit
-         if (present(checkpoint)) then
-            call write_reduced_checkpoint(checkpoint, scene, state, records, snapshots, error)
-            if (allocated(error)) then
-               summary%status = status_failed
-               summary%message = error%message
-               call release_stop_signals()
-               return
-            end if
+         if (present(checkpoint) .and. present(state)) then
+            call write_checkpoint(checkpoint, scene, state, records, snapshots, error)
+         else if (present(checkpoint)) then
+            call write_reduced_checkpoint(checkpoint, scene, reduced_state, records, snapshots, error)
+         end if
+         if (allocated(error)) then
+            summary%status = status_failed
+            summary%message = error%message
+            exit
          end if
          if (signum /= 0) then
             call interrupted(scene, summary%steps, signum, present(checkpoint), summary)
@@ -282,8 +283,7 @@ contains
          end if
       end do
       call release_stop_signals()
-      call recorder_outcome(recorder, summary, error)
-   end subroutine continue_reduced
+   end subroutine run_blocks
 
    !> Status 'interrupted', and where: the loop stopped after step `done` on `signum` (with a
    !> checkpoint `saved`).
