@@ -16,7 +16,7 @@ program beamstops_main
    use beamstops_namelist, only: default_output
    use beamstops_recorder_hdf5, only: partial_path, check_output_path
    use beamstops_run, only: continue_run, continue_reduced
-   use beamstops_stop_signals, only: stop_signal
+   use beamstops_stop_signals, only: caught_signal
    use beamstops_writer_thread, only: writer_thread, start_writer, stop_writer
    use beamstops_batch, only: lockstep_groups, simulate_group, min_group_members
    use beamstops_reduced, only: reduced_model_type, reduce_model
@@ -493,7 +493,7 @@ contains
       character(len=*), intent(in) :: input
       type(run_summary), intent(in) :: summary
       type(error_type), allocatable, intent(in) :: start_error, write_error, finish_error
-      character(len=:), allocatable :: output
+      character(len=:), allocatable :: output, again
       status = 0
       output = scene%output_file
       if (reported(start_error, exit_input, status)) return
@@ -512,10 +512,14 @@ contains
          write (error_unit, '(a)') 'beamstops: error: '//output//': run diverged: '//summary%message
          status = exit_diverged
       else if (summary%status == status_interrupted) then
+         if (file_exists(checkpoint_path(output))) then
+            again = 'beamstops run '//input//' --restart continues it'
+         else
+            again = 'beamstops run '//input//' runs it again'
+         end if
          write (error_unit, '(a)') 'beamstops: '//output//': run interrupted: '//summary%message//'; '//output// &
-            & ' is left as it was, the run so far is in '//partial_path(output)//'; beamstops run '//input// &
-            & ' --restart continues it'
-         status = exit_signal + stop_signal()
+            & ' is left as it was, the run so far is in '//partial_path(output)//'; '//again
+         status = exit_signal + caught_signal()
       else if (summary%status /= status_complete) then
          write (error_unit, '(a)') 'beamstops: error: '//output//': run '//summary%status//': '// &
             & summary%message//'; '//output//' is left as it was, the run so far is in '//partial_path(output)
@@ -606,6 +610,12 @@ contains
             end do
          else
             call run_group_to_files(scenes, models, paths, members, progress, status)
+            if (any(status(members) > exit_signal)) then
+               ! a signal stopped the group: the scenes of the groups after it are not started
+               if (count(group > g) > 0) write (error_unit, '(a,i0,a,i0,a)') 'beamstops: ', count(group > g), &
+                  & ' of the ', n, ' scenes were not started'
+               call quit(maxval(status))
+            end if
          end if
       end do
       if (any(status /= 0)) write (error_unit, '(a,i0,a,i0,a)') 'beamstops: ', count(status /= 0), ' of ', n, &
@@ -696,7 +706,7 @@ contains
       if (.not. all(opened)) recorders = pack(recorders, opened)
       recorders(1)%show_progress = progress
       allocate (summaries(size(ids)), failures(size(ids)))
-      call simulate_group(scenes(ids), models(ids), recorders, summaries, failures, error)
+      call simulate_group(scenes(ids), models(ids), recorders, summaries, failures, error, stop_signals=.true.)
       if (allocated(error)) then
          write (error_unit, '(a)') 'beamstops: note: '//error%message//'; running these scenes one at a time'
          do k = 1, size(ids)

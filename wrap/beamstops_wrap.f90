@@ -17,10 +17,10 @@ end subroutine bs_version
 
 !> The signal that stopped the last run of bs_run with interruptible = 1 (0: none).
 subroutine bs_stop_signal(signum)
-   use beamstops_stop_signals, only: stop_signal
+   use beamstops_stop_signals, only: caught_signal
    implicit none
    integer, intent(out) :: signum
-   signum = stop_signal()
+   signum = caught_signal()
 end subroutine bs_stop_signal
 
 !> Groups and keys the reader accepts, one group a line: `group: key key ...`.

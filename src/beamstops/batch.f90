@@ -14,6 +14,7 @@ module beamstops_batch
    use beamstops_summary, only: run_summary
    use beamstops_lockstep, only: check_lockstep, simulate_lockstep
    use beamstops_run, only: close_run
+   use beamstops_stop_signals, only: catch_stop_signals, release_stop_signals
    implicit none
    private
    public :: lockstep_groups, simulate_group, min_group_members
@@ -92,7 +93,7 @@ contains
    !> (close_run). `error` says the group could not start (then nothing ran: the caller may run
    !> the scenes alone); `failures(k)` holds member k's error from close_run (its &ensemble
    !> members could not run, or its recorder could not write).
-   subroutine simulate_group(scenes, models, recorders, summaries, failures, error)
+   subroutine simulate_group(scenes, models, recorders, summaries, failures, error, stop_signals)
       !> The group's validated scenes (K).
       type(scene_type), intent(in) :: scenes(:)
       !> Their models (K); the first is the group's (they share A).
@@ -105,9 +106,17 @@ contains
       type(error_type), intent(out) :: failures(:)
       !> Set when the group cannot start.
       type(error_type), allocatable, intent(out) :: error
+      !> Catch SIGINT and SIGTERM while the lockstep loop runs: a signal stops it between two
+      !> blocks, every member still running 'interrupted' (without a checkpoint).
+      logical, intent(in), optional :: stop_signals
       type(error_type), allocatable :: failure
       integer :: k
+      if (present(stop_signals)) then
+         if (stop_signals) call catch_stop_signals()
+      end if
       call simulate_lockstep(scenes, models(1), recorders, summaries, error)
+      ! the ensembles' members and the files' ends take a signal's usual effect
+      call release_stop_signals()
       if (allocated(error)) return
       do k = 1, size(scenes)
          call close_run(scenes(k), models(k), recorders(k), summaries(k), failure)

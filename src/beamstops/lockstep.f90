@@ -59,7 +59,8 @@ module beamstops_lockstep
    use beamstops_lockstep_span, only: simulate_span_lockstep
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
       & col_work, col_dissipated, col_damped
-   use beamstops_summary, only: run_summary, status_complete, status_diverged, status_failed, status_running, &
+   use beamstops_stop_signals, only: stop_signal
+   use beamstops_summary, only: mark_interrupted, run_summary, status_complete, status_diverged, status_failed, status_running, &
       & check_divergence
    implicit none
    private
@@ -296,9 +297,15 @@ contains
             if (ms%observers(k)%active) call ms%observers(k)%drain()
             call recorders(k)%progress(ms%step - 1, steps)
          end do
+         if (stop_signal() /= 0) exit
       end do
       do k = 1, nk
          if (ms%active(k)) call finish_member(k, scenes(k), ms, model, summaries(k), t0)
+      end do
+      ! stopped by a signal (beamstops_stop_signals, caught by simulate_group's caller)
+      do k = 1, nk
+         if (summaries(k)%status == status_running) call mark_interrupted(scenes(k), stop_signal(), .false., &
+            & summaries(k))
       end do
    end subroutine simulate_lockstep
 

@@ -39,7 +39,8 @@ module beamstops_lockstep_span
    use beamstops_lockstep_members, only: operators_type, lane, chunk
    use beamstops_span_step, only: span_loop_type, start_span_block, next_span_step, span_step, end_span_block
    use beamstops_recorder, only: recorder_type
-   use beamstops_summary, only: run_summary, status_complete, status_failed, status_running, &
+   use beamstops_stop_signals, only: stop_signal
+   use beamstops_summary, only: mark_interrupted, run_summary, status_complete, status_failed, status_running, &
       & check_divergence
    implicit none
    private
@@ -139,6 +140,13 @@ contains
             lanes%g(lane(k), :, chunk(k)) = 0
             if (allocated(lanes%cd)) lanes%cd(lane(k), :, chunk(k)) = 0
          end do
+         if (stop_signal() /= 0) exit
+      end do
+      ! stopped by a signal (beamstops_stop_signals, caught by simulate_group's caller)
+      do k = 1, nk
+         if (.not. active(k)) cycle
+         call finish_member(scenes(k), models(k), states(k), summaries(k), (thread_cpu_seconds() - t0)/nk)
+         call mark_interrupted(scenes(k), stop_signal(), .false., summaries(k))
       end do
    end subroutine simulate_span_lockstep
 

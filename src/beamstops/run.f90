@@ -8,14 +8,14 @@ module beamstops_run
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
    use, intrinsic :: iso_c_binding, only: c_int
-   use beamstops_strings, only: fmt_int, fmt_real
-   use beamstops_stop_signals, only: catch_stop_signals, release_stop_signals, stop_signal, signal_name
+   use beamstops_strings, only: fmt_int
+   use beamstops_stop_signals, only: catch_stop_signals, release_stop_signals, stop_signal
    use beamstops_scene, only: scene_type, steps_of
    use beamstops_model, only: model_type, build_model, check_stability
    use beamstops_scheme, only: state_type, start_state, run_scheme
    use beamstops_recorder, only: recorder_type
    use beamstops_checkpoint, only: write_checkpoint
-   use beamstops_summary, only: run_summary, status_running, status_failed, status_complete, status_interrupted
+   use beamstops_summary, only: run_summary, status_running, status_failed, status_complete, mark_interrupted
    use beamstops_ensemble, only: run_members
    use beamstops_reduced, only: reduced_model_type, reduce_model
    use beamstops_reduced_scheme, only: start_reduced, reduced_state_type, run_reduced
@@ -278,26 +278,13 @@ contains
             exit
          end if
          if (signum /= 0) then
-            call interrupted(scene, summary%steps, signum, present(checkpoint), summary)
+            call mark_interrupted(scene, signum, present(checkpoint), summary)
             exit
          end if
       end do
       call release_stop_signals()
    end subroutine run_blocks
 
-   !> Status 'interrupted', and where: the loop stopped after step `done` on `signum` (with a
-   !> checkpoint `saved`).
-   subroutine interrupted(scene, done, signum, saved, summary)
-      type(scene_type), intent(in) :: scene
-      integer(ik), intent(in) :: done
-      integer(c_int), intent(in) :: signum
-      logical, intent(in) :: saved
-      type(run_summary), intent(inout) :: summary
-      summary%status = status_interrupted
-      summary%message = 'stopped by '//signal_name(signum)//' at t = '//fmt_real(real(done, wp)*scene%dt)// &
-         & ' s (step '//fmt_int(done)//' of '//fmt_int(steps_of(scene))//'), its records flushed'
-      if (saved) summary%message = summary%message//' and a checkpoint saved'
-   end subroutine interrupted
 
    !> A recorder that could not write makes the run 'failed' with the recorder's message.
    subroutine recorder_outcome(recorder, summary, error)

@@ -41,8 +41,12 @@ void beamstops_release_stop_signals(void)
     catching = 0;
 }
 
-/* The signal noted since beamstops_catch_stop_signals (0: none). */
-int beamstops_stop_signal(void) { return caught; }
+/* The signal noted since beamstops_catch_stop_signals, while the signals are caught (0: none,
+   or not catching: a loop after beamstops_release_stop_signals, an ensemble's members, goes on). */
+int beamstops_stop_signal(void) { return catching ? caught : 0; }
+
+/* The signal noted the last time the signals were caught (0: none), for the run's report. */
+int beamstops_caught_signal(void) { return caught; }
 
 /* The name of a signal the loop stops on ("SIGINT", "SIGTERM"; "signal" otherwise). */
 const char *beamstops_stop_signal_name(int signum)

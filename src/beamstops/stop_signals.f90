@@ -8,7 +8,7 @@ module beamstops_stop_signals
    use, intrinsic :: iso_c_binding, only: c_int, c_ptr, c_char, c_f_pointer
    implicit none
    private
-   public :: catch_stop_signals, release_stop_signals, stop_signal, signal_name
+   public :: catch_stop_signals, release_stop_signals, stop_signal, caught_signal, signal_name
 
    interface
       !> Note SIGINT and SIGTERM from now on instead of their default action (a second one takes it).
@@ -17,11 +17,17 @@ module beamstops_stop_signals
       !> Give SIGINT and SIGTERM back the actions they had before catch_stop_signals.
       subroutine release_stop_signals() bind(c, name='beamstops_release_stop_signals')
       end subroutine release_stop_signals
-      !> The signal noted since catch_stop_signals (0: none).
+      !> The signal noted since catch_stop_signals, while the signals are caught (0: none, or
+      !> released).
       function stop_signal() bind(c, name='beamstops_stop_signal') result(signum)
          import :: c_int
          integer(c_int) :: signum
       end function stop_signal
+      !> The signal noted the last time the signals were caught (0: none), for the run's report.
+      function caught_signal() bind(c, name='beamstops_caught_signal') result(signum)
+         import :: c_int
+         integer(c_int) :: signum
+      end function caught_signal
       function c_signal_name(signum) bind(c, name='beamstops_stop_signal_name') result(name)
          import :: c_int, c_ptr
          integer(c_int), value :: signum

@@ -3,12 +3,14 @@ module beamstops_summary
    use beamstops_kinds, only: wp, ik
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_observe_statistics, only: statistics_table
-   use beamstops_scene, only: scene_type
-   use beamstops_strings, only: fmt_real
+   use beamstops_scene, only: scene_type, steps_of
+   use beamstops_strings, only: fmt_real, fmt_int
+   use beamstops_stop_signals, only: signal_name
+   use, intrinsic :: iso_c_binding, only: c_int
    implicit none
    private
    public :: run_summary, status_complete, status_diverged, status_running, status_failed, status_interrupted, &
-      & check_divergence
+      & check_divergence, mark_interrupted
 
    !> Status texts written to the output's `status` attribute.
    character(len=*), parameter :: status_complete = 'complete', status_diverged = 'diverged', &
@@ -81,4 +83,27 @@ contains
       summary%message = 'the solution blew up (kinetic energy beyond 1e8 times the energy supplied) before t = '// &
          & fmt_real(t, 6)//' s'
    end subroutine check_divergence
+
+   !> Status 'interrupted' and its message: the loop stopped on `signum` after summary%steps of
+   !> the scene's steps, its records flushed (and a checkpoint `saved`, or none: `rerun` says to
+   !> run it again).
+   subroutine mark_interrupted(scene, signum, saved, summary)
+      !> Scene (dt and the number of steps).
+      type(scene_type), intent(in) :: scene
+      !> The signal (beamstops_stop_signals).
+      integer(c_int), intent(in) :: signum
+      !> Whether a checkpoint was saved.
+      logical, intent(in) :: saved
+      !> Summary of the run, steps set.
+      type(run_summary), intent(inout) :: summary
+      summary%status = status_interrupted
+      summary%message = 'stopped by '//signal_name(signum)//' at t = '// &
+         & fmt_real(real(summary%steps, wp)*scene%dt, 12)//' s (step '//fmt_int(summary%steps)//' of '// &
+         & fmt_int(steps_of(scene))//'), its records flushed'
+      if (saved) then
+         summary%message = summary%message//' and a checkpoint saved'
+      else
+         summary%message = summary%message//'; no checkpoint (a member of a lockstep group has none)'
+      end if
+   end subroutine mark_interrupted
 end module beamstops_summary

@@ -9,6 +9,7 @@ import subprocess
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import beamstops
@@ -27,11 +28,13 @@ def write(folder: Path, name: str, extra: str = "") -> Path:
     return path
 
 
-def stop_while_running(scene: Path, signum: int) -> subprocess.CompletedProcess[str]:
-    """Run `scene`, send `signum` once its time loop has written records (the partial file past
-    2 MB: the first buffers of 16,384 rows), and return how the program ended."""
-    partial = scene.with_suffix(".h5.partial")
-    process = subprocess.Popen([PROGRAM, "run", str(scene)], cwd=scene.parent, stdout=subprocess.PIPE,
+def stop_while_running(scenes: list[Path], signum: int) -> subprocess.CompletedProcess[str]:
+    """`beamstops run` of `scenes`, sent `signum` once the first one's time loop has written
+    records (its partial file past 2 MB: the first buffers of 16,384 rows); how it ended. Skips the
+    test when the first scene ended before the signal."""
+    first = scenes[0]
+    partial = first.with_suffix(".h5.partial")
+    process = subprocess.Popen([PROGRAM, "run", *map(str, scenes)], cwd=first.parent, stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True)
     deadline = time.time() + 60
     while process.poll() is None and time.time() < deadline and \
@@ -40,8 +43,8 @@ def stop_while_running(scene: Path, signum: int) -> subprocess.CompletedProcess[
     if process.poll() is None:
         process.send_signal(signum)
     out, err = process.communicate(timeout=120)
-    if process.returncode == 0:
-        pytest.skip("the run ended before the signal")
+    if first.with_suffix(".h5").exists():
+        pytest.skip("the first scene ended before the signal")
     return subprocess.CompletedProcess(process.args, process.returncode, out, err)
 
 
@@ -52,7 +55,7 @@ def test_a_signal_stops_the_run_politely_and_restart_continues_bit_for_bit(tmp_p
     reference = write(tmp_path, "reference", extra)
     assert run("run", reference, cwd=tmp_path).returncode == 0
     scene = write(tmp_path, "stopped", extra)
-    done = stop_while_running(scene, signum)
+    done = stop_while_running([scene], signum)
     assert done.returncode == 128 + signum, done.stderr
     name = signal.Signals(signum).name
     assert done.stderr.count("\n") == 1, done.stderr
@@ -79,18 +82,34 @@ def test_a_signal_stops_several_scenes_after_the_one_it_stopped(tmp_path: Path) 
     scenes = [write(tmp_path, name, f"&mesh elements={elements} /\n") for name, elements in
               (("a", 19), ("b", 18), ("c", 17))]
     partial = tmp_path / "a.h5.partial"
-    process = subprocess.Popen([PROGRAM, "run", *map(str, scenes)], cwd=tmp_path, stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True)
-    deadline = time.time() + 60
-    while process.poll() is None and time.time() < deadline and \
-            (not partial.exists() or partial.stat().st_size < 2_000_000):
-        time.sleep(0.001)
-    process.send_signal(signal.SIGTERM)
-    _, err = process.communicate(timeout=120)
-    if (tmp_path / "a.h5").exists():
-        pytest.skip("the first scene ended before the signal")
-    assert process.returncode == 128 + signal.SIGTERM, err
+    done = stop_while_running(scenes, signal.SIGTERM)
+    err = done.stderr
+    assert done.returncode == 128 + signal.SIGTERM, err
     assert "a.h5: run interrupted: stopped by SIGTERM" in err
     assert err.rstrip("\n").splitlines()[-1] == "beamstops: 2 of the 3 scenes were not started", err
     assert beamstops.load(partial, allow_incomplete=True).status == "interrupted"
     assert not any((tmp_path / name).exists() for name in ("b.h5", "b.h5.partial", "c.h5", "c.h5.partial"))
+
+
+def test_a_signal_stops_a_lockstep_group_with_every_member_flushed(tmp_path: Path) -> None:
+    """Four scenes sharing A (ω varied) run in lockstep; SIGTERM stops the group between two
+    blocks: every member's partial file says 'interrupted' and holds the records of the steps done,
+    the same bits as the scene run alone; no checkpoint (the message says to run it again)."""
+    scenes = [write(tmp_path, f"m{k}", f"&support omega={omega} /\n") for k, omega in enumerate((8, 9, 10, 11))]
+    partial = tmp_path / "m0.h5.partial"
+    done = stop_while_running(scenes, signal.SIGTERM)
+    err = done.stderr
+    assert done.returncode == 128 + signal.SIGTERM, err
+    assert "4 in 1 lockstep group(s)" in err
+    for k in range(4):
+        assert f"m{k}.h5: run interrupted: stopped by SIGTERM" in err
+        assert f"beamstops run {scenes[k]} runs it again" in err
+        assert not (tmp_path / f"m{k}.h5.checkpoint").exists()
+    member = beamstops.load(partial, allow_incomplete=True)
+    assert member.status == "interrupted"
+    assert member.t.size == int(member.attrs["steps"]) + 1 > 0
+    assert run("run", scenes[0], cwd=tmp_path).returncode == 0
+    alone = beamstops.load(tmp_path / "m0.h5")
+    for name in ("t", "tip_u", "tip_v", "reaction", "energy", "work", "dissipated"):
+        kept = getattr(member, name)
+        assert np.array_equal(kept.view(np.uint64), getattr(alone, name)[:kept.size].view(np.uint64)), name
