@@ -23,6 +23,16 @@ subroutine bs_stop_signal(signum)
    signum = caught_signal()
 end subroutine bs_stop_signal
 
+!> Raise the end of allocation an HDF5 file's superblock records to the file's size (a run killed
+!> while HDF5 flushed its file; beamstops_files' raise_hdf5_eoa): raised = 1 when it was.
+subroutine bs_raise_hdf5_eoa(path, raised)
+   use beamstops_files, only: raise_hdf5_eoa
+   implicit none
+   character(len=*), intent(in) :: path
+   integer, intent(out) :: raised
+   raised = merge(1, 0, raise_hdf5_eoa(path))
+end subroutine bs_raise_hdf5_eoa
+
 !> Groups and keys the reader accepts, one group a line: `group: key key ...`.
 subroutine bs_keys(text)
    use beamstops_namelist, only: group_names, group_keys

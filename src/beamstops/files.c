@@ -209,3 +209,38 @@ void beamstops_errno_text(int code, char *text, size_t size)
 {
     snprintf(text, size, "%s", strerror(code));
 }
+
+/* An HDF5 file killed while HDF5 flushed it may carry metadata written after the last
+   superblock: chunk indexes pointing past the end-of-allocation address (EOA) the superblock
+   records, which HDF5 then refuses ("addr overflow"). Everything the process wrote is in the file
+   (a killed process loses nothing it wrote), so raising the EOA to the file's size makes those
+   addresses valid again, as `h5clear --increment=0` does. Superblock versions 0 and 1 only (the
+   program's files; later versions carry a checksum), 8-byte addresses, at byte 0. Returns 1 when
+   the EOA was raised, 0 when the file needs nothing, -1 when it is not such a file or cannot be
+   written. */
+int beamstops_raise_hdf5_eoa(const char *path)
+{
+    static const unsigned char signature[8] = {0x89, 'H', 'D', 'F', '\r', '\n', 0x1a, '\n'};
+    unsigned char head[52], word[8];
+    struct stat s;
+    uint64_t eoa = 0, size;
+    int fd = open(path, O_RDWR), version, at, k, outcome = -1;
+    if (fd < 0)
+        return -1;
+    if (fstat(fd, &s) == 0 && pread(fd, head, sizeof head, 0) == (ssize_t)sizeof head &&
+        memcmp(head, signature, 8) == 0 && head[13] == 8 && (head[8] == 0 || head[8] == 1)) {
+        version = head[8];
+        at = version == 0 ? 40 : 44; /* after the base and free-space addresses */
+        for (k = 7; k >= 0; k--)
+            eoa = (eoa << 8) | head[at + k];
+        size = (uint64_t)s.st_size;
+        outcome = 0;
+        if (size > eoa) {
+            for (k = 0; k < 8; k++)
+                word[k] = (unsigned char)(size >> (8 * k));
+            outcome = pwrite(fd, word, 8, at) == 8 ? 1 : -1;
+        }
+    }
+    close(fd);
+    return outcome;
+}

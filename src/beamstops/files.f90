@@ -6,6 +6,7 @@ module beamstops_files
    implicit none
    private
    public :: file_exists, is_directory, same_file, same_path, rename_file, replace_file, remove_file, creation_error
+   public :: raise_hdf5_eoa
    public :: read_whole_file, read_ok, read_missing, read_folder, read_too_big, read_unopened, read_failed
 
    !> Outcomes of read_whole_file: read, no such file, a folder, more bytes than allowed, not
@@ -65,6 +66,11 @@ module beamstops_files
          character(kind=c_char), intent(in) :: path(*)
          integer(c_int) :: code
       end function c_creation_errno
+      function c_raise_hdf5_eoa(path) bind(c, name='beamstops_raise_hdf5_eoa') result(outcome)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int) :: outcome
+      end function c_raise_hdf5_eoa
       subroutine c_errno_text(code, text, size) bind(c, name='beamstops_errno_text')
          import :: c_char, c_int, c_size_t
          integer(c_int), value :: code
@@ -203,4 +209,13 @@ contains
       integer(c_int) :: status
       status = c_remove(path//c_null_char)
    end subroutine remove_file
+
+   !> Raise the end-of-allocation address an HDF5 file's superblock records to the file's size
+   !> when the file is longer (files.c, beamstops_raise_hdf5_eoa: a run killed while HDF5 flushed
+   !> its file). True when it was raised.
+   logical function raise_hdf5_eoa(path)
+      !> The HDF5 file.
+      character(len=*), intent(in) :: path
+      raise_hdf5_eoa = c_raise_hdf5_eoa(path//c_null_char) == 1
+   end function raise_hdf5_eoa
 end module beamstops_files

@@ -156,25 +156,14 @@ class Result:
                 f"cpu_seconds={a.get('cpu_seconds')!r})")
 
 
-def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result:
-    """Read the HDF5 output of ``beamstops run``.
 
-    A file whose ``status`` is not 'complete' (a run that diverged, failed or is still
-    being written) raises :class:`IncompleteRunError` (a ValueError, holding what the
-    file has) unless ``allow_incomplete``.
-    """
+def _read(path: str) -> tuple[dict[str, Any], dict[str, np.ndarray], dict[str, np.ndarray], dict[str, Statistic],
+                              dict[str, Any], dict[str, Statistic]]:
+    """The attributes, arrays, shock log, statistics (with their settings) and ensemble table of
+    a file written by ``beamstops run``."""
     import h5py
 
-    path = os.fspath(path)
-    if os.path.isdir(path):
-        raise IsADirectoryError(f"{path}: is a folder, not the HDF5 output of `beamstops run`; name the file")
-    if not os.path.isfile(path):
-        raise FileNotFoundError(f"{path}: no such file")
-    try:
-        file = h5py.File(path, "r")
-    except OSError as exc:
-        raise OSError(f"{path}: cannot read as HDF5 ({exc})") from None
-    with file as f:
+    with h5py.File(path, "r") as f:
         attrs = {name: _plain(value) for name, value in f.attrs.items()}
         if "status" not in attrs:
             raise ValueError(f"{path}: not a beamstops output (no status attribute)")
@@ -185,6 +174,41 @@ def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result
         impacts = read_impacts(f, path)
         statistics, statistics_attrs = read_statistics(f, path)
         ensemble, _ = read_statistics(f, path, "ensemble")
+    return attrs, arrays, impacts, statistics, statistics_attrs, ensemble
+
+
+def _raise_eoa(path: str) -> bool:
+    """Raise the end of allocation the file's superblock records to the file's size (the
+    engine's ``raise_hdf5_eoa``, as ``h5clear --increment=0``): everything a killed run wrote is
+    in the file, and its indexes may point past the allocation its last flush recorded. True
+    when it was raised."""
+    from . import _engine
+    from .engine_call import engine_call
+
+    return bool(engine_call(_engine.bs_raise_hdf5_eoa, path.encode()))
+
+def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result:
+    """Read the HDF5 output of ``beamstops run``.
+
+    A file whose ``status`` is not 'complete' (a run that diverged, failed or is still
+    being written) raises :class:`IncompleteRunError` (a ValueError, holding what the
+    file has) unless ``allow_incomplete``. A file HDF5 refuses with "addr overflow" (a run
+    killed while HDF5 flushed it) has the end of allocation its superblock records raised to its
+    size, in place, and is read again (what ``h5clear --increment=0`` does; nothing else of the
+    file changes).
+    """
+    path = os.fspath(path)
+    if os.path.isdir(path):
+        raise IsADirectoryError(f"{path}: is a folder, not the HDF5 output of `beamstops run`; name the file")
+    if not os.path.isfile(path):
+        raise FileNotFoundError(f"{path}: no such file")
+    try:
+        attrs, arrays, impacts, statistics, statistics_attrs, ensemble = _read(path)
+    except (OSError, RuntimeError) as exc:
+        # a run killed while HDF5 flushed its file: indexes past the allocation the file records
+        if "addr overflow" not in str(exc) or not _raise_eoa(path):
+            raise OSError(f"{path}: cannot read as HDF5 ({exc})") from None
+        attrs, arrays, impacts, statistics, statistics_attrs, ensemble = _read(path)
     nodes = arrays["snapshot_x"].size if "snapshot_x" in arrays else 0
     arrays.setdefault("snapshot_t", np.empty(0))
     arrays.setdefault("snapshot_x", np.empty(0))

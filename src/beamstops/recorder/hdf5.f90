@@ -20,7 +20,7 @@ module beamstops_recorder_hdf5
    use beamstops_scene, only: scene_type, law_name, law_compliance, stop_count, steps_of
    use beamstops_model, only: model_type
    use beamstops_summary, only: run_summary, status_running, status_complete, status_diverged, status_failed
-   use beamstops_files, only: file_exists, is_directory, same_file, replace_file, creation_error
+   use beamstops_files, only: file_exists, is_directory, same_file, replace_file, creation_error, raise_hdf5_eoa
    use beamstops_recorder_hdf5_vector, only: write_vector
    use beamstops_recorder, only: recorder_type, n_columns, col_t, all_finite
    use beamstops_attributes, only: attribute_list, kind_real, kind_int, kind_logical, kind_text
@@ -313,8 +313,10 @@ contains
       type(error_type), allocatable, intent(out) :: error
       character(len=*), parameter :: end_groups(3) = [character(len=10) :: 'impacts', 'statistics', 'ensemble']
       integer :: hdferr, i
-      logical :: stale
+      logical :: stale, raised
       call prepare(self, path, scene, model)
+      ! a run killed while HDF5 flushed may have left indexes past the allocation the file records
+      raised = raise_hdf5_eoa(self%partial)
       call h5fopen_f(self%partial, H5F_ACC_RDWR_F, self%file, hdferr)
       if (hdferr /= 0) then
          call fail(self, 'cannot reopen '//self%partial//', the output of the interrupted run (a run killed while '// &
