@@ -106,6 +106,8 @@ program beamstops_main
 
    !> SIGXFSZ (Linux on x86, ARM, POWER, RISC-V, s390; BSD and macOS too) and SIG_IGN.
    integer(c_int), parameter :: sigxfsz = 25_c_int
+   !> SIGTERM (Linux and the BSDs).
+   integer(c_int), parameter :: sigterm = 15_c_int
    integer(c_intptr_t), parameter :: sig_ign = 1_c_intptr_t
 
    integer, parameter :: exit_input = 1, exit_usage = 2, exit_diverged = 3, exit_output = 4, exit_signal = 128
@@ -360,6 +362,13 @@ contains
 
    !> A write beyond the file-size limit (ulimit -f) kills the process with SIGXFSZ; ignored, the
    !> write fails with EFBIG instead, and the run ends with a message like any failed write.
+   !> Once a signal has stopped a run, a SIGTERM more (a batch system's second, a sweep worker's
+   !> beside the one sent to the whole group) does not cut the files' end short.
+   subroutine hold_terminate()
+      type(c_funptr) :: previous
+      previous = c_signal(sigterm, transfer(sig_ign, c_null_funptr))
+   end subroutine hold_terminate
+
    subroutine ignore_file_size_signal()
       type(c_funptr) :: previous
       previous = c_signal(sigxfsz, transfer(sig_ign, c_null_funptr))
@@ -443,6 +452,7 @@ contains
       else
          call continue_run(scene, model, state, recorder, summary, write_error, checkpoint, .true.)
       end if
+      if (summary%status == status_interrupted) call hold_terminate()
       call recorder%finish(summary, finish_error)
       status = run_outcome(scene, input, summary, error, write_error, finish_error)
    end function run_to_file
@@ -717,6 +727,9 @@ contains
          end do
          return
       end if
+      do k = 1, size(ids)
+         if (summaries(k)%status == status_interrupted) call hold_terminate()
+      end do
       do k = 1, size(ids)
          i = ids(k)
          if (allocated(write_error)) deallocate (write_error)

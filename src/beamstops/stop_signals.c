@@ -3,8 +3,10 @@
  * signal; the loop looks at the note between two of its blocks and stops there with its records
  * flushed and a checkpoint saved. The note is the one piece of process-wide mutable state of the
  * engine: a signal handler can set nothing else (async-signal-safe, volatile sig_atomic_t). A
- * second signal takes the default action (SA_RESETHAND): a user who presses Ctrl-C twice is not
- * kept waiting. SA_RESTART: the writer thread's writes, if the signal lands on it, go on. */
+ * second SIGINT takes the default action (SA_RESETHAND): a user who presses Ctrl-C twice is not
+ * kept waiting. A second SIGTERM is noted again: a batch system (or a sweep's worker, and the
+ * signal sent to the whole group) may send it twice, and forces the end with SIGKILL after its
+ * grace period. SA_RESTART: the writer thread's writes, if the signal lands on it, go on. */
 #include <signal.h>
 #include <string.h>
 
@@ -17,18 +19,20 @@ static void note(int signum) { caught = signum; }
 /* Note SIGINT and SIGTERM from now on (instead of their action; those ignored stay ignored). */
 void beamstops_catch_stop_signals(void)
 {
-    struct sigaction action;
+    struct sigaction interrupt, terminate;
     if (catching) return;
-    memset(&action, 0, sizeof action);
-    action.sa_handler = note;
-    sigemptyset(&action.sa_mask);
-    action.sa_flags = SA_RESETHAND | SA_RESTART;
+    memset(&interrupt, 0, sizeof interrupt);
+    interrupt.sa_handler = note;
+    sigemptyset(&interrupt.sa_mask);
+    terminate = interrupt;
+    interrupt.sa_flags = SA_RESETHAND | SA_RESTART;
+    terminate.sa_flags = SA_RESTART;
     caught = 0;
     /* a signal the process ignores (a background job's SIGINT, nohup) stays ignored */
     sigaction(SIGINT, NULL, &previous_int);
     sigaction(SIGTERM, NULL, &previous_term);
-    if (previous_int.sa_handler != SIG_IGN) sigaction(SIGINT, &action, NULL);
-    if (previous_term.sa_handler != SIG_IGN) sigaction(SIGTERM, &action, NULL);
+    if (previous_int.sa_handler != SIG_IGN) sigaction(SIGINT, &interrupt, NULL);
+    if (previous_term.sa_handler != SIG_IGN) sigaction(SIGTERM, &terminate, NULL);
     catching = 1;
 }
 

@@ -204,6 +204,54 @@ amplitude = { start = 0.10, stop = 0.15, step = 0.01 }
     assert without_timing(read_summary(tmp_path / "clean")) == without_timing(resumed)
 
 
+def test_a_point_stopped_by_a_signal_continues_from_its_checkpoint(tmp_path: Path,
+                                                                   write_spec: Callable[..., Path],
+                                                                   without_timing: Callable[..., Any]) -> None:
+    """SIGTERM to the whole sweep (a batch system's time limit) while a point runs: the point's
+    program stops politely (checkpoint saved, its partial file 'interrupted'); the resumed sweep
+    continues that point from the checkpoint (--restart) instead of starting it over. Seen by a
+    mark put into the partial file's first record: a run started over would not keep it."""
+    text = """
+[sweep]
+lockstep = 1
+[scene]
+dt = 1e-6
+t_end = 3.0
+record_every = 100
+[axes]
+amplitude = { start = 0.10, stop = 0.12, num = 2 }
+"""
+    spec_path = write_spec(text)
+    out = tmp_path / "out"
+    command = [sys.executable, "-m", "beamstops", "sweep", str(spec_path), "-o", str(out), "-j", "1", "--interval", "0.1"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               start_new_session=True)
+    deadline = time.monotonic() + 60
+    while process.poll() is None and not list((out / "points").glob("*.h5.partial")) and \
+            time.monotonic() < deadline:
+        time.sleep(0.01)
+    time.sleep(0.2)  # into its time loop
+    os.killpg(process.pid, signal.SIGTERM)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 130, err
+    partials = list((out / "points").glob("*.h5.partial"))
+    if not partials:
+        pytest.skip("the point ended before the signal")
+    partial = partials[0]
+    assert Path(f"{str(partial)[:-len('.partial')]}.checkpoint").is_file()
+    assert beamstops.load(partial, allow_incomplete=True).status == "interrupted"
+    with h5py.File(partial, "r+") as f:
+        f["tip/u"][0] = 42.0
+    done = subprocess.run(command, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    final = Path(str(partial)[:-len(".partial")])
+    assert beamstops.load(final).tip_u[0] == 42.0  # continued, not started over
+    assert not partial.exists()
+    clean = run_sweep(load_spec(spec_path), tmp_path / "clean", jobs=1, stream=None)
+    assert clean.complete == 2
+    assert without_timing(read_summary(tmp_path / "clean")) == without_timing(read_summary(out))
+
+
 def test_a_folder_holds_one_specification(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                           write_spec: Callable[..., Path]) -> None:
     from beamstops import cli

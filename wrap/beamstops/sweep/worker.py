@@ -11,6 +11,12 @@ existing ``NAME.h5`` is always a finished run. Its record (parameters, status, m
 the run's figures and the reductions) is written next to its HDF5 file as ``NAME.json``
 (atomically) and returned. Tasks and records are plain data, so that any
 ``concurrent.futures`` executor carries them: local processes or MPI ranks.
+
+A worker stopped by SIGTERM (the sweep stopped, a batch system's time limit) sends SIGTERM to
+its program, which stops between two blocks of its loop with a checkpoint saved
+(``NAME.h5.checkpoint``; not for members of a lockstep group), and SIGKILL after 30 s. When the
+sweep resumes, a point with a checkpoint continues from it (``--restart``), bit for bit, instead
+of starting over.
 """
 
 from __future__ import annotations
@@ -77,17 +83,29 @@ _ARMED = False
 _PROGRAM: Optional[subprocess.Popen[str]] = None  # the program this worker is running, if any
 
 
+#: Seconds a worker stopped by SIGTERM gives its program to stop politely before SIGKILL.
+_GRACE = 30.0
+
+
 def _on_term(signum: int, frame: Any) -> None:
-    # Stop the running program (as subprocess.run does when it is left by an exception), then
-    # this worker. Nothing is raised: the handler runs between any two bytecodes, inside a
-    # weakref callback or the pool's machinery too, where an exception surfaces as an
-    # "Exception ignored" traceback and the worker goes on; nothing of ours needs cleaning (a
-    # point's record is written atomically, and an unfinished point runs again on resume).
+    # Stop the running program, then this worker. The program is sent SIGTERM: it stops between
+    # two blocks of its loop with its records flushed and a checkpoint saved (a point running
+    # alone then continues from there on resume, bit for bit); SIGKILL after _GRACE seconds.
+    # Nothing is raised: the handler runs between any two bytecodes, inside a weakref callback or
+    # the pool's machinery too, where an exception surfaces as an "Exception ignored" traceback
+    # and the worker goes on; nothing of ours needs cleaning (a point's record is written
+    # atomically, and an unfinished point runs again on resume).
     program = _PROGRAM
     if program is not None and program.returncode is None:
         try:
-            os.kill(program.pid, signal.SIGKILL)
-        except OSError:
+            os.kill(program.pid, signal.SIGTERM)
+            deadline = time.monotonic() + _GRACE
+            while os.waitpid(program.pid, os.WNOHANG) == (0, 0):
+                if time.monotonic() > deadline:
+                    os.kill(program.pid, signal.SIGKILL)
+                    break
+                time.sleep(0.005)
+        except OSError:  # ended (and reaped) already
             pass
     os._exit(128 + signum)
 
@@ -161,9 +179,13 @@ def _run_program(task: dict[str, Any], nml: Path, h5: Path, record: dict[str, An
             stale.unlink()
     Scene(**task["scene"]).to_namelist(nml)
     command = [task["program"], "run", str(nml), "-o", str(h5)]
+    # a point a signal stopped (its checkpoint saved) continues from it, bit for bit
+    resume = _resumable(h5)
     start = time.perf_counter()
     try:
-        done = _run(command, timeout=task.get("timeout"))
+        done = _run(command + ["--restart"] if resume else command, timeout=task.get("timeout"))
+        if resume and done.returncode in (1, 4):  # a checkpoint of another scene, a partial file HDF5 refuses
+            done = _run(command, timeout=task.get("timeout"))
     except subprocess.TimeoutExpired:
         record["wall_seconds"] = time.perf_counter() - start
         record["message"] = f"timed out after {task['timeout']:g} s (the run was stopped)"
@@ -179,6 +201,12 @@ def _run_program(task: dict[str, Any], nml: Path, h5: Path, record: dict[str, An
         record["message"] = _message(done.stderr, done.stdout, done.returncode)
     else:
         record["message"] = _message(done.stderr, done.stdout, done.returncode)
+
+
+def _resumable(h5: Path) -> bool:
+    """Whether the point writing `h5` was stopped with a checkpoint saved (the program's
+    OUT.h5.partial and OUT.h5.checkpoint): `beamstops run --restart` continues it."""
+    return Path(f"{h5}.partial").is_file() and Path(f"{h5}.checkpoint").is_file()
 
 
 def _base_record(task: dict[str, Any], folder: Path, h5: Path) -> dict[str, Any]:
@@ -221,8 +249,11 @@ def run_batch(tasks: list[dict[str, Any]]) -> dict[str, Any]:
             Scene(**{**task["scene"], "file": h5.name}).to_namelist(nml)
             paths.append(nml.name)
         timeout = tasks[0].get("timeout")
+        # points a signal stopped (their checkpoints saved) continue from them, alone, bit for bit
+        resume = any(_resumable(Path(task["folder"]) / f"{task['name']}.h5") for task in tasks)
         try:
-            done = _run([tasks[0]["program"], "run", *paths], cwd=tasks[0]["folder"],
+            done = _run([tasks[0]["program"], "run", *paths, *(["--restart"] if resume else [])],
+                        cwd=tasks[0]["folder"],
                         timeout=timeout * len(tasks) if timeout else None)
             for line in done.stderr.splitlines():
                 match = _GROUPS.match(line)
