@@ -164,6 +164,24 @@ def test_resume_skips_finished_points_and_reruns_interrupted_ones(tmp_path: Path
     assert without_timing(read_summary(out)) == without_timing(first)
 
 
+def stop_sweep(spec_path: Path, out: Path, pattern: str, settle: float) -> tuple[list[str], str]:
+    """Start ``beamstops sweep`` of `spec_path` into `out` on one worker, in a session of its own;
+    once a file matching `pattern` is in out/points and `settle` seconds more have passed, send
+    SIGTERM to the whole session (a batch system's time limit: the whole job). The command and
+    the sweep's stderr; the sweep must say it was interrupted (exit 130)."""
+    command = [sys.executable, "-m", "beamstops", "sweep", str(spec_path), "-o", str(out), "-j", "1", "--interval", "0.1"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               start_new_session=True)
+    deadline = time.monotonic() + 60
+    while process.poll() is None and not list((out / "points").glob(pattern)) and time.monotonic() < deadline:
+        time.sleep(0.01)
+    time.sleep(settle)
+    os.killpg(process.pid, signal.SIGTERM)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 130, err
+    return command, err
+
+
 def test_resume_after_a_real_interruption_gives_the_uninterrupted_results(tmp_path: Path,
                                                                           write_spec: Callable[..., Path],
                                                                           without_timing: Callable[..., Any]) -> None:
@@ -181,16 +199,8 @@ amplitude = { start = 0.10, stop = 0.15, step = 0.01 }
 """
     spec_path = write_spec(text)
     out = tmp_path / "out"
-    command = [sys.executable, "-m", "beamstops", "sweep", str(spec_path), "-o", str(out), "-j", "1", "--interval", "0.1"]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                               start_new_session=True)
-    deadline = time.monotonic() + 60
-    while not list((out / "points").glob("*.json")) and time.monotonic() < deadline:
-        time.sleep(0.02)
-    time.sleep(0.5)  # the sweep takes the point's result after its worker wrote the file (slow when loaded)
-    os.killpg(process.pid, signal.SIGTERM)  # a batch system's time limit: the whole job
-    _, err = process.communicate(timeout=60)
-    assert process.returncode == 130, err
+    # the sweep takes the point's result after its worker wrote the file (slow when loaded)
+    command, err = stop_sweep(spec_path, out, "*.json", 0.5)
     assert "interrupted" in err and "Traceback" not in err
     statuses = [r["status"] for r in read_summary(out)]
     assert "complete" in statuses and "pending" in statuses, statuses
@@ -211,29 +221,10 @@ def test_a_point_stopped_by_a_signal_continues_from_its_checkpoint(tmp_path: Pat
     program stops politely (checkpoint saved, its partial file 'interrupted'); the resumed sweep
     continues that point from the checkpoint (--restart) instead of starting it over. Seen by a
     mark put into the partial file's first record: a run started over would not keep it."""
-    text = """
-[sweep]
-lockstep = 1
-[scene]
-dt = 1e-6
-t_end = 3.0
-record_every = 100
-[axes]
-amplitude = { start = 0.10, stop = 0.12, num = 2 }
-"""
-    spec_path = write_spec(text)
+    spec_path = write_spec("[sweep]\nlockstep = 1\n[scene]\ndt = 1e-6\nt_end = 3.0\nrecord_every = 100\n"
+                           "[axes]\namplitude = { start = 0.10, stop = 0.12, num = 2 }\n")
     out = tmp_path / "out"
-    command = [sys.executable, "-m", "beamstops", "sweep", str(spec_path), "-o", str(out), "-j", "1", "--interval", "0.1"]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                               start_new_session=True)
-    deadline = time.monotonic() + 60
-    while process.poll() is None and not list((out / "points").glob("*.h5.partial")) and \
-            time.monotonic() < deadline:
-        time.sleep(0.01)
-    time.sleep(0.2)  # into its time loop
-    os.killpg(process.pid, signal.SIGTERM)
-    _, err = process.communicate(timeout=60)
-    assert process.returncode == 130, err
+    command, _ = stop_sweep(spec_path, out, "*.h5.partial", 0.2)  # 0.2 s: into the point's time loop
     partials = list((out / "points").glob("*.h5.partial"))
     if not partials:
         pytest.skip("the point ended before the signal")
