@@ -1,8 +1,9 @@
 /* A polite stop for `beamstops run` (used by src/beamstops/stop_signals.f90): while the time
  * loop runs, SIGINT and SIGTERM (Ctrl-C, a batch system's time limit, `kill`) only note the
  * signal; the loop looks at the note between two of its blocks and stops there with its records
- * flushed and a checkpoint saved. The note is the one piece of process-wide mutable state of the
- * engine: a signal handler can set nothing else (async-signal-safe, volatile sig_atomic_t). A
+ * flushed and a checkpoint saved. The note, and the actions it stands in for meanwhile, are the
+ * engine's only process-wide mutable state: a signal handler can reach nothing else (it may only
+ * set a volatile sig_atomic_t), and the actions are the process's own. A
  * second SIGINT takes the default action (SA_RESETHAND): a user who presses Ctrl-C twice is not
  * kept waiting. A second SIGTERM is noted again: a batch system (or a sweep's worker, and the
  * signal sent to the whole group) may send it twice, and forces the end with SIGKILL after its
@@ -28,7 +29,7 @@ void beamstops_catch_stop_signals(void)
     interrupt.sa_flags = SA_RESETHAND | SA_RESTART;
     terminate.sa_flags = SA_RESTART;
     caught = 0;
-    /* a signal the process ignores (a background job's SIGINT, nohup) stays ignored */
+    /* a signal the process ignores (the SIGINT of a job a script put in the background) stays ignored */
     sigaction(SIGINT, NULL, &previous_int);
     sigaction(SIGTERM, NULL, &previous_term);
     if (previous_int.sa_handler != SIG_IGN) sigaction(SIGINT, &interrupt, NULL);

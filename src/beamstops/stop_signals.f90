@@ -1,9 +1,10 @@
-!> A polite stop for `beamstops run` (C side: stop_signals.c). The program catches SIGINT and
-!> SIGTERM around its time loop (catch_stop_signals, release_stop_signals); a signal then only
-!> leaves a note, which the loop reads between two of its blocks (stop_signal): the run stops
-!> there with its records flushed and a checkpoint saved, and `--restart` continues it bit for
-!> bit. Without catch_stop_signals (the Python layer, lockstep groups) stop_signal is 0 and a
-!> signal has its usual effect.
+!> A polite stop (C side: stop_signals.c). Around a time loop (one scene's: continue_run,
+!> continue_reduced; a lockstep group's: simulate_group) the program, and the Python layer in its
+!> main thread, catch SIGINT and SIGTERM (catch_stop_signals, release_stop_signals); a signal
+!> then only leaves a note, which the loop reads between two of its blocks (stop_signal): the
+!> run stops there with its records flushed, a checkpoint saved where the loop has one, status
+!> 'interrupted', and `--restart` continues it bit for bit. Elsewhere stop_signal is 0 and a
+!> signal has its usual effect; caught_signal says afterwards which signal it was.
 module beamstops_stop_signals
    use, intrinsic :: iso_c_binding, only: c_int, c_ptr, c_char, c_f_pointer
    implicit none
