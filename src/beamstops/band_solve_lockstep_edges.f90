@@ -11,7 +11,7 @@ module beamstops_band_solve_lockstep_edges
    private
    public :: lockstep_lanes, forward_first_rows, forward_last_rows, back_first_rows, back_last_rows
    public :: back_update_first_rows, back_update_last_rows
-   public :: matvec_rhs_first_rows, matvec_rhs_last_rows, lockstep_load_work
+   public :: matvec_rhs_first_rows, matvec_rhs_last_rows, lockstep_load_work, load_work_first_rows, load_work_last_rows
 
    !> Members the kernels advance at once (the first extent of their arrays): one AVX-512
    !> register of doubles, two of AVX2.
@@ -233,7 +233,7 @@ contains
    !> g.d of every lane in the order of beamstops_band_solve's load_work_product (row j in sum
    !> mod(n - j, 3) + 1 from the last row down, then (s1 + s2) + s3), n >= kd: after the back
    !> substitution (the narrow kernels', the general and span loops'; the wide kernels take it
-   !> on the way).
+   !> on the way, with load_work_first_rows and load_work_last_rows).
    pure subroutine lockstep_load_work(n, g, d, gd)
       !> Unknowns.
       integer, intent(in) :: n
@@ -243,13 +243,7 @@ contains
       real(wp), intent(out) :: gd(lockstep_lanes)
       real(wp) :: ga(lockstep_lanes), gb(lockstep_lanes), gc(lockstep_lanes)
       integer :: i, k
-!GCC$ ivdep
-!GCC$ vector
-      do k = 1, lockstep_lanes
-         ga(k) = g(k, n)*d(k, n)
-         gb(k) = g(k, n - 1)*d(k, n - 1)
-         gc(k) = g(k, n - 2)*d(k, n - 2)
-      end do
+      call load_work_first_rows(n, g, d, ga, gb, gc)
       do i = n - kd, 3, -3
 !GCC$ ivdep
 !GCC$ vector
@@ -259,6 +253,39 @@ contains
             gc(k) = gc(k) + g(k, i - 2)*d(k, i - 2)
          end do
       end do
+      call load_work_last_rows(i, n, g, d, ga, gb, gc, gd)
+   end subroutine lockstep_load_work
+
+   !> The three partial sums of lockstep_load_work started with the last kd rows' terms.
+   pure subroutine load_work_first_rows(n, g, d, ga, gb, gc)
+      !> Unknowns.
+      integer, intent(in) :: n
+      !> Load vectors and d (lanes, n).
+      real(wp), intent(in) :: g(lockstep_lanes, n), d(lockstep_lanes, n)
+      !> g_n d_n, g_{n-1} d_{n-1}, g_{n-2} d_{n-2} (lanes).
+      real(wp), intent(out) :: ga(lockstep_lanes), gb(lockstep_lanes), gc(lockstep_lanes)
+      integer :: k
+!GCC$ ivdep
+!GCC$ vector
+      do k = 1, lockstep_lanes
+         ga(k) = g(k, n)*d(k, n)
+         gb(k) = g(k, n - 1)*d(k, n - 1)
+         gc(k) = g(k, n - 2)*d(k, n - 2)
+      end do
+   end subroutine load_work_first_rows
+
+   !> The terms of rows i and i-1 (those of them >= 1) left after the loop by three, added into
+   !> their partial sums, and g.d = (ga + gb) + gc.
+   pure subroutine load_work_last_rows(i, n, g, d, ga, gb, gc, gd)
+      !> First row left, and unknowns.
+      integer, intent(in) :: i, n
+      !> Load vectors and d (lanes, n).
+      real(wp), intent(in) :: g(lockstep_lanes, n), d(lockstep_lanes, n)
+      !> The partial sums (lanes).
+      real(wp), intent(inout) :: ga(lockstep_lanes), gb(lockstep_lanes), gc(lockstep_lanes)
+      !> The products (lanes).
+      real(wp), intent(out) :: gd(lockstep_lanes)
+      integer :: k
       if (i >= 1) then
 !GCC$ ivdep
 !GCC$ vector
@@ -278,6 +305,6 @@ contains
       do k = 1, lockstep_lanes
          gd(k) = (ga(k) + gb(k)) + gc(k)
       end do
-   end subroutine lockstep_load_work
+   end subroutine load_work_last_rows
 
 end module beamstops_band_solve_lockstep_edges

@@ -13,7 +13,8 @@ module beamstops_band_solve_lockstep_wide
    use beamstops_kinds, only: wp
    use beamstops_band, only: kd
    use beamstops_band_solve_lockstep_edges, only: lockstep_lanes, forward_first_rows, forward_last_rows, &
-      & back_first_rows, back_last_rows, back_update_first_rows, back_update_last_rows, matvec_rhs_first_rows, matvec_rhs_last_rows
+      & back_first_rows, back_last_rows, back_update_first_rows, back_update_last_rows, matvec_rhs_first_rows, matvec_rhs_last_rows, &
+      & load_work_first_rows, load_work_last_rows
    implicit none
    private
    public :: wide_forward_rows, wide_back_rows, wide_back_update_rows, wide_periodic_rows
@@ -92,13 +93,7 @@ contains
       real(wp) :: ga(lockstep_lanes), gb(lockstep_lanes), gc(lockstep_lanes)
       integer :: i, k
       call back_update_first_rows(n, b, c, z, d, u, xa, xb, xc)
-!GCC$ ivdep
-!GCC$ vector
-      do k = 1, lockstep_lanes
-         ga(k) = g(k, n)*d(k, n)
-         gb(k) = g(k, n - 1)*d(k, n - 1)
-         gc(k) = g(k, n - 2)*d(k, n - 2)
-      end do
+      call load_work_first_rows(n, g, d, ga, gb, gc)
       do i = n - kd, 3, -3
 !GCC$ ivdep
 !GCC$ vector
@@ -120,13 +115,7 @@ contains
       ! the rows left (fewer than three), then their terms of g.d (each row's term needs only
       ! its own d)
       call back_update_last_rows(off, i, n, b, c, z, d, u, xa, xb, xc)
-      if (i >= 1) ga = ga + g(:, i)*d(:, i)
-      if (i - 1 >= 1) gb = gb + g(:, i - 1)*d(:, i - 1)
-!GCC$ ivdep
-!GCC$ vector
-      do k = 1, lockstep_lanes
-         gd(k) = (ga(k) + gb(k)) + gc(k)
-      end do
+      call load_work_last_rows(i, n, g, d, ga, gb, gc, gd)
    end subroutine wide_back_update_rows
 
    !> The interior rows kd+1 .. n-kd of the product by a periodic S and the right-hand side
