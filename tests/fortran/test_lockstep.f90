@@ -347,6 +347,23 @@ contains
       end do
    end subroutine test_energy_sums
 
+   !> The paper's scene with `elements` elements and dt = 1e-5 s, its model, the factor of A as a
+   !> band_solver and S by diagonals: what the kernel tests run on.
+   subroutine kernel_model(elements, model, solver, s, error)
+      integer, intent(in) :: elements
+      type(model_type), intent(out) :: model
+      type(band_solver), intent(out) :: solver
+      type(band_diagonals), intent(out) :: s
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      scene%elements = elements
+      scene%dt = 1.0e-5_wp
+      call build_model(scene, model, error)
+      if (allocated(error)) return
+      call prepare_solver(model%factor, solver)
+      call prepare_diagonals(model%stiffness, s)
+   end subroutine kernel_model
+
    !> The kernels of beamstops_band_solve_lockstep against those of beamstops_band_solve, lane by
    !> lane, on random vectors: the product by S, both substitutions (with and without the
    !> energy sums), the dot product, the update. The place to look first when the one-scene
@@ -368,12 +385,8 @@ contains
       integer :: a, rep, k, n
       character(len=:), allocatable :: where
       do a = 1, size(meshes)
-         scene%elements = meshes(a)
-         scene%dt = 1.0e-5_wp
-         call build_model(scene, model, error)
+         call kernel_model(meshes(a), model, solver, s, error)
          if (allocated(error)) return
-         call prepare_solver(model%factor, solver)
-         call prepare_diagonals(model%stiffness, s)
          call prepare_diagonals(model%mass, m)
          n = model%n
          if (allocated(x)) deallocate (x, y, b, u, d, ub, v, w, uk, w2)
@@ -484,6 +497,7 @@ contains
          end do
       end do
       ! the one-member back substitution with the update on meshes too small for lockstep
+      scene%dt = 1.0e-5_wp
       do a = 1, 3
          scene%elements = a
          call build_model(scene, model, error)
@@ -508,7 +522,6 @@ contains
    subroutine test_kernel_shapes(error)
       type(error_type), allocatable, intent(out) :: error
       integer, parameter :: lanes = lockstep_lanes
-      type(scene_type) :: scene
       type(model_type) :: model
       type(band_solver) :: solver
       type(band_diagonals) :: s
@@ -521,12 +534,8 @@ contains
          & int_text(vector_registers))
       if (allocated(error)) return
       do m = 1, size(kernel_meshes)
-         scene%elements = kernel_meshes(m)
-         scene%dt = 1.0e-5_wp
-         call build_model(scene, model, error)
+         call kernel_model(kernel_meshes(m), model, solver, s, error)
          if (allocated(error)) return
-         call prepare_solver(model%factor, solver)
-         call prepare_diagonals(model%stiffness, s)
          call lockstep_periodic_rows(s, periodic, rows)
          n = model%n
          if (allocated(x)) deallocate (x, g, d, u, y, b, dd, uu)
