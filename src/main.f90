@@ -360,8 +360,6 @@ contains
       call c_exit(int(status, c_int))
    end subroutine quit
 
-   !> A write beyond the file-size limit (ulimit -f) kills the process with SIGXFSZ; ignored, the
-   !> write fails with EFBIG instead, and the run ends with a message like any failed write.
    !> Once a signal has stopped a run, a SIGTERM more (a batch system's second, a sweep worker's
    !> beside the one sent to the whole group) does not cut the files' end short.
    subroutine hold_terminate()
@@ -369,6 +367,8 @@ contains
       previous = c_signal(sigterm, transfer(sig_ign, c_null_funptr))
    end subroutine hold_terminate
 
+   !> A write beyond the file-size limit (ulimit -f) kills the process with SIGXFSZ; ignored, the
+   !> write fails with EFBIG instead, and the run ends with a message like any failed write.
    subroutine ignore_file_size_signal()
       type(c_funptr) :: previous
       previous = c_signal(sigxfsz, transfer(sig_ign, c_null_funptr))

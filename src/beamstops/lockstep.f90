@@ -60,7 +60,7 @@ module beamstops_lockstep
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
       & col_work, col_dissipated, col_damped
    use beamstops_stop_signals, only: stop_signal
-   use beamstops_summary, only: mark_interrupted, run_summary, status_complete, status_diverged, status_failed, status_running, &
+   use beamstops_summary, only: mark_interrupted, lockstep_no_checkpoint, run_summary, status_complete, status_diverged, status_failed, status_running, &
       & check_divergence
    implicit none
    private
@@ -304,7 +304,7 @@ contains
       end do
       ! stopped by a signal (beamstops_stop_signals, caught by simulate_group's caller)
       do k = 1, nk
-         if (summaries(k)%status == status_running) call mark_interrupted(scenes(k), stop_signal(), .false., &
+         if (summaries(k)%status == status_running) call mark_interrupted(scenes(k), stop_signal(), lockstep_no_checkpoint, &
             & summaries(k))
       end do
    end subroutine simulate_lockstep

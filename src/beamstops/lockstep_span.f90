@@ -40,7 +40,7 @@ module beamstops_lockstep_span
    use beamstops_span_step, only: span_loop_type, start_span_block, next_span_step, span_step, end_span_block
    use beamstops_recorder, only: recorder_type
    use beamstops_stop_signals, only: stop_signal
-   use beamstops_summary, only: mark_interrupted, run_summary, status_complete, status_failed, status_running, &
+   use beamstops_summary, only: mark_interrupted, lockstep_no_checkpoint, run_summary, status_complete, status_failed, status_running, &
       & check_divergence
    implicit none
    private
@@ -146,7 +146,7 @@ contains
       do k = 1, nk
          if (.not. active(k)) cycle
          call finish_member(scenes(k), models(k), states(k), summaries(k), (thread_cpu_seconds() - t0)/nk)
-         call mark_interrupted(scenes(k), stop_signal(), .false., summaries(k))
+         call mark_interrupted(scenes(k), stop_signal(), lockstep_no_checkpoint, summaries(k))
       end do
    end subroutine simulate_span_lockstep
 

@@ -278,7 +278,11 @@ contains
             exit
          end if
          if (signum /= 0) then
-            call mark_interrupted(scene, signum, present(checkpoint), summary)
+            if (present(checkpoint)) then
+               call mark_interrupted(scene, signum, ' and a checkpoint saved', summary)
+            else
+               call mark_interrupted(scene, signum, '', summary)
+            end if
             exit
          end if
       end do

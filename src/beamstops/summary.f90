@@ -10,11 +10,13 @@ module beamstops_summary
    implicit none
    private
    public :: run_summary, status_complete, status_diverged, status_running, status_failed, status_interrupted, &
-      & check_divergence, mark_interrupted
+      & check_divergence, mark_interrupted, lockstep_no_checkpoint
 
    !> Status texts written to the output's `status` attribute.
    character(len=*), parameter :: status_complete = 'complete', status_diverged = 'diverged', &
       & status_running = 'running', status_failed = 'failed', status_interrupted = 'interrupted'
+   !> The end of the message of a lockstep member that a signal stopped (mark_interrupted).
+   character(len=*), parameter :: lockstep_no_checkpoint = '; no checkpoint (a member of a lockstep group has none)'
 
    !> Summary of a run.
    type :: run_summary
@@ -85,25 +87,19 @@ contains
    end subroutine check_divergence
 
    !> Status 'interrupted' and its message: the loop stopped on `signum` after summary%steps of
-   !> the scene's steps, its records flushed (and a checkpoint `saved`, or none: `rerun` says to
-   !> run it again).
-   subroutine mark_interrupted(scene, signum, saved, summary)
+   !> the scene's steps, its records flushed, then `after` (what became of the checkpoint).
+   subroutine mark_interrupted(scene, signum, after, summary)
       !> Scene (dt and the number of steps).
       type(scene_type), intent(in) :: scene
       !> The signal (beamstops_stop_signals).
       integer(c_int), intent(in) :: signum
-      !> Whether a checkpoint was saved.
-      logical, intent(in) :: saved
+      !> The end of the message (e.g. ' and a checkpoint saved').
+      character(len=*), intent(in) :: after
       !> Summary of the run, steps set.
       type(run_summary), intent(inout) :: summary
       summary%status = status_interrupted
       summary%message = 'stopped by '//signal_name(signum)//' at t = '// &
          & fmt_real(real(summary%steps, wp)*scene%dt, 12)//' s (step '//fmt_int(summary%steps)//' of '// &
-         & fmt_int(steps_of(scene))//'), its records flushed'
-      if (saved) then
-         summary%message = summary%message//' and a checkpoint saved'
-      else
-         summary%message = summary%message//'; no checkpoint (a member of a lockstep group has none)'
-      end if
+         & fmt_int(steps_of(scene))//'), its records flushed'//after
    end subroutine mark_interrupted
 end module beamstops_summary
