@@ -156,7 +156,6 @@ class Result:
                 f"cpu_seconds={a.get('cpu_seconds')!r})")
 
 
-
 def _read(path: str) -> tuple[dict[str, Any], dict[str, np.ndarray], dict[str, np.ndarray], dict[str, Statistic],
                               dict[str, Any], dict[str, Statistic]]:
     """The attributes, arrays, shock log, statistics (with their settings) and ensemble table of
@@ -186,6 +185,7 @@ def _raise_eoa(path: str) -> bool:
     from .engine_call import engine_call
 
     return bool(engine_call(_engine.bs_raise_hdf5_eoa, path.encode()))
+
 
 def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result:
     """Read the HDF5 output of ``beamstops run``.
