@@ -22,7 +22,7 @@ module beamstops_band_solve
    private
    public :: band_solver, prepare_solver, fused_solve, forward_substitution, back_substitution
    public :: back_substitution_edge, back_substitution_update, load_work_product
-   public :: energy_dots
+   public :: energy_dots, forward_substitution_energy
    public :: band_diagonals, prepare_diagonals, diagonal_matvec, diagonal_matvec_rhs, diagonal_row, dot
 
    !> The factor of A = M + dt^2 beta S in the form the fused substitutions read.
@@ -106,27 +106,77 @@ contains
       end associate
    end subroutine forward_substitution
 
+   !> forward_substitution, then energy_dots' sums of u, d and su (usu, dsu, dmd): the same
+   !> operations and bits. The sums are taken halfway down the substitution's chain (n >= kd),
+   !> where their instructions run beside it; after the chain they stood between the two
+   !> substitutions and delayed the second (docs/performance_notes.md, "The energy sums halfway
+   !> down the forward substitution").
+   pure subroutine forward_substitution_energy(solver, mass, u, d, su, b, usu, dsu, dmd)
+      !> Solver from prepare_solver.
+      type(band_solver), intent(in) :: solver
+      !> M by diagonals.
+      type(band_diagonals), intent(in) :: mass
+      !> u, d and su (n).
+      real(wp), intent(in), contiguous :: u(:), d(:), su(:)
+      !> Right-hand side b (n), replaced by D^{-2} w.
+      real(wp), intent(inout), contiguous :: b(:)
+      !> u.su, d.su and d.M d.
+      real(wp), intent(out) :: usu, dsu, dmd
+      real(wp) :: sums(3)
+      if (solver%n < kd) then
+         call forward_substitution(solver, b)
+         call energy_dots(mass, u, d, su, usu, dsu, dmd)
+         return
+      end if
+      call forward_rows(solver%n, solver%off, solver%inv_d2, b, mass%a, u, d, su, sums)
+      usu = sums(1)
+      dsu = sums(2)
+      dmd = sums(3)
+   end subroutine forward_substitution_energy
+
    !> The rows of forward_substitution for n >= kd, all in one routine of explicit-shape arrays:
    !> the compiler keeps the three running values in registers and every array at a fixed
    !> stride, and the first and last rows are written out (no call, no loop of their own on the
-   !> chain).
-   pure subroutine forward_rows(n, off, inv_d2, b)
+   !> chain). With `sums`, energy_rows' sums of m, u, d and su halfway down the chain (one
+   !> routine for both, so that the compiler keeps the edge rows inlined).
+   pure subroutine forward_rows(n, off, inv_d2, b, m, u, d, su, sums)
       integer, intent(in) :: n
       real(wp), intent(in) :: off(kd, n), inv_d2(n)
       real(wp), intent(inout) :: b(n)
+      real(wp), intent(in), optional :: m(n, 0:kd), u(n), d(n), su(n)
+      real(wp), intent(out), optional :: sums(3)
       real(wp) :: xa, xb, xc
-      integer :: j
+      integer :: j, half
+      ! the first row of the turns after the sums: about the middle, else past the last turn
+      if (present(sums)) then
+         half = kd + 1 + 3*max(0, (n/2 - kd - 1)/3)
+      else
+         half = kd + 1 + 3*max(0, (n - kd)/3)
+      end if
       call first_rows(n, off, inv_d2, b, xa, xb, xc)
-      do j = kd + 1, n - 2, 3
-         xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
-         b(j) = xa*inv_d2(j)
-         xb = row(b(j + 1), off(1, j + 1), off(2, j + 1), off(3, j + 1), xb, xc, xa)
-         b(j + 1) = xb*inv_d2(j + 1)
-         xc = row(b(j + 2), off(1, j + 2), off(2, j + 2), off(3, j + 2), xc, xa, xb)
-         b(j + 2) = xc*inv_d2(j + 2)
+      do j = kd + 1, half - 1, 3
+         call forward_turn(n, off, inv_d2, j, b, xa, xb, xc)
+      end do
+      if (present(sums)) call energy_rows(n, m, u, d, su, sums)
+      do j = half, n - 2, 3
+         call forward_turn(n, off, inv_d2, j, b, xa, xb, xc)
       end do
       call last_rows(n, off, inv_d2, j, b, xa, xb, xc)
    end subroutine forward_rows
+
+   !> Rows j, j+1 and j+2 of the forward substitution; xa, xb, xc hold w_{j-3}, w_{j-2},
+   !> w_{j-1} and are left holding w_j, w_{j+1}, w_{j+2}.
+   pure subroutine forward_turn(n, off, inv_d2, j, b, xa, xb, xc)
+      integer, intent(in) :: n, j
+      real(wp), intent(in) :: off(kd, n), inv_d2(n)
+      real(wp), intent(inout) :: b(n), xa, xb, xc
+      xa = row(b(j), off(1, j), off(2, j), off(3, j), xa, xb, xc)
+      b(j) = xa*inv_d2(j)
+      xb = row(b(j + 1), off(1, j + 1), off(2, j + 1), off(3, j + 1), xb, xc, xa)
+      b(j + 1) = xb*inv_d2(j + 1)
+      xc = row(b(j + 2), off(1, j + 2), off(2, j + 2), off(3, j + 2), xc, xa, xb)
+      b(j + 2) = xc*inv_d2(j + 2)
+   end subroutine forward_turn
 
    !> The dot products of the discrete energy: usu = u.su, dsu = d.su and dmd = d.M d =
    !> sum_j d_j (M_jj d_j + 2 sum_k M_j-k,j d_j-k) (M by diagonals), each in eight partial sums

@@ -14,8 +14,8 @@ module beamstops_scheme
    use beamstops_model, only: model_type
    use beamstops_error, only: error_type
    use beamstops_band, only: band_matvec, cholesky_solve
-   use beamstops_band_solve, only: band_solver, forward_substitution, back_substitution, energy_dots, &
-      & band_diagonals, diagonal_matvec, diagonal_matvec_rhs, dot, back_substitution_edge, back_substitution_update
+   use beamstops_band_solve, only: band_solver, forward_substitution, forward_substitution_energy, back_substitution, &
+      & energy_dots, band_diagonals, diagonal_matvec, diagonal_matvec_rhs, dot, back_substitution_edge, back_substitution_update
    use beamstops_state, only: state_type
    use beamstops_clock, only: thread_cpu_seconds
    use beamstops_forcing, only: load_average, load_rotation, start_loads, next_load
@@ -514,10 +514,10 @@ contains
       call substitute_forward(solver, mass, n, u, d, su, energy, rhs, usu, dsu, dmd)
    end subroutine plain_forward_pass
 
-   !> The forward substitution of a pass, then the energy sums when they are wanted (0 otherwise).
-   !> Independent of the substitution's chain, yet not hidden by it: a recorded step costs about
-   !> their own instructions more, and interleaved with the substitution's rows they cost more
-   !> still (measured with a variant of each; the notes of issue 15).
+   !> The forward substitution of a pass and the energy sums when they are wanted (0 otherwise).
+   !> The sums are independent of the substitution's chain; taken after it, they stood between
+   !> the two substitutions and a recorded step cost about their own instructions more, so they
+   !> are taken halfway down it (forward_substitution_energy; docs/performance_notes.md).
    subroutine substitute_forward(solver, mass, n, u, d, su, energy, rhs, usu, dsu, dmd)
       !> Factor of A.
       type(band_solver), intent(in) :: solver
@@ -533,10 +533,10 @@ contains
       real(wp), intent(inout) :: rhs(n)
       !> u.S u, d.S u and d.M d.
       real(wp), intent(out) :: usu, dsu, dmd
-      call forward_substitution(solver, rhs)
       if (energy) then
-         call energy_dots(mass, u, d, su, usu, dsu, dmd)
+         call forward_substitution_energy(solver, mass, u, d, su, rhs, usu, dsu, dmd)
       else
+         call forward_substitution(solver, rhs)
          usu = 0
          dsu = 0
          dmd = 0

@@ -20,7 +20,7 @@ module test_lockstep
    use beamstops_model, only: build_model
    use beamstops_band, only: band_matvec
    use beamstops_band_solve, only: band_solver, band_diagonals, prepare_solver, prepare_diagonals, diagonal_matvec, &
-      & forward_substitution, energy_dots, back_substitution, dot, &
+      & forward_substitution, forward_substitution_energy, energy_dots, back_substitution, dot, &
       & back_substitution_edge, back_substitution_update, load_work_product
    use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_work_columns, lockstep_matvec, &
       & lockstep_forward, lockstep_energy_dots, lockstep_back, lockstep_dot, lockstep_update, lockstep_back_edge, &
@@ -447,6 +447,13 @@ contains
                   & dot_product(abs(d(k, :)), w)]
                if (any(abs(f - e) > 4*n*epsilon(1.0_wp)*g)) call test_failed(error, where//'energy sums against '// &
                   & 'dot products, lane '//int_text(k))
+               ! the sums taken halfway down the forward substitution: the bits of the two apart
+               v = x(k, :)
+               w = x(k, :)
+               call forward_substitution(solver, v)
+               call forward_substitution_energy(solver, m, u(k, :), d(k, :), y(k, :), w, f(1), f(2), f(3))
+               if (.not. (all(same_bits(v, w)) .and. all(same_bits(f, e)))) call test_failed(error, where// &
+                  & 'forward substitution with the energy sums, lane '//int_text(k))
             end do
             call lockstep_dot(n, u, d, work, dd)
             do k = 1, lanes
