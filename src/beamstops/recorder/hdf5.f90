@@ -27,6 +27,7 @@ module beamstops_recorder_hdf5
    use beamstops_output_attributes, only: run_attributes, summary_attributes
    use beamstops_recorder_hdf5_observations, only: write_observations
    use beamstops_recorder_hdf5_writes, only: write_order, hand_over, n_series
+   use beamstops_recorder_disk_space, only: open_reservation, close_reservation
    use beamstops_writer_thread, only: writer_thread, wait_orders, stream_row
    implicit none
    private
@@ -108,6 +109,7 @@ contains
          call fatal_error(error, self%message)
          return
       end if
+      call open_reservation(self%order%space, self%partial)
       do i = 1, 3
          call h5gcreate_f(self%file, trim(group_names(i)), group, hdferr)
          call h5gclose_f(group, hdferr)
@@ -281,6 +283,7 @@ contains
       call close_dataset(self%order%stops_u)
       call close_dataset(self%order%stops_reaction)
       call h5fclose_f(self%file, hdferr)
+      call close_reservation(self%order%space)
       self%file = -1
       if (hdferr /= 0 .or. .not. ok) call fail(self, write_failure(self))
       deallocate (self%order)
@@ -324,6 +327,7 @@ contains
          call fatal_error(error, self%message)
          return
       end if
+      call open_reservation(self%order%space, self%partial)
       do i = 1, n_series
          call reopen_series(trim(series_path(i)), self%order%series(i), [records])
       end do
