@@ -318,13 +318,15 @@ end subroutine bs_run
 !> Studies: a scene without stops run in the paper's three-level form (module
 !> beamstops_three_level), recording the tip every record_every steps; `records` from bs_sizes.
 !> Only to measure the round-off floor that the engine's increment form removes (SPEC 4).
-subroutine bs_run_three_level(text, source, records, t, tip_u, cpu_seconds, status, message)
+!> `interruptible` as bs_run's; status 2: a stop signal ended the loop (bs_stop_signal says which).
+subroutine bs_run_three_level(text, source, records, interruptible, t, tip_u, cpu_seconds, status, message)
    use beamstops, only: error_type, fatal_error, scene_type, record_count, model_type, prepare_run, run_three_level
    use beamstops_wrap_support, only: scene_of, report
    implicit none
    !f2py threadsafe
    character(len=*), intent(in) :: text, source
    integer(8), intent(in) :: records
+   integer, intent(in) :: interruptible
    real(8), intent(out) :: t(records), tip_u(records), cpu_seconds
    integer, intent(out) :: status
    character(len=1024), intent(out) :: message
@@ -332,19 +334,22 @@ subroutine bs_run_three_level(text, source, records, t, tip_u, cpu_seconds, stat
    type(model_type) :: model
    type(error_type), allocatable :: error
    real(8), allocatable :: tt(:), uu(:)
+   integer :: signum
    t = 0; tip_u = 0; cpu_seconds = 0
+   signum = 0
    call scene_of(text, source, scene, error)
    if (.not. allocated(error)) then
       if (records /= record_count(scene)) call fatal_error(error, trim(source)//': the arrays given to '// &
          & 'bs_run_three_level do not have the size bs_sizes returns for this scene')
    end if
    if (.not. allocated(error)) call prepare_run(scene, trim(source), model, error)
-   if (.not. allocated(error)) call run_three_level(scene, model, tt, uu, cpu_seconds, error)
+   if (.not. allocated(error)) call run_three_level(scene, model, tt, uu, cpu_seconds, error, interruptible /= 0, signum)
    if (.not. allocated(error)) then
       t = tt
       tip_u = uu
    end if
    call report(error, status, message)
+   if (signum /= 0) status = 2
 end subroutine bs_run_three_level
 
 !> Studies: the full state of the engine's own loop (start_state, advance) at chosen steps,
@@ -352,16 +357,21 @@ end subroutine bs_run_three_level
 !> with M and S (band storage, per unit mass). Rationale: the energy norm of an error,
 !> 1/2 e'.M e' + 1/2 e.S e, needs slopes and velocities, which the records (tip) and the
 !> snapshots (nodal values) do not hold. `steps` ascending in 0..steps_of(scene); n = 2J.
-subroutine bs_states(text, source, count, steps, n, u, v, mass, stiffness, cpu_seconds, status, message)
+!> `interruptible` as bs_run's (the loop looks for a signal every block_steps steps); status 2:
+!> a stop signal ended it (bs_stop_signal says which).
+subroutine bs_states(text, source, count, steps, n, interruptible, u, v, mass, stiffness, cpu_seconds, status, message)
    use beamstops, only: error_type, fatal_error, scene_type, steps_of, model_type, prepare_run, &
       & state_type, start_state, array_recorder
-   use beamstops_scheme, only: advance
+   use beamstops_scheme, only: advance, block_steps
+   use beamstops_stop_signals, only: catch_stop_signals, release_stop_signals, stop_signal, signal_name
+   use beamstops_strings, only: fmt_real
    use beamstops_wrap_support, only: scene_of, report
    implicit none
    !f2py threadsafe
    character(len=*), intent(in) :: text, source
    integer(8), intent(in) :: count, n
    integer(8), intent(in) :: steps(count)
+   integer, intent(in) :: interruptible
    real(8), intent(out) :: u(n, count), v(n, count), mass(4, n), stiffness(4, n), cpu_seconds
    integer, intent(out) :: status
    character(len=1024), intent(out) :: message
@@ -373,6 +383,7 @@ subroutine bs_states(text, source, count, steps, n, u, v, mass, stiffness, cpu_s
    real(8), allocatable :: d_prev(:)
    real(8) :: t0, t1
    integer(8) :: k, step
+   integer :: signum
    u = 0; v = 0; mass = 0; stiffness = 0; cpu_seconds = 0
    call scene_of(text, source, scene, error)
    if (.not. allocated(error)) then
@@ -403,6 +414,8 @@ subroutine bs_states(text, source, count, steps, n, u, v, mass, stiffness, cpu_s
    end if
    mass = model%mass
    stiffness = model%stiffness
+   signum = 0
+   if (interruptible /= 0) call catch_stop_signals()
    call cpu_time(t0)
    do k = 1, count
       step = steps(k)
@@ -411,13 +424,34 @@ subroutine bs_states(text, source, count, steps, n, u, v, mass, stiffness, cpu_s
          v(:, k) = model%v0
          cycle
       end if
-      if (state%step <= step - 1) call advance(scene, model, state, recorder, step - 1)
+      call advance_to(step - 1)
+      if (signum /= 0) exit
       d_prev = state%d
       call advance(scene, model, state, recorder, step)
       u(:, k) = state%u - state%d
       v(:, k) = (state%d + d_prev)/(2*scene%dt)
    end do
    call cpu_time(t1)
+   if (interruptible /= 0) call release_stop_signals()
    cpu_seconds = t1 - t0
    call report(error, status, message)
+   if (signum /= 0) then
+      status = 2
+      message = 'interrupted by '//signal_name(signum)//' at t = '//fmt_real(real(state%step - 1, 8)*scene%dt, 6)//' s'
+   end if
+
+contains
+
+   !> Advance the state to step `last` (done), in blocks of block_steps steps with a look for a
+   !> stop signal after each when interruptible (the same steps as one call: advance's blocks).
+   subroutine advance_to(last)
+      integer(8), intent(in) :: last
+      do while (state%step <= last)
+         call advance(scene, model, state, recorder, min(last, state%step + block_steps - 1))
+         if (interruptible /= 0) then
+            signum = stop_signal()
+            if (signum /= 0) return
+         end if
+      end do
+   end subroutine advance_to
 end subroutine bs_states

@@ -11,11 +11,13 @@
 module beamstops_three_level
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
+   use beamstops_strings, only: fmt_real
    use beamstops_scene, only: scene_type, steps_of, record_count, law_none
    use beamstops_model, only: model_type
    use beamstops_band, only: band_matvec, cholesky_solve
    use beamstops_forcing, only: load_average
-   use beamstops_scheme, only: state_type, start_state
+   use beamstops_scheme, only: state_type, start_state, block_steps
+   use beamstops_stop_signals, only: catch_stop_signals, release_stop_signals, stop_signal, signal_name
    use beamstops_recorder_array, only: array_recorder
    implicit none
    private
@@ -25,8 +27,10 @@ contains
 
    !> Run a scene without stops in the three-level form, recording the tip displacement
    !> u^n_tip at t_n = n dt every scene%record_every steps (n = 0 included), as the
-   !> engine's records do. The scene's law must be 'none'.
-   subroutine run_three_level(scene, model, t, tip_u, cpu_seconds, error)
+   !> engine's records do. The scene's law must be 'none'. With `stop_signals`, SIGINT and SIGTERM
+   !> are caught during the loop, which looks for them every block_steps steps: a signal ends the
+   !> run with an error that names it, and `stopped_by` says which it was.
+   subroutine run_three_level(scene, model, t, tip_u, cpu_seconds, error, stop_signals, stopped_by)
       !> Validated scene (law_none).
       type(scene_type), intent(in) :: scene
       !> Its model (build_model).
@@ -37,17 +41,23 @@ contains
       real(wp), allocatable, intent(out) :: tip_u(:)
       !> CPU time of the time loop (s).
       real(wp), intent(out) :: cpu_seconds
-      !> Set when the scene has stops or the start fails.
+      !> Set when the scene has stops or the start fails, or a stop signal ended the loop.
       type(error_type), allocatable, intent(out) :: error
+      !> Catch SIGINT and SIGTERM during the loop (default: they keep their handlers).
+      logical, intent(in), optional :: stop_signals
+      !> The signal that ended the loop (0: none).
+      integer, intent(out), optional :: stopped_by
       type(scene_type) :: quiet
       type(state_type) :: state
       type(array_recorder) :: recorder
       real(wp), allocatable :: a_band(:, :), u_prev(:), u_now(:), u_next(:), mu(:), su(:), au(:)
       real(wp) :: sigma_prev, sigma_now, sigma_next, weight, t0, t1
       integer(ik) :: step, steps, filled
-      integer :: tip
+      integer :: tip, signum
+      logical :: catching
 
       cpu_seconds = 0
+      if (present(stopped_by)) stopped_by = 0
       allocate (t(record_count(scene)), tip_u(record_count(scene)))
       t = 0
       tip_u = 0
@@ -79,8 +89,16 @@ contains
       tip_u(1) = model%u0(tip)
       filled = 1
 
+      catching = .false.
+      if (present(stop_signals)) catching = stop_signals
+      if (catching) call catch_stop_signals()
+      signum = 0
       call cpu_time(t0)
       do step = 1, steps
+         if (catching .and. mod(step, block_steps) == 0) then
+            signum = stop_signal()
+            if (signum /= 0) exit
+         end if
          if (mod(step, int(scene%record_every, ik)) == 0) then
             filled = filled + 1
             t(filled) = real(step, wp)*model%dt
@@ -101,5 +119,9 @@ contains
       end do
       call cpu_time(t1)
       cpu_seconds = t1 - t0
+      if (catching) call release_stop_signals()
+      if (present(stopped_by)) stopped_by = signum
+      if (signum /= 0) call fatal_error(error, 'interrupted by '//signal_name(signum)//' at t = '// &
+         & fmt_real(real(step - 1, wp)*model%dt, 6)//' s')
    end subroutine run_three_level
 end module beamstops_three_level

@@ -1,6 +1,8 @@
 """Ctrl-C (SIGINT) during an in-memory run stops the engine's loop within a block and raises
 KeyboardInterrupt at once, instead of after the whole run; SIGTERM keeps its usual effect (raised
-again once the loop has stopped); a thread other than the main one leaves the signals alone."""
+again once the loop has stopped); a thread other than the main one leaves the signals alone. The
+studies' own engine calls (the engine's states at chosen steps, the three-level form) stop the
+same way."""
 
 from __future__ import annotations
 
@@ -17,7 +19,23 @@ SCRIPT = """
 import sys, threading, beamstops
 scene = beamstops.Scene(dt=1e-6, t_end=2000.0, record_every=1000000)
 where = sys.argv[1]
-if where == "thread":
+if where == "states":
+    from beamstops.studies import common
+    print("running", flush=True)
+    try:
+        common.states(scene, [2000.0])
+    except KeyboardInterrupt:
+        print("interrupted", flush=True)
+        sys.exit(7)
+elif where == "three_level":
+    from beamstops.studies import common
+    print("running", flush=True)
+    try:
+        common.run_three_level(scene.replace(law="none"))
+    except KeyboardInterrupt:
+        print("interrupted", flush=True)
+        sys.exit(7)
+elif where == "thread":
     worker = threading.Thread(target=beamstops.run, args=(scene,), daemon=True)
     worker.start()
     print("running", flush=True)
@@ -55,17 +73,25 @@ def start(where: str) -> subprocess.Popen[str]:
     return process
 
 
-@pytest.mark.parametrize("where", ["main", "thread"])
+@pytest.mark.parametrize("where", ["main", "thread", "states", "three_level"])
 def test_ctrl_c_interrupts_an_in_memory_run_promptly(where: str) -> None:
     process = start(where)
     process.send_signal(signal.SIGINT)
     out, err = finish(process)
     assert process.returncode == 7, err
-    assert out == ("interrupted\n" if where == "main" else "main thread interrupted\n"), err
+    assert out == ("main thread interrupted\n" if where == "thread" else "interrupted\n"), err
 
 
 def test_sigterm_keeps_its_usual_effect() -> None:
     process = start("main")
+    process.send_signal(signal.SIGTERM)
+    finish(process)
+    assert process.returncode == -signal.SIGTERM
+
+
+@pytest.mark.parametrize("where", ["states", "three_level"])
+def test_sigterm_ends_the_studies_calls(where: str) -> None:
+    process = start(where)
     process.send_signal(signal.SIGTERM)
     finish(process)
     assert process.returncode == -signal.SIGTERM

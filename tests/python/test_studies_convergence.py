@@ -55,6 +55,22 @@ def test_states_match_the_records() -> None:
     np.testing.assert_allclose(states.v[tip], result.tip_v[steps], rtol=1e-12, atol=1e-12)
 
 
+def test_states_in_blocks_equal_one_call() -> None:
+    """In the main thread the engine advances the states in blocks, looking for a stop signal
+    after each (Ctrl-C); in another thread in one call: the same bits."""
+    import threading
+
+    scene = Scene(t_end=0.05, dt=1e-6, elements=5)
+    times = [0.0, 1e-6, 0.02, 0.05]
+    blocks = common.states(scene, times)
+    found: list[common.States] = []
+    worker = threading.Thread(target=lambda: found.append(common.states(scene, times)))
+    worker.start()
+    worker.join()
+    np.testing.assert_array_equal(blocks.u.view(np.uint64), found[0].u.view(np.uint64))
+    np.testing.assert_array_equal(blocks.v.view(np.uint64), found[0].v.view(np.uint64))
+
+
 def test_prolongation_is_exact_in_the_energy_norm() -> None:
     coarse, fine = common.states(Scene(elements=3, t_end=0.001, dt=1e-4), [0.0]), \
         common.states(Scene(elements=12, t_end=0.001, dt=1e-4), [0.0])

@@ -41,6 +41,21 @@ def _check(status: int, message: Any) -> None:
         raise ValueError(_text(message))
 
 
+def interruptible() -> int:
+    """1 in the main thread: the engine's loop then catches Ctrl-C (SIGINT) and SIGTERM and stops
+    within a block (a few ms) instead of at its end; the caller raises the signal again
+    (:func:`raise_stop_signal`). Other threads leave the signals alone (0)."""
+    return int(threading.current_thread() is threading.main_thread())
+
+
+def raise_stop_signal() -> None:
+    """Raise again the signal that stopped the engine's last interruptible loop, for Python's own
+    handler (KeyboardInterrupt for Ctrl-C, the process's end for SIGTERM's default)."""
+    signum = int(engine_call(_engine.bs_stop_signal))
+    if signum:
+        signal.raise_signal(signum)
+
+
 def _scene_text(scene: Scene) -> bytes:
     from .scene import Scene
 
@@ -203,21 +218,16 @@ def run(scene: Scene, *, allow_incomplete: bool = False, shock_capacity: int = 4
     records, snapshots, nodes, stops = sizes(scene)
     width = max(stops, 1, scene.bins + 1)
     capacity = max(int(shock_capacity), 1)
-    # In the main thread, Ctrl-C (SIGINT) or SIGTERM stops the engine's loop within a block (a few
-    # ms) instead of waiting for its end; the signal is then raised again, for Python's own
-    # handler (KeyboardInterrupt for Ctrl-C). Other threads leave the signals alone.
-    interruptible = int(threading.current_thread() is threading.main_thread())
+    stoppable = interruptible()
     while True:
         (t, tip_u, tip_v, reaction, energy, work, dissipated, damped, snapshot_t, snapshot_x, snapshot_u, stops_x,
          stops_u, stops_reaction, filled, snaps, shocks, shock_count, shock_labels, stat_value, stat_half, stat_entries,
          stat_labels, attribute_text, status, message) = engine_call(
-            _engine.bs_run, text, b"scene", records, snapshots, nodes, stops, capacity, width, interruptible)
+            _engine.bs_run, text, b"scene", records, snapshots, nodes, stops, capacity, width, stoppable)
         _check(status, message)
         attrs = attributes_of(_text(attribute_text))
         if attrs.get("status") == "interrupted":
-            signum = int(engine_call(_engine.bs_stop_signal))
-            if signum:
-                signal.raise_signal(signum)
+            raise_stop_signal()
             break  # a handler that returned: the records so far (status 'interrupted')
         if int(shock_count) <= capacity:
             break

@@ -22,7 +22,7 @@ import numpy as np
 
 from .. import _engine
 from ..engine_call import engine_call
-from ..engine import _check, _scene_text, run, sizes
+from ..engine import _check, _scene_text, _text, interruptible, raise_stop_signal, run, sizes
 from ..result import IncompleteRunError, Result
 from ..scene import Scene
 
@@ -71,12 +71,23 @@ def run_tip(scene: Scene, grid: float) -> Result:
         return exc.result
 
 
+def _check_stopped(status: int, message: Any) -> None:
+    """An engine call's outcome: status 2, a stop signal ended its loop (Ctrl-C in the main thread):
+    the signal is raised again (KeyboardInterrupt); a handler that returns leaves a RuntimeError,
+    the call having no result to give. Otherwise as :func:`beamstops.engine._check`."""
+    if status == 2:
+        raise_stop_signal()
+        raise RuntimeError(_text(message))
+    _check(status, message)
+
+
 def run_three_level(scene: Scene) -> tuple[np.ndarray, np.ndarray, float]:
     """The scene (law 'none') in the paper's three-level form (engine module beamstops_three_level):
     record times, tip displacement every ``record_every`` steps, and the loop's CPU time (s)."""
     records = sizes(scene)[0]
-    t, tip_u, cpu, status, message = engine_call(_engine.bs_run_three_level, _scene_text(scene), b"scene", records)
-    _check(status, message)
+    t, tip_u, cpu, status, message = engine_call(_engine.bs_run_three_level, _scene_text(scene), b"scene", records,
+                                                 interruptible())
+    _check_stopped(status, message)
     return np.asarray(t), np.asarray(tip_u), float(cpu)
 
 
@@ -100,8 +111,9 @@ class States:
 def states(scene: Scene, times: Sequence[float]) -> States:
     """The engine's full state at the steps nearest ``times`` (wrapper ``bs_states``)."""
     steps = np.array([round(t / scene.dt) for t in times], dtype=np.int64)
-    u, v, mass, stiffness, cpu, status, message = engine_call(_engine.bs_states, _scene_text(scene), b"scene", steps, 2 * scene.elements)
-    _check(status, message)
+    u, v, mass, stiffness, cpu, status, message = engine_call(_engine.bs_states, _scene_text(scene), b"scene", steps,
+                                                              2 * scene.elements, interruptible())
+    _check_stopped(status, message)
     return States(steps=steps, u=np.asarray(u), v=np.asarray(v), mass=np.asarray(mass),
                   stiffness=np.asarray(stiffness), cpu_seconds=float(cpu))
 
