@@ -53,7 +53,12 @@ def test_an_interrupted_output_holds_no_blocks_past_its_end(tmp_path: Path) -> N
                                stderr=subprocess.DEVNULL)
     partial = tmp_path / "out.h5.partial"
     deadline = time.time() + 60
-    while time.time() < deadline and (not partial.exists() or partial.stat().st_size < 5_000_000):
+    while process.poll() is None and time.time() < deadline:
+        try:
+            if partial.stat().st_size >= 5_000_000:
+                break
+        except FileNotFoundError:  # not created yet (or, the run over, renamed: then it failed below)
+            pass
         time.sleep(0.005)
     process.send_signal(signal.SIGINT)
     assert process.wait(timeout=60) != 0

@@ -26,6 +26,15 @@ SCENE = """&time dt=1e-6, t_end={t_end} /
 """
 
 
+def stat_or_none(path: Path) -> os.stat_result | None:
+    """The file's stat, or None when it does not exist (any more: a run that ends renames its
+    partial file and removes its checkpoint between two looks)."""
+    try:
+        return path.stat()
+    except FileNotFoundError:
+        return None
+
+
 def write_scene(folder: Path, name: str, t_end: float = 1.0) -> Path:
     path = folder / f"{name}.nml"
     path.write_text(SCENE.format(t_end=t_end, file=f"{name}.h5"))
@@ -113,10 +122,13 @@ def test_killed_reduced_runs_resume_bit_for_bit(tmp_path: Path) -> None:
     for _ in range(3):
         process = subprocess.Popen([PROGRAM, *map(str, args)], cwd=tmp_path, stdout=subprocess.DEVNULL,
                                    stderr=subprocess.DEVNULL)
-        seen = checkpoint.stat().st_mtime_ns if checkpoint.exists() else 0
+        before = stat_or_none(checkpoint)
+        seen = before.st_mtime_ns if before else 0
         deadline = time.time() + 60
-        while process.poll() is None and time.time() < deadline and \
-                (not checkpoint.exists() or checkpoint.stat().st_mtime_ns == seen):
+        while process.poll() is None and time.time() < deadline:
+            now = stat_or_none(checkpoint)
+            if now is not None and now.st_mtime_ns != seen:
+                break
             time.sleep(0.005)
         if process.poll() is None:
             process.send_signal(signal.SIGKILL)

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import beamstops
-from test_reliability_restart import PROGRAM, REDUCED, assert_identical, run
+from test_reliability_restart import PROGRAM, REDUCED, assert_identical, run, stat_or_none
 
 pytestmark = pytest.mark.skipif(PROGRAM is None, reason="the beamstops program is not on PATH")
 
@@ -38,8 +38,10 @@ def stop_while_running(scenes: list[Path], signum: int) -> subprocess.CompletedP
     process = subprocess.Popen([PROGRAM, "run", *map(str, scenes)], cwd=first.parent, stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True)
     deadline = time.time() + 60
-    while process.poll() is None and time.time() < deadline and \
-            (not partial.exists() or partial.stat().st_size < 2_000_000):
+    while process.poll() is None and time.time() < deadline:
+        now = stat_or_none(partial)
+        if now is not None and now.st_size >= 2_000_000:
+            break
         time.sleep(0.001)
     if process.poll() is None:
         process.send_signal(signum)
