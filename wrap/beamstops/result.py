@@ -187,6 +187,23 @@ def _raise_eoa(path: str) -> bool:
     return bool(engine_call(_engine.bs_raise_hdf5_eoa, path.encode()))
 
 
+RECORD_SERIES = ("t", "tip_u", "tip_v", "reaction", "energy", "work", "dissipated", "damped", "stops_u", "stops_reaction")
+"""The arrays with one entry a record."""
+
+
+def _common_records(arrays: dict[str, np.ndarray]) -> None:
+    """The records every series holds, in place: an output that did not complete may hold one
+    series a record or a buffer longer than another (the writer hands its buffers over when any
+    of them is full, the values at the stops coming a step ahead of the tip's row, and a run
+    that stopped between two hand-overs, or was killed during one, wrote some of them)."""
+    lengths = [arrays[name].shape[0] for name in RECORD_SERIES if name in arrays]
+    if lengths:
+        common = min(lengths)
+        for name in RECORD_SERIES:
+            if name in arrays:
+                arrays[name] = arrays[name][:common]
+
+
 def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result:
     """Read the HDF5 output of ``beamstops run``.
 
@@ -195,7 +212,7 @@ def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result
     file has) unless ``allow_incomplete``. A file HDF5 refuses with "addr overflow" (a run
     killed while HDF5 flushed it) has the end of allocation its superblock records raised to its
     size, in place, and is read again (what ``h5clear --increment=0`` does; nothing else of the
-    file changes).
+    file changes). The series of a file that is not complete are cut to the records they all hold.
     """
     path = os.fspath(path)
     if os.path.isdir(path):
@@ -213,6 +230,8 @@ def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result
     arrays.setdefault("snapshot_t", np.empty(0))
     arrays.setdefault("snapshot_x", np.empty(0))
     arrays.setdefault("snapshot_u", np.empty((0, nodes)))
+    if attrs.get("status") != "complete":
+        _common_records(arrays)
     records = arrays["t"].size if "t" in arrays else 0
     arrays.setdefault("stops_u", np.empty((records, 0)))
     arrays.setdefault("stops_reaction", np.empty((records, 0)))

@@ -1,8 +1,10 @@
 !> Disk space reserved ahead of an output file as its records are appended
 !> (src/beamstops/recorder/disk_space.c): the HDF5 recorder's writer reserves the blocks its next
-!> writes go to, so that the file system does not allocate them one write at a time. A run that
-!> is killed leaves its partial file with at most one reservation of blocks past its end; they
-!> are released when the run is resumed and ends, or when the file is removed.
+!> writes go to, so that the file system does not allocate them one write at a time, and keeps
+!> `margin` more reserved for what closing the file writes: a write that finds no room on the
+!> disk (or under the file-size limit) is refused before it starts, and the file still closes
+!> readable. A run that is killed leaves its partial file with at most one reservation of blocks
+!> past its end; they are released when the run is resumed and ends, or when the file is removed.
 module beamstops_recorder_disk_space
    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_int64_t, c_null_char
    implicit none
@@ -12,6 +14,10 @@ module beamstops_recorder_disk_space
    !> Bytes reserved at a time: four times what the write asks for, at least 1 MiB (the paper's
    !> Figure 4 run, 1.2 MB an order of the writer, reserves 4.7 MB every fourth order).
    integer(c_int64_t), parameter :: least_ahead = 2_c_int64_t**20
+   !> Bytes kept reserved past the data for what closing the file adds at its end (on the Figure 4
+   !> scene, stopped by the file-size limit: 168 bytes past the last records; the rest of the close
+   !> rewrites metadata inside the file).
+   integer(c_int64_t), parameter :: margin = 2_c_int64_t**16
 
    !> The reservation of one file: a descriptor of it (-1: none) and the end of what is reserved
    !> (-1: the file system took no reservation, none is asked again).
@@ -52,14 +58,21 @@ contains
       reservation%reserved = merge(0_c_int64_t, -1_c_int64_t, reservation%fd >= 0)
    end subroutine open_reservation
 
-   !> Make sure the next `bytes` past the file's end are reserved.
-   subroutine reserve(reservation, bytes)
+   !> Make sure the next `bytes` past the file's end are reserved, and `margin` more; `room` is
+   !> false when the disk, or the file-size limit, has no room for them (the write must not start).
+   subroutine reserve(reservation, bytes, room)
       !> The reservation.
       type(disk_reservation), intent(inout) :: reservation
       !> Bytes the next writes add to the file.
       integer(c_int64_t), intent(in) :: bytes
-      if (reservation%reserved < 0) return
-      reservation%reserved = c_extend(reservation%fd, bytes, max(least_ahead, 4*bytes), reservation%reserved)
+      !> Whether they may be written.
+      logical, intent(out) :: room
+      integer(c_int64_t) :: new_end
+      room = .true.
+      if (reservation%fd < 0) return
+      new_end = c_extend(reservation%fd, bytes + margin, max(least_ahead, 4*bytes) + margin, reservation%reserved)
+      room = new_end /= -2
+      if (room) reservation%reserved = new_end
    end subroutine reserve
 
    !> End the reservation: the blocks reserved past the file's end are released.

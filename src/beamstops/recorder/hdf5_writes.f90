@@ -67,11 +67,16 @@ contains
       call write_rows(order)
    end subroutine write_order_job
 
-   !> Append the order's rows to their datasets, in space reserved ahead of them.
+   !> Append the order's rows to their datasets, in space reserved ahead of them (none of them when
+   !> the disk or the file-size limit has no room left: the order fails).
    subroutine write_rows(order)
       type(write_order), intent(inout) :: order
       integer :: i
-      call reserve(order%space, order_bytes(order))
+      logical :: room
+      ! no room: nothing of the order is written, and the file closes readable in its reserved room
+      call reserve(order%space, order_bytes(order), room)
+      if (.not. room) order%failed = .true.
+      if (order%failed) return
       if (order%fill > 0) call to_columns(order)
       do i = 1, n_series
          call append(order, order%series(i), 1, order%written, order%fill, order%columns(:, series_column(i)))
