@@ -11,7 +11,7 @@ module test_writer
    use test_support, only: validated_model
    use beamstops_recorder_hdf5_vector, only: read_vector
    use beamstops_run, only: continue_run
-   use beamstops_files, only: remove_file, file_exists
+   use beamstops_files, only: remove_file, file_exists, replace_file
    use beamstops_writer_thread, only: writer_thread, start_writer, stop_writer, stream_row
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_signaling_nan, &
       & ieee_positive_inf, ieee_negative_inf
@@ -30,9 +30,68 @@ contains
          & 'recorder''s, bit for bit', test_thread), &
          & new_unittest('without a thread, the orders carried out where posted: the same bits', test_inline), &
          & new_unittest('a record streamed into a buffer is the same bits and is finite unless one value is a NaN or '// &
-         & 'an infinity, at every position and buffer alignment', test_stream_row) &
+         & 'an infinity, at every position and buffer alignment', test_stream_row), &
+         & new_unittest('a finished file replaces an earlier one, which is removed; a file that cannot be moved '// &
+         & 'leaves the earlier one in place', test_replace_file) &
          & ]
    end subroutine collect_writer
+
+   !> replace_file onto an earlier file: the new content in place, the earlier file removed (by a
+   !> process of its own: looked for until it is gone), nothing else left beside it; from a source
+   !> that does not exist: not done, and the earlier file where it was, unchanged.
+   subroutine test_replace_file(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: target = 'test_replace_file.out', source = 'test_replace_file.new'
+      character(len=*), parameter :: aside_prefix = '.test_replace_file.out.replaced-'
+      logical :: ok
+      integer :: tries
+      call write_text(target, 'earlier')
+      call write_text(source, 'new')
+      call replace_file(source, target, ok)
+      call check(error, ok, 'replaced')
+      if (allocated(error)) return
+      call check(error, read_text(target) == 'new' .and. .not. file_exists(source), 'the new file in place')
+      if (allocated(error)) return
+      do tries = 1, 1000
+         if (.not. any_aside()) exit
+         call execute_command_line('sleep 0.01')
+      end do
+      call check(error, .not. any_aside(), 'the earlier file removed')
+      if (allocated(error)) return
+      call replace_file('test_replace_file.missing', target, ok)
+      call check(error, .not. ok, 'a missing source is not moved')
+      if (allocated(error)) return
+      call check(error, read_text(target) == 'new' .and. .not. any_aside(), 'the earlier file where it was')
+      call remove_file(target)
+
+   contains
+
+      subroutine write_text(path, text)
+         character(len=*), intent(in) :: path, text
+         integer :: unit
+         open (newunit=unit, file=path, status='replace', action='write')
+         write (unit, '(a)') text
+         close (unit)
+      end subroutine write_text
+
+      function read_text(path) result(text)
+         character(len=*), intent(in) :: path
+         character(len=32) :: text
+         integer :: unit, stat
+         text = ''
+         open (newunit=unit, file=path, status='old', action='read', iostat=stat)
+         if (stat /= 0) return
+         read (unit, '(a)', iostat=stat) text
+         close (unit)
+      end function read_text
+
+      !> Whether a file moved aside by replace_file is still there.
+      logical function any_aside()
+         character(len=32) :: pid
+         write (pid, '(i0)') getpid()
+         any_aside = file_exists(aside_prefix//trim(pid))
+      end function any_aside
+   end subroutine test_replace_file
 
    !> 40,000 steps, each recorded (several buffers of the recorder), a snapshot every 97 steps,
    !> a checkpoint every 15,000 steps.

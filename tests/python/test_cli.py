@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import shutil
 import subprocess
+import time
 from pathlib import Path
 
 import h5py
@@ -264,6 +265,11 @@ def test_an_earlier_output_is_replaced_only_when_the_run_is_complete(tmp_path: P
     with h5py.File(output) as f:
         assert f.attrs["status"] == b"complete" and f.attrs["steps"] == 10000
     assert not list(tmp_path.glob("*.partial"))
+    # the earlier output was moved aside and is removed by a process of its own
+    deadline = time.time() + 30
+    while list(tmp_path.glob(".*.replaced-*")) and time.time() < deadline:
+        time.sleep(0.01)
+    assert not list(tmp_path.glob(".*.replaced-*"))
 
 
 def limit_file_size(size: int):  # type: ignore[no-untyped-def]
