@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -77,7 +78,9 @@ int beamstops_same_path(const char *a, const char *b)
 
 /* Remove the file at path in a process of its own that this one does not wait for (forked twice,
    in a session of its own, so that it is neither a zombie of this process nor stopped by a Ctrl-C
-   meant for it); here, when no process can be started. The child calls only unlink and _exit. */
+   meant for it; with no file descriptor open, so that a caller reading this process's output
+   through a pipe does not wait for it either); here, when no process can be started. The
+   children call only async-signal-safe functions. */
 static void remove_detached(const char *path)
 {
     pid_t child = fork();
@@ -86,6 +89,11 @@ static void remove_detached(const char *path)
         pid_t grandchild = fork();
         if (grandchild == 0) {
             setsid();
+#if defined(SYS_close_range)
+            if (syscall(SYS_close_range, 0U, ~0U, 0U) != 0)
+#endif
+                for (int fd = 0; fd < 1024; fd++)
+                    close(fd);
             unlink(path);
             _exit(0);
         }
