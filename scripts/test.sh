@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Run every test: the Fortran unit tests (meson test, TAP) and the Python tests (pytest)
-# against the package installed in .venv by scripts/setup.sh.
+# against the package installed in .venv by scripts/setup.sh. The build (build/tests) also holds
+# the microbenchmarks (-Dbench=true), which tests/python/test_bench_quick.py runs.
 set -uo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export PATH="$PWD/.venv/bin:$PATH"
 build=build/tests
 if [ ! -f "$build/build.ninja" ]; then
-  meson setup "$build" -Dpython=false -Dtests=true --buildtype=release >/dev/null || exit 1
+  meson setup "$build" -Dpython=false -Dtests=true -Dbench=true --buildtype=release >/dev/null || exit 1
 fi
 meson compile -C "$build" >/dev/null || { meson compile -C "$build"; exit 1; }
 meson test -C "$build" --print-errorlogs --num-processes 2
