@@ -19,8 +19,9 @@ module beamstops_recorder_disk_space
    !> rewrites metadata inside the file).
    integer(c_int64_t), parameter :: margin = 2_c_int64_t**16
 
-   !> The reservation of one file: a descriptor of it (-1: none) and the end of what is reserved
-   !> (-1: the file system took no reservation, none is asked again).
+   !> The reservation of one file: a descriptor of it (-1: none, nothing is checked) and the end
+   !> of what is reserved (-1: the file system takes no reservation; the file-size limit is still
+   !> checked before each write).
    type :: disk_reservation
       integer(c_int) :: fd = -1
       integer(c_int64_t) :: reserved = 0
