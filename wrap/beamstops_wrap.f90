@@ -363,8 +363,7 @@ subroutine bs_states(text, source, count, steps, n, interruptible, u, v, mass, s
    use beamstops, only: error_type, fatal_error, scene_type, steps_of, model_type, prepare_run, &
       & state_type, start_state, array_recorder
    use beamstops_scheme, only: advance, block_steps
-   use beamstops_stop_signals, only: catch_stop_signals, release_stop_signals, stop_signal, signal_name
-   use beamstops_strings, only: fmt_real
+   use beamstops_stop_signals, only: catch_stop_signals, release_stop_signals, stop_signal, interrupted_at
    use beamstops_wrap_support, only: scene_of, report
    implicit none
    !f2py threadsafe
@@ -437,7 +436,7 @@ subroutine bs_states(text, source, count, steps, n, interruptible, u, v, mass, s
    call report(error, status, message)
    if (signum /= 0) then
       status = 2
-      message = 'interrupted by '//signal_name(signum)//' at t = '//fmt_real(real(state%step - 1, 8)*scene%dt, 6)//' s'
+      message = interrupted_at(signum, real(state%step - 1, 8)*scene%dt)
    end if
 
 contains

@@ -7,9 +7,11 @@
 !> signal has its usual effect; caught_signal says afterwards which signal it was.
 module beamstops_stop_signals
    use, intrinsic :: iso_c_binding, only: c_int, c_ptr, c_char, c_f_pointer
+   use beamstops_kinds, only: wp
+   use beamstops_strings, only: fmt_real
    implicit none
    private
-   public :: catch_stop_signals, release_stop_signals, stop_signal, caught_signal, signal_name
+   public :: catch_stop_signals, release_stop_signals, stop_signal, caught_signal, signal_name, interrupted_at
 
    interface
       !> Note SIGINT and SIGTERM from now on instead of their default action (a second one takes it).
@@ -52,4 +54,15 @@ contains
          name = name//text(k)
       end do
    end function signal_name
+
+   !> 'interrupted by SIGINT at t = ... s': how a loop without a summary of its own (the studies'
+   !> three-level form and states) says that a signal ended it at time t.
+   function interrupted_at(signum, t) result(text)
+      !> Signal number.
+      integer(c_int), intent(in) :: signum
+      !> Time reached (s).
+      real(wp), intent(in) :: t
+      character(len=:), allocatable :: text
+      text = 'interrupted by '//signal_name(signum)//' at t = '//fmt_real(t, 6)//' s'
+   end function interrupted_at
 end module beamstops_stop_signals

@@ -11,13 +11,12 @@
 module beamstops_three_level
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
-   use beamstops_strings, only: fmt_real
    use beamstops_scene, only: scene_type, steps_of, record_count, law_none
    use beamstops_model, only: model_type
    use beamstops_band, only: band_matvec, cholesky_solve
    use beamstops_forcing, only: load_average
    use beamstops_scheme, only: state_type, start_state, block_steps
-   use beamstops_stop_signals, only: catch_stop_signals, release_stop_signals, stop_signal, signal_name
+   use beamstops_stop_signals, only: catch_stop_signals, release_stop_signals, stop_signal, interrupted_at
    use beamstops_recorder_array, only: array_recorder
    implicit none
    private
@@ -121,7 +120,6 @@ contains
       cpu_seconds = t1 - t0
       if (catching) call release_stop_signals()
       if (present(stopped_by)) stopped_by = signum
-      if (signum /= 0) call fatal_error(error, 'interrupted by '//signal_name(signum)//' at t = '// &
-         & fmt_real(real(step - 1, wp)*model%dt, 6)//' s')
+      if (signum /= 0) call fatal_error(error, interrupted_at(signum, real(step - 1, wp)*model%dt))
    end subroutine run_three_level
 end module beamstops_three_level
