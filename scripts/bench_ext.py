@@ -39,6 +39,18 @@ def run(cmd: list[str], cwd: Path | None = None, quiet: bool = True) -> None:
         print(done.stdout)
 
 
+def existing_build(fallback: str) -> Path:
+    """A meson build of the engine for the tests to reuse: $BEAMSTOPS_BUILD, else build/tests
+    (scripts/test.sh) or build/bench (scripts/bench.py) when configured, else build/`fallback`."""
+    if os.environ.get("BEAMSTOPS_BUILD"):
+        return Path(os.environ["BEAMSTOPS_BUILD"])
+    for name in ("tests", "bench"):
+        candidate = REPO / "build" / name
+        if (candidate / "build.ninja").exists():
+            return candidate
+    return REPO / "build" / fallback
+
+
 def meson_build(build_dir: Path | None = None, bench: bool = True) -> Path:
     """Configure (if needed) and compile a meson build of the engine; return its directory."""
     build_dir = Path(build_dir) if build_dir else REPO / "build" / "bench"

@@ -18,6 +18,9 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(REPO / "scripts"))
+
+import bench_ext  # noqa: E402
 
 SECTIONS = [
     "## Speed (scripts/bench.py --quick)",
@@ -34,21 +37,11 @@ SECTIONS = [
 ]
 
 
-def build_dir() -> Path:
-    if os.environ.get("BEAMSTOPS_BUILD"):
-        return Path(os.environ["BEAMSTOPS_BUILD"])
-    for name in ("tests", "bench"):
-        candidate = REPO / "build" / name
-        if (candidate / "build.ninja").exists():
-            return candidate
-    return REPO / "build" / "speed-test"
-
-
 def test_bench_quick_runs_every_section(tmp_path: Path) -> None:
     if shutil.which("meson") is None or shutil.which(os.environ.get("FC", "gfortran")) is None:
         pytest.skip("meson and a Fortran compiler are needed to build the benchmarks")
     out = tmp_path / "bench.md"
-    done = subprocess.run([sys.executable, str(REPO / "scripts" / "bench.py"), "--quick", "--build", str(build_dir()),
+    done = subprocess.run([sys.executable, str(REPO / "scripts" / "bench.py"), "--quick", "--build", str(bench_ext.existing_build("speed-test")),
                            "--out", str(out)], capture_output=True, text=True, timeout=900, cwd=tmp_path)
     assert done.returncode == 0, done.stderr[-3000:]
     text = out.read_text()

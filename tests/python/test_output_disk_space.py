@@ -8,9 +8,7 @@ the same path) stops with its partial output readable: the records written so fa
 
 from __future__ import annotations
 
-import os
 import resource
-import shutil
 import signal
 import subprocess
 import time
@@ -20,9 +18,8 @@ import numpy as np
 import pytest
 
 import beamstops
-from test_reliability_restart import assert_identical
+from test_reliability_restart import PROGRAM, assert_identical, stat_or_none
 
-PROGRAM = os.environ.get("BEAMSTOPS_PROGRAM") or shutil.which("beamstops")
 pytestmark = pytest.mark.skipif(PROGRAM is None, reason="the beamstops program is not on PATH")
 
 SCENE = """&time dt=1e-6, t_end={t_end} /
@@ -62,11 +59,9 @@ def test_an_interrupted_output_holds_no_blocks_past_its_end(tmp_path: Path) -> N
     partial = tmp_path / "out.h5.partial"
     deadline = time.time() + 60
     while process.poll() is None and time.time() < deadline:
-        try:
-            if partial.stat().st_size >= 5_000_000:
-                break
-        except FileNotFoundError:  # not created yet (or, the run over, renamed: then it failed below)
-            pass
+        now = stat_or_none(partial)  # None: not created yet (or, the run over, renamed: it fails below)
+        if now is not None and now.st_size >= 5_000_000:
+            break
         time.sleep(0.005)
     process.send_signal(signal.SIGINT)
     assert process.wait(timeout=60) != 0

@@ -31,13 +31,7 @@ SIGNORINI, NONE, COMPLIANCE = 1, 0, 2
 
 
 def _find_build() -> Path:
-    if os.environ.get("BEAMSTOPS_BUILD"):
-        return bench_ext.meson_build(Path(os.environ["BEAMSTOPS_BUILD"]), bench=False)
-    for name in ("tests", "bench"):
-        candidate = REPO / "build" / name
-        if (candidate / "build.ninja").exists():
-            return bench_ext.meson_build(candidate, bench=False)
-    return bench_ext.meson_build(REPO / "build" / "speed-test", bench=False)
+    return bench_ext.meson_build(bench_ext.existing_build("speed-test"), bench=False)
 
 
 @pytest.fixture(scope="module")
