@@ -110,8 +110,9 @@ static void remove_detached(const char *path)
    aside first, to a hidden name beside it (`.NAME.replaced-PID`), `from` renamed onto `to`, and
    the earlier file removed by a process of its own (remove_detached): removing it costs the
    kernel the freeing of its pages and blocks, 14-15 ms for the Figure 4 run's 145 MB, which a
-   run into an existing output paid at its end (re-runs of that scene took 283 ms against 260 ms
-   into a fresh folder, the least of 8 each). Renaming onto the existing file instead would make
+   run into an existing output paid at its end (scripts/bench_rerun.py: a re-run of that scene
+   took 15.6 ms more than a run into a fresh folder, now none measurable). Renaming onto the
+   existing file instead would make
    ext4 (its default auto_da_alloc) write the new file's data out first: 0.12-0.27 s (strace -T).
    For a moment `to` does not exist, and after a power cut the new file may be incomplete where
    a rename onto it would have kept the old one; an output can be run again, so outputs take

@@ -1,5 +1,6 @@
 """`scripts/bench.py --quick` runs to its end and prints every section of docs/bench.md: the
-benchmark behind the README's speed tables stays runnable. Its build is $BEAMSTOPS_BUILD, else
+benchmark behind the README's speed tables stays runnable; so does `scripts/bench_rerun.py
+--quick`, behind the README's figures for a re-run. Its build is $BEAMSTOPS_BUILD, else
 build/tests (scripts/test.sh) or build/bench, configured with -Dbench=true when it is not (the
 microbenchmarks under bench/ then compile into it), else a build/speed-test made here. Timings
 vary with the machine and are not asserted; what the bench checks for itself is: every sweep
@@ -61,3 +62,16 @@ def test_bench_quick_runs_every_section(tmp_path: Path) -> None:
         done_points, total = re.fullmatch(r"(\d+) of (\d+)", lockstep).groups()  # type: ignore[union-attr]
         assert done_points == total and int(total) > 0, row
         assert same == "yes", row
+
+
+def test_bench_rerun_quick_runs() -> None:
+    """`scripts/bench_rerun.py --quick` (the README's re-run figures) runs to its end and no
+    earlier output is left behind by the runs into an existing one."""
+    program = os.environ.get("BEAMSTOPS_PROGRAM") or shutil.which("beamstops")
+    if program is None:
+        pytest.skip("the beamstops program is not on PATH")
+    done = subprocess.run([sys.executable, str(REPO / "scripts" / "bench_rerun.py"), "--quick", "--program", program],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert re.search(r"re-run - fresh: least -?[0-9.]+ ms, median -?[0-9.]+ ms \(3 runs each; earlier outputs "
+                     r"left behind: 0\)", done.stdout), done.stdout
