@@ -40,6 +40,8 @@ def main() -> int:
     if args.program is None:
         parser.error("no beamstops program: give --program")
     program = str(Path(args.program).resolve())  # the runs run in a folder of their own
+    if not Path(program).is_file():
+        parser.error(f"--program {args.program}: no such file")
     runs = 3 if args.quick else args.runs
     fresh: list[float] = []
     rerun: list[float] = []
