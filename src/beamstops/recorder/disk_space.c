@@ -3,7 +3,8 @@
    (fallocate with FALLOC_FL_KEEP_SIZE) before the writes reach them.
    - Speed: on ext4, a write into a reserved block skips the work of the delayed allocation on
      each block it passes (reserving, mapping and counting it): writing 145 MB in 128 KB writes
-     took 24-27 ms of CPU without a reservation and 14-15 ms with it, the reservation included.
+     took 24-27 ms of CPU without a reservation and 14-15 ms with it, the reservation included
+     (scripts/bench_buffered_writes.c).
    - A full disk: a write that finds no room is refused before it starts, while the blocks reserved
      earlier still hold room for what closing the file writes, so that the file closes readable
      with the records written so far (a write that ran out of room halfway left HDF5 a file it
