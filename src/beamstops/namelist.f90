@@ -111,7 +111,7 @@ contains
    !> anew (Python's Scene.replace), as 'group:key' words: such a key that does nothing under
    !> the other keys (a spring without the compliance law, &damping modes without ratio) is
    !> dropped where a key given anew is refused.
-   subroutine scene_from_text(text, source, scene, error, default_file, carried)
+   recursive subroutine scene_from_text(text, source, scene, error, default_file, carried)
       !> Namelist text.
       character(len=*), intent(in) :: text
       !> Where the text came from, for messages.
@@ -512,6 +512,11 @@ contains
             if (index(one_msg, 'Cannot match namelist object name') > 0 .and. .not. known_key(g, key)) then
                call fatal_error(error, source//': &'//trim(group_names(g))//': unknown key '//key// &
                   & '; keys of &'//trim(group_names(g))//': '//trim(group_keys(g)))
+            else if (value_kind(key) == 'a whole number' .and. whole_number_text(value)) then
+               ! a whole number too large for the key's integer kind: out of range, not malformed
+               call fatal_error(error, source//': &'//trim(group_names(g))//' '// &
+                  & assignment_text(body(starts(i):min(last, starts(i) + 120)))//' is out of range; allowed: '// &
+                  & whole_range(trim(group_names(g)), key, adjustl(value)))
             else
                call fatal_error(error, source//': &'//trim(group_names(g))//' '// &
                   & assignment_text(body(starts(i):min(last, starts(i) + 120)))//' is malformed; allowed: '//key// &
@@ -522,7 +527,68 @@ contains
          call fatal_error(error, source//': &'//trim(group_names(g))//': '//trim(explain(stat, msg, groups_text(g)))// &
             & ' in `'//trim(groups_text(g))//'`; keys of &'//trim(group_names(g))//': '//trim(group_keys(g)))
       end subroutine malformed_key
+
+      !> The allowed range of a whole-number key given `value`, a whole number beyond its integer
+      !> kind: the range validate_scene names for the kind's extreme of the value's sign given alone,
+      !> else the one it names for the other extreme with the kind's limit added, else the kind's range.
+      function whole_range(group, key, value) result(allowed)
+         character(len=*), intent(in) :: group, key, value
+         character(len=:), allocatable :: allowed, largest, beyond, other
+         if (key == 'checkpoint_every') then
+            largest = fmt_int(huge(1_ik))
+         else
+            largest = itoa(huge(1))
+         end if
+         if (value(1:1) == '-') then
+            beyond = '-'//largest; other = largest
+         else
+            beyond = largest; other = '-'//largest
+         end if
+         allowed = range_named(group, key, beyond)
+         if (len(allowed) > 0) return
+         allowed = range_named(group, key, other)
+         if (len(allowed) > 0) then
+            if (value(1:1) == '-') then
+               allowed = allowed//', and at least '//beyond
+            else
+               allowed = allowed//', and at most '//beyond
+            end if
+         else
+            allowed = key//' = a whole number from -'//largest//' to '//largest
+         end if
+      end function whole_range
+
+      !> What validate_scene allows of the key, refusing it at `extreme` given alone ('' if it does not).
+      function range_named(group, key, extreme) result(range)
+         character(len=*), intent(in) :: group, key, extreme
+         character(len=:), allocatable :: range
+         type(scene_type) :: probe
+         type(error_type), allocatable :: probe_error
+         integer :: at
+         range = ''
+         call scene_from_text('&'//group//' '//key//' = '//extreme//' /', source, probe, probe_error)
+         if (.not. allocated(probe_error)) return
+         at = index(probe_error%message, '; allowed: ')
+         if (at > 0 .and. index(probe_error%message, '&'//group//' '//key//' ') > 0) &
+            & range = probe_error%message(at + len('; allowed: '):)
+      end function range_named
    end subroutine scene_from_text
+
+   !> Whether a value's text is one whole number (an optional sign and digits; blanks and a
+   !> trailing comma aside).
+   pure logical function whole_number_text(text)
+      character(len=*), intent(in) :: text
+      character(len=:), allocatable :: t
+      t = trim(adjustl(text))
+      do while (len(t) > 0)
+         if (t(len(t):) /= ',') exit
+         t = trim(t(:len(t) - 1))
+      end do
+      if (len(t) > 0) then
+         if (t(1:1) == '+' .or. t(1:1) == '-') t = t(2:)
+      end if
+      whole_number_text = len(t) > 0 .and. verify(t, '0123456789') == 0
+   end function whole_number_text
 
    !> The text without the UTF-8 byte order mark some editors put at its start.
    pure function without_bom(text) result(rest)

@@ -370,6 +370,15 @@ contains
       type(error_type), allocatable, intent(out) :: error
       call expect_error('kind.nml', [character(len=ll) :: '&time beta = 0.25 /', '&mesh elements = 19.5 /'], &
          & [character(len=32) :: '&mesh elements = 19.5', 'is malformed', 'a whole number'], error)
+      if (allocated(error)) return
+      ! a whole number beyond the integer kind is out of range, with the key's own range
+      call expect_error('huge.nml', [character(len=ll) :: '&mesh elements = 99999999999999999999 /'], &
+         & [character(len=48) :: '&mesh elements = 99999999999999999999', 'is out of range', &
+         & 'allowed: 1 <= elements <= 1000000'], error)
+      if (allocated(error)) return
+      call expect_error('huge.nml', [character(len=ll) :: '&output checkpoint_every = 99999999999999999999 /'], &
+         & [character(len=48) :: 'is out of range', 'checkpoint_every >= 0 (0: none)', &
+         & 'and at most 9223372036854775807'], error)
    end subroutine test_malformed_kind
 
    !> Reading the canonical text of a scene gives the same canonical text (so the same values:
