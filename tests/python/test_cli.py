@@ -538,6 +538,55 @@ def test_run_stops_a_threaded_openblas_pool_unless_told(chosen: str | None, tmp_
         assert f.attrs["status"] == b"complete"
 
 
+def _cpu_list(text: str) -> set[int]:
+    """The CPUs of a list such as '0-3,6' (/proc/PID/status's Cpus_allowed_list)."""
+    cpus: set[int] = set()
+    for part in text.strip().split(","):
+        low, _, high = part.partition("-")
+        cpus.update(range(int(low), int(high or low) + 1))
+    return cpus
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs /proc")
+@pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="needs two CPUs (with one, no writer thread)")
+def test_the_writer_thread_keeps_off_the_time_loops_cpu(tmp_path: Path) -> None:
+    """The HDF5 writer thread may run on any CPU the process may use but the one the time loop
+    is on (the kernel had woken it there, where it preempted the loop while the other CPU idled):
+    while the run goes on, its allowed CPUs are the process's without the loop's."""
+    import time
+
+    scene = write(tmp_path, "&time dt=1e-6, t_end=4 /\n&output file='long.h5', record_every=1 /\n")
+    process = subprocess.Popen([PROGRAM, "run", str(scene)], cwd=tmp_path, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+    samples: list[tuple[set[int], set[int], int]] = []
+    try:
+        while process.poll() is None and len(samples) < 20:
+            time.sleep(0.02)
+            if not (tmp_path / "long.h5.partial").exists():
+                continue
+            try:
+                tasks = {int(t.name): t for t in Path(f"/proc/{process.pid}/task").iterdir()}
+                if len(tasks) != 2:
+                    continue
+                loop, writer = tasks[process.pid], next(t for tid, t in tasks.items() if tid != process.pid)
+                allowed = {t: _cpu_list(next(line.split(":", 1)[1] for line in (t / "status").read_text().splitlines()
+                                             if line.startswith("Cpus_allowed_list"))) for t in (loop, writer)}
+                loop_cpu = int((loop / "stat").read_text().rsplit(")", 1)[1].split()[36])
+            except (OSError, StopIteration, KeyError):
+                continue
+            samples.append((allowed[loop], allowed[writer], loop_cpu))
+        assert process.wait(timeout=120) == 0
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert len(samples) >= 5, "the run ended before it could be watched"
+    # the writer is kept off one CPU of the process's, never more (all of them only after the loop
+    # had to wait for it: a machine so busy that the writer fell behind), and (the loop moving
+    # seldom) off the loop's own most of the time
+    assert all(writer <= loop and len(loop - writer) <= 1 for loop, writer, _ in samples), samples
+    assert sum(cpu not in writer for _, writer, cpu in samples) >= len(samples) // 2, samples
+
+
 def test_an_empty_or_repeated_output_name_is_refused_before_the_run(tmp_path: Path) -> None:
     scene = write(tmp_path, SHORT)
     for args in (["-o", ""], ["-o", "  "], ["-o", "a.h5", "-o", "b.h5"]):
