@@ -194,8 +194,10 @@ void beamstops_writer_post(void *p, void *arg)
     keep_off(w, waited ? -1 : sched_getcpu());
     w->arg = arg;
     w->busy = 1;
-    pthread_cond_broadcast(&w->changed);
     pthread_mutex_unlock(&w->lock);
+    /* after the unlock: woken with the lock still held, the writer went back to sleep on the
+       lock and the unlock had to wake it again (two futex calls a post, strace) */
+    pthread_cond_broadcast(&w->changed);
 }
 
 /* Finish the last order, end the thread and free it. */
