@@ -199,6 +199,7 @@ contains
             return
          end if
       end do
+      call sentinel_given(); if (allocated(error)) return
 
       call derive_beam(source, length, k2, mass_per_length, youngs_modulus, density, outer_diameter, &
          & wall_thickness, scene, error)
@@ -460,6 +461,40 @@ contains
          end do
       end subroutine check_assignments
 
+      !> The elements of &stops nodes and &damping modes not given keep the sentinel unset_node; one
+      !> given equal to it would pass for not given. Each group is read again with another sentinel
+      !> (huge(1)): an element that holds unset_node both times was given so, and is out of range.
+      subroutine sentinel_given()
+         integer :: first_nodes(max_stops), first_modes(2), i, stops_group, damping_group
+         stops_group = findloc(group_names, 'stops', 1)
+         damping_group = findloc(group_names, 'damping', 1)
+         if (has_group(stops_group)) then
+            first_nodes = nodes
+            nodes = huge(1)
+            call read_group(stops_group, cleaned, stat, msg)
+            do i = 1, max_stops
+               if (nodes(i) == unset_node) then
+                  call fatal_error(error, source//': &stops nodes('//itoa(i)//') = '//itoa(unset_node)// &
+                     & ' is out of range; allowed: 1 <= nodes <= elements = '//itoa(elements))
+                  return
+               end if
+            end do
+            nodes = first_nodes
+         end if
+         if (has_group(damping_group)) then
+            first_modes = modes
+            modes = huge(1)
+            call read_group(damping_group, cleaned, stat, msg)
+            if (any(modes == unset_node)) then
+               call fatal_error(error, source//': &damping modes = '//itoa(first_modes(1))//', '// &
+                  & itoa(first_modes(2))//' is out of range; allowed: two distinct modes, 1 <= mode <= 2 elements = '// &
+                  & itoa(2*elements))
+               return
+            end if
+            modes = first_modes
+         end if
+      end subroutine sentinel_given
+
       !> The message of a group gfortran could not read: each `key = value` of the group is read
       !> alone to find the first one that fails, and the message names it with the kind of value
       !> the key takes; gfortran's own words when no single assignment fails.
@@ -512,6 +547,12 @@ contains
             if (index(one_msg, 'Cannot match namelist object name') > 0 .and. .not. known_key(g, key)) then
                call fatal_error(error, source//': &'//trim(group_names(g))//': unknown key '//key// &
                   & '; keys of &'//trim(group_names(g))//': '//trim(group_keys(g)))
+            else if ((key == 'nodes' .or. key == 'modes') .and. whole_numbers_text(value)) then
+               ! whole numbers, one of them too large for an integer: out of range, not malformed
+               call fatal_error(error, source//': &'//trim(group_names(g))//' '// &
+                  & assignment_text(body(starts(i):min(last, starts(i) + 120)))//' is out of range; allowed: '// &
+                  & list_range(trim(group_names(g)), key, index(cleaned, body) + starts(i) - 1, &
+                  & index(cleaned, body) + last - 1, value))
             else if (value_kind(key) == 'a whole number' .and. whole_number_text(value)) then
                ! a whole number too large for the key's integer kind: out of range, not malformed
                call fatal_error(error, source//': &'//trim(group_names(g))//' '// &
@@ -558,6 +599,29 @@ contains
          end if
       end function whole_range
 
+      !> The allowed range of a list of whole numbers (&stops nodes, &damping modes), one of them
+      !> beyond the integer kind: the range validate_scene names when the scene is read again with
+      !> such values at the kind's extreme (cleaned(first:final) is the key's assignment), else the
+      !> kind's range.
+      function list_range(group, key, first, final, value) result(allowed)
+         character(len=*), intent(in) :: group, key, value
+         integer, intent(in) :: first, final
+         character(len=:), allocatable :: allowed, largest
+         type(scene_type) :: probe
+         type(error_type), allocatable :: probe_error
+         integer :: at
+         largest = itoa(huge(1))
+         allowed = key//' = whole numbers from -'//largest//' to '//largest
+         call scene_from_text(cleaned(:first - 1)//key//' = '//clamped_list(value)//' '//cleaned(final + 1:), source, &
+            & probe, probe_error)
+         if (.not. allocated(probe_error)) return
+         at = index(probe_error%message, '; allowed: ')
+         if (at == 0) return
+         if (index(probe_error%message, '&'//group//' '//key//' ') > 0 .or. &
+            & index(probe_error%message, '&'//group//' '//key//'(') > 0) &
+            & allowed = probe_error%message(at + len('; allowed: '):)
+      end function list_range
+
       !> What validate_scene allows of the key, refusing it at `extreme` given alone ('' if it does not).
       function range_named(group, key, extreme) result(range)
          character(len=*), intent(in) :: group, key, extreme
@@ -573,6 +637,79 @@ contains
             & range = probe_error%message(at + len('; allowed: '):)
       end function range_named
    end subroutine scene_from_text
+
+   !> The next item of a list's text (separated by commas or blanks) at or after `pos`:
+   !> text(first:last), `pos` moved past it; first = 0 when there is none.
+   pure subroutine next_item(text, pos, first, last)
+      character(len=*), intent(in) :: text
+      integer, intent(inout) :: pos
+      integer, intent(out) :: first, last
+      first = 0
+      last = 0
+      do while (pos <= len(text))
+         if (text(pos:pos) /= ',' .and. text(pos:pos) /= ' ') exit
+         pos = pos + 1
+      end do
+      if (pos > len(text)) return
+      first = pos
+      do while (pos <= len(text))
+         if (text(pos:pos) == ',' .or. text(pos:pos) == ' ') exit
+         pos = pos + 1
+      end do
+      last = pos - 1
+   end subroutine next_item
+
+   !> Whether a list's text holds whole numbers only (at least one), one of them beyond the
+   !> default integer kind.
+   logical function whole_numbers_text(text)
+      character(len=*), intent(in) :: text
+      integer :: pos, first, last, count
+      logical :: beyond
+      pos = 1
+      count = 0
+      beyond = .false.
+      whole_numbers_text = .false.
+      do
+         call next_item(text, pos, first, last)
+         if (first == 0) exit
+         if (.not. whole_number_text(text(first:last))) return
+         beyond = beyond .or. beyond_integer(text(first:last))
+         count = count + 1
+      end do
+      whole_numbers_text = count > 0 .and. beyond
+   end function whole_numbers_text
+
+   !> The list with each whole number beyond the default integer kind replaced by the kind's
+   !> extreme of its sign, the items separated by commas.
+   function clamped_list(text) result(list)
+      character(len=*), intent(in) :: text
+      character(len=:), allocatable :: list
+      integer :: pos, first, last
+      pos = 1
+      list = ''
+      do
+         call next_item(text, pos, first, last)
+         if (first == 0) exit
+         if (len(list) > 0) list = list//', '
+         if (.not. beyond_integer(text(first:last))) then
+            list = list//text(first:last)
+         else if (text(first:first) == '-') then
+            list = list//'-'//itoa(huge(1))
+         else
+            list = list//itoa(huge(1))
+         end if
+      end do
+   end function clamped_list
+
+   !> Whether a whole number's text (an optional sign and digits) is beyond the default integer kind.
+   logical function beyond_integer(text)
+      character(len=*), intent(in) :: text
+      integer :: value, stat
+      beyond_integer = .false.
+      if (.not. whole_number_text(text)) return
+      read (text, *, iostat=stat) value
+      beyond_integer = stat /= 0
+   end function beyond_integer
 
    !> Whether a value's text is one whole number (an optional sign and digits; blanks and a
    !> trailing comma aside).

@@ -379,6 +379,14 @@ contains
       call expect_error('huge.nml', [character(len=ll) :: '&output checkpoint_every = 99999999999999999999 /'], &
          & [character(len=48) :: 'is out of range', 'checkpoint_every >= 0 (0: none)', &
          & 'and at most 9223372036854775807'], error)
+      if (allocated(error)) return
+      call expect_error('huge.nml', [character(len=ll) :: '&stops nodes = 5, 99999999999999999999,', &
+         & '  lower = -0.1, upper = 0.1 /'], [character(len=48) :: 'nodes = 5, 99999999999999999999', &
+         & 'is out of range', '1 <= nodes <= elements = 19'], error)
+      if (allocated(error)) return
+      ! the sentinel of an element not given, given: out of range (it had passed for not given)
+      call expect_error('sentinel.nml', [character(len=ll) :: '&stops nodes = -2147483647, lower = -0.1, upper = 0.1 /'], &
+         & [character(len=48) :: '&stops nodes(1) = -2147483647', 'is out of range'], error)
    end subroutine test_malformed_kind
 
    !> Reading the canonical text of a scene gives the same canonical text (so the same values:

@@ -138,6 +138,13 @@ REFUSED = [
     ("&ensemble seed=-9999999999 /", ["&ensemble seed=-9999999999 is out of range",
                                       "a whole number from -2147483647 to 2147483647"]),
     ("&mesh elements=2147483648a /", ["&mesh elements=2147483648a is malformed", "a whole number"]),
+    ("&stops nodes=5, 99999999999999999999 lower=-0.1 upper=0.1 /",
+     ["&stops nodes=5, 99999999999999999999 is out of range", "1 <= nodes <= elements = 19"]),
+    ("&damping ratio=0.01 modes=1, -99999999999999999999 /",
+     ["&damping modes=1, -99999999999999999999 is out of range", "1 <= mode <= 2 elements = 38"]),
+    # the value that marks a list element as not given, given: refused, not taken as not given
+    ("&stops nodes=-2147483647 lower=-0.1 upper=0.1 /", ["&stops nodes(1) = -2147483647 is out of range"]),
+    ("&damping ratio=0.01 modes=-2147483647, 2 /", ["&damping modes = -2147483647, 2 is out of range"]),
     ("&time dt=-1e-5 /", ["&time dt = -1e-05", "allowed"]),
     ("&time dt=nan /", ["&time dt", "allowed"]),
     ("&time beta=0.7 /", ["&time beta", "0.5"]),
