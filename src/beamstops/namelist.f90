@@ -461,39 +461,60 @@ contains
          end do
       end subroutine check_assignments
 
-      !> The elements of &stops nodes and &damping modes not given keep the sentinel unset_node; one
-      !> given equal to it would pass for not given. Each group is read again with another sentinel
-      !> (huge(1)): an element that holds unset_node both times was given so, and is out of range.
+      !> Keys not given keep a sentinel (unset for reals, unset_node for &stops nodes and &damping
+      !> modes); a value given equal to it would pass for not given. The groups are read again with
+      !> other sentinels (huge): a key that holds the sentinel both times was given so. A real is
+      !> then taken as given, one step toward zero (its range check follows); a node or mode is out
+      !> of range.
       subroutine sentinel_given()
-         integer :: first_nodes(max_stops), first_modes(2), i, stops_group, damping_group
-         stops_group = findloc(group_names, 'stops', 1)
-         damping_group = findloc(group_names, 'damping', 1)
-         if (has_group(stops_group)) then
-            first_nodes = nodes
-            nodes = huge(1)
-            call read_group(stops_group, cleaned, stat, msg)
-            do i = 1, max_stops
-               if (nodes(i) == unset_node) then
-                  call fatal_error(error, source//': &stops nodes('//itoa(i)//') = '//itoa(unset_node)// &
-                     & ' is out of range; allowed: 1 <= nodes <= elements = '//itoa(elements))
-                  return
-               end if
-            end do
-            nodes = first_nodes
-         end if
-         if (has_group(damping_group)) then
-            first_modes = modes
-            modes = huge(1)
-            call read_group(damping_group, cleaned, stat, msg)
-            if (any(modes == unset_node)) then
-               call fatal_error(error, source//': &damping modes = '//itoa(first_modes(1))//', '// &
-                  & itoa(first_modes(2))//' is out of range; allowed: two distinct modes, 1 <= mode <= 2 elements = '// &
-                  & itoa(2*elements))
+         real(wp) :: first(14), first_lower(max_stops), first_upper(max_stops), first_x(max_stops), first_ratio(2)
+         integer :: first_nodes(max_stops), first_modes(2), i, g
+         first = [k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness, stiffness, &
+            & stiffness_per_mass, mass_coefficient, stiffness_coefficient, histogram_lower, histogram_upper, 0.0_wp, 0.0_wp]
+         first_lower = lower; first_upper = upper; first_x = x; first_ratio = ratio
+         first_nodes = nodes; first_modes = modes
+         k2 = huge(1.0_wp); mass_per_length = huge(1.0_wp); youngs_modulus = huge(1.0_wp); density = huge(1.0_wp)
+         outer_diameter = huge(1.0_wp); wall_thickness = huge(1.0_wp); stiffness = huge(1.0_wp)
+         stiffness_per_mass = huge(1.0_wp); mass_coefficient = huge(1.0_wp); stiffness_coefficient = huge(1.0_wp)
+         histogram_lower = huge(1.0_wp); histogram_upper = huge(1.0_wp)
+         lower = huge(1.0_wp); upper = huge(1.0_wp); x = huge(1.0_wp); ratio = huge(1.0_wp)
+         nodes = huge(1); modes = huge(1)
+         do g = 1, size(group_names)
+            if (.not. has_group(g)) cycle
+            if (all(trim(group_names(g)) /= [character(len=10) :: 'beam', 'stops', 'damping', 'statistics'])) cycle
+            call read_group(g, cleaned, stat, msg)
+         end do
+         do i = 1, max_stops
+            if (nodes(i) == unset_node) then
+               call fatal_error(error, source//': &stops nodes('//itoa(i)//') = '//itoa(unset_node)// &
+                  & ' is out of range; allowed: 1 <= nodes <= elements = '//itoa(elements))
                return
             end if
-            modes = first_modes
+         end do
+         if (any(modes == unset_node)) then
+            call fatal_error(error, source//': &damping modes = '//itoa(first_modes(1))//', '// &
+               & itoa(first_modes(2))//' is out of range; allowed: two distinct modes, 1 <= mode <= 2 elements = '// &
+               & itoa(2*elements))
+            return
          end if
+         nodes = first_nodes; modes = first_modes
+         k2 = again(first(1), k2); mass_per_length = again(first(2), mass_per_length)
+         youngs_modulus = again(first(3), youngs_modulus); density = again(first(4), density)
+         outer_diameter = again(first(5), outer_diameter); wall_thickness = again(first(6), wall_thickness)
+         stiffness = again(first(7), stiffness); stiffness_per_mass = again(first(8), stiffness_per_mass)
+         mass_coefficient = again(first(9), mass_coefficient)
+         stiffness_coefficient = again(first(10), stiffness_coefficient)
+         histogram_lower = again(first(11), histogram_lower); histogram_upper = again(first(12), histogram_upper)
+         lower = again(first_lower, lower); upper = again(first_upper, upper); x = again(first_x, x)
+         ratio = again(first_ratio, ratio)
       end subroutine sentinel_given
+
+      !> A real key after both reads: its first value, or (the sentinel given) the next one toward zero.
+      elemental real(wp) function again(first_read, second_read)
+         real(wp), intent(in) :: first_read, second_read
+         again = first_read
+         if (second_read == unset) again = unset + spacing(unset)
+      end function again
 
       !> The message of a group gfortran could not read: each `key = value` of the group is read
       !> alone to find the first one that fails, and the message names it with the kind of value

@@ -145,6 +145,8 @@ REFUSED = [
     # the value that marks a list element as not given, given: refused, not taken as not given
     ("&stops nodes=-2147483647 lower=-0.1 upper=0.1 /", ["&stops nodes(1) = -2147483647 is out of range"]),
     ("&damping ratio=0.01 modes=-2147483647, 2 /", ["&damping modes = -2147483647, 2 is out of range"]),
+    ("&stops lower=-1.7976931348623157e308 /", ["&stops lower = -1.797693134862315", "is out of range", "-1e+06 <= lower"]),
+    ("&beam k2=-1.7976931348623157e308 /", ["&beam k2 = -1.797693134862315", "is out of range"]),
     ("&time dt=-1e-5 /", ["&time dt = -1e-05", "allowed"]),
     ("&time dt=nan /", ["&time dt", "allowed"]),
     ("&time beta=0.7 /", ["&time beta", "0.5"]),
