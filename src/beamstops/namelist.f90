@@ -737,11 +737,7 @@ contains
    pure logical function whole_number_text(text)
       character(len=*), intent(in) :: text
       character(len=:), allocatable :: t
-      t = trim(adjustl(text))
-      do while (len(t) > 0)
-         if (t(len(t):) /= ',') exit
-         t = trim(t(:len(t) - 1))
-      end do
+      t = assignment_text(text)
       if (len(t) > 0) then
          if (t(1:1) == '+' .or. t(1:1) == '-') t = t(2:)
       end if
