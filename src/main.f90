@@ -115,7 +115,7 @@ program beamstops_main
    type(path_type), allocatable :: paths(:)
    logical :: restart = .false.
    type(scene_type) :: scene
-   type(model_type) :: model
+   type(model_type), target :: model
    !> With &mesh modes > 0, the reduced model the run steps (prepare_run).
    type(reduced_model_type) :: reduced
    type(error_type), allocatable :: error
@@ -381,7 +381,7 @@ contains
    !> With `restart`, the partial file continues from the checkpoint OUT.checkpoint.
    recursive integer function run_to_file(scene, model, input, restart, progress, reduced) result(status)
       type(scene_type), intent(in) :: scene
-      type(model_type), intent(in) :: model
+      type(model_type), intent(in), target :: model
       character(len=*), intent(in) :: input
       logical, intent(in) :: restart
       !> Print a progress line on stderr.
@@ -389,7 +389,7 @@ contains
       !> With &mesh modes > 0, the reduced model the run steps (prepare_run); built here when absent
       !> (the scenes of `run A.nml B.nml ...`, prepared and checked up front without keeping it).
       type(reduced_model_type), intent(in), optional :: reduced
-      type(hdf5_recorder) :: recorder
+      type(hdf5_recorder), target :: recorder
       type(run_summary) :: summary
       type(state_type) :: state
       type(reduced_model_type) :: built
@@ -568,7 +568,7 @@ contains
       type(path_type), intent(in) :: paths(:)
       logical, intent(in) :: restart
       type(scene_type), allocatable :: scenes(:)
-      type(model_type), allocatable :: models(:)
+      type(model_type), allocatable, target :: models(:)
       type(error_type), allocatable :: error
       integer, allocatable :: group(:), status(:), members(:)
       logical, allocatable :: alone(:)
@@ -691,12 +691,12 @@ contains
    !> that cannot start runs its scenes one at a time instead.
    subroutine run_group_to_files(scenes, models, paths, members, progress, status)
       type(scene_type), intent(in) :: scenes(:)
-      type(model_type), intent(in) :: models(:)
+      type(model_type), intent(in), target :: models(:)
       type(path_type), intent(in) :: paths(:)
       integer, intent(in) :: members(:)
       logical, intent(in) :: progress
       integer, intent(inout) :: status(:)
-      type(hdf5_recorder), allocatable :: recorders(:)
+      type(hdf5_recorder), allocatable, target :: recorders(:)
       type(run_summary), allocatable :: summaries(:)
       type(error_type), allocatable :: failures(:)
       type(error_type), allocatable :: error, start_error, write_error, finish_error

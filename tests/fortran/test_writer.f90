@@ -32,7 +32,9 @@ contains
          & new_unittest('a record streamed into a buffer is the same bits and is finite unless one value is a NaN or '// &
          & 'an infinity, at every position and buffer alignment', test_stream_row), &
          & new_unittest('a finished file replaces an earlier one, which is removed; a file that cannot be moved '// &
-         & 'leaves the earlier one in place', test_replace_file) &
+         & 'leaves the earlier one in place', test_replace_file), &
+         & new_unittest('a file that cannot be created: told by open without a thread, by the run and finish '// &
+         & 'with one (the writer creates it), the same message; nothing left', test_uncreatable) &
          & ]
    end subroutine collect_writer
 
@@ -121,6 +123,47 @@ contains
       call compare_with_memory(none, 'test_writer_inline.h5', error)
    end subroutine test_inline
 
+   !> A partial file in a folder that does not exist: without a writer thread, open fails with
+   !> "cannot create"; with one, open returns, the run stops at its first full buffer and finish
+   !> fails with the same message; no file either way.
+   subroutine test_uncreatable(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: path = 'test_writer_no_such_folder/out.h5'
+      type(writer_thread) :: none, thread
+      type(scene_type) :: scene
+      type(model_type), target :: model
+      type(hdf5_recorder), target :: inline, threaded
+      type(run_summary) :: summary
+      type(state_type) :: state
+      type(error_type), allocatable :: opened, failure, finished
+      call prepare(scene, model, error)
+      if (allocated(error)) return
+      inline%writer = none
+      call inline%open(path, scene, model, opened)
+      call check(error, allocated(opened), 'without a thread, open fails')
+      if (allocated(error)) return
+      call check(error, index(opened%message, 'cannot create '//path//'.partial') > 0, opened%message)
+      if (allocated(error)) return
+      call start_writer(thread)
+      threaded%writer = thread
+      call threaded%open(path, scene, model, opened)
+      call check(error, .not. allocated(opened), 'with a thread, open returns (the writer creates the file)')
+      if (allocated(error)) return
+      call start_state(scene, model, state, threaded, error)
+      if (allocated(error)) return
+      call continue_run(scene, model, state, threaded, summary, failure, path//'.checkpoint')
+      call threaded%finish(summary, finished)
+      call stop_writer(thread)
+      call check(error, summary%status /= status_complete .and. state%step < 3*16384, &
+         & 'the run stops early, at a buffer handed over')
+      if (allocated(error)) return
+      call check(error, allocated(finished), 'finish fails')
+      if (allocated(error)) return
+      call check(error, index(finished%message, 'cannot create '//path//'.partial') > 0, finished%message)
+      if (allocated(error)) return
+      call check(error, .not. file_exists(path) .and. .not. file_exists(path//'.partial'), 'no file')
+   end subroutine test_uncreatable
+
    !> The scene run into `path` through `writer` (checkpoints into path.checkpoint), and into
    !> memory: the file's series equal the memory's, bit for bit.
    subroutine compare_with_memory(writer, path, error)
@@ -128,8 +171,8 @@ contains
       character(len=*), intent(in) :: path
       type(error_type), allocatable, intent(out) :: error
       type(scene_type) :: scene
-      type(model_type) :: model
-      type(hdf5_recorder) :: file_rec
+      type(model_type), target :: model
+      type(hdf5_recorder), target :: file_rec
       type(array_recorder) :: memory
       type(run_summary) :: summary, reference
       type(state_type) :: state

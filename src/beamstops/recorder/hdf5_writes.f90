@@ -4,7 +4,7 @@
 !> start at. The recorder fills one set of buffers while the writer stores the other; it hands
 !> an order over only when the previous one is done, and reads `failed` only then.
 module beamstops_recorder_hdf5_writes
-   use, intrinsic :: iso_c_binding, only: c_ptr, c_f_pointer, c_loc, c_int64_t
+   use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_f_pointer, c_loc, c_int64_t, c_associated
    use hdf5
    use beamstops_kinds, only: wp
    use beamstops_recorder_disk_space, only: disk_reservation, reserve
@@ -40,7 +40,19 @@ module beamstops_recorder_hdf5_writes
       logical :: failed = .false.
       !> The disk space reserved ahead of the file's writes.
       type(disk_reservation) :: space
+      !> When set, the order creates the file instead (beamstops_recorder_hdf5's create_file): the
+      !> recorder whose file it is, and the run's model.
+      type(c_ptr) :: creating = c_null_ptr, model = c_null_ptr
    end type write_order
+
+   interface
+      !> Create the file of the recorder at `recorder` (c_loc of a beamstops_recorder_hdf5
+      !> hdf5_recorder), for the run's model at `model`.
+      subroutine create_file(recorder, model) bind(c, name='beamstops_create_file')
+         import :: c_ptr
+         type(c_ptr), value :: recorder, model
+      end subroutine create_file
+   end interface
 
 contains
 
@@ -54,7 +66,7 @@ contains
    end subroutine hand_over
 
    !> The writer thread's job (called by writer_thread.c): carry out the order at `arg` (c_loc
-   !> of a write_order).
+   !> of a write_order): create the file, or append the order's rows.
    subroutine write_order_job(arg) bind(c, name='beamstops_write_order')
       !> The order.
       type(c_ptr), value :: arg
@@ -64,6 +76,12 @@ contains
       ! too (failures become the recorder's message)
       call h5eset_auto_f(0, hdferr)
       call c_f_pointer(arg, order)
+      if (c_associated(order%creating)) then
+         call create_file(order%creating, order%model)
+         order%creating = c_null_ptr
+         order%model = c_null_ptr
+         return
+      end if
       call write_rows(order)
    end subroutine write_order_job
 
