@@ -75,7 +75,8 @@ typedef struct {
     pthread_cond_t changed;
     void *arg;
     int busy, quit;
-    /* The CPUs the process may use, and the one the writer is kept off (-1: none). */
+    /* The CPUs the process may use, and the one the writer is kept off (-1: none; -2: the
+       process's CPUs unknown, the writer's placement left to the kernel). */
     cpu_set_t allowed;
     int excluded;
 } writer_t;
