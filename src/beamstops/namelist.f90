@@ -467,10 +467,10 @@ contains
       !> then taken as given, one step toward zero (its range check follows); a node or mode is out
       !> of range.
       subroutine sentinel_given()
-         real(wp) :: first(14), first_lower(max_stops), first_upper(max_stops), first_x(max_stops), first_ratio(2)
+         real(wp) :: first(12), first_lower(max_stops), first_upper(max_stops), first_x(max_stops), first_ratio(2)
          integer :: first_nodes(max_stops), first_modes(2), i, g
          first = [k2, mass_per_length, youngs_modulus, density, outer_diameter, wall_thickness, stiffness, &
-            & stiffness_per_mass, mass_coefficient, stiffness_coefficient, histogram_lower, histogram_upper, 0.0_wp, 0.0_wp]
+            & stiffness_per_mass, mass_coefficient, stiffness_coefficient, histogram_lower, histogram_upper]
          first_lower = lower; first_upper = upper; first_x = x; first_ratio = ratio
          first_nodes = nodes; first_modes = modes
          k2 = huge(1.0_wp); mass_per_length = huge(1.0_wp); youngs_modulus = huge(1.0_wp); density = huge(1.0_wp)
@@ -606,9 +606,9 @@ contains
          else
             beyond = largest; other = '-'//largest
          end if
-         allowed = range_named(group, key, beyond)
+         allowed = range_named(group, key, '&'//group//' '//key//' = '//beyond//' /')
          if (len(allowed) > 0) return
-         allowed = range_named(group, key, other)
+         allowed = range_named(group, key, '&'//group//' '//key//' = '//other//' /')
          if (len(allowed) > 0) then
             if (value(1:1) == '-') then
                allowed = allowed//', and at least '//beyond
@@ -628,33 +628,28 @@ contains
          character(len=*), intent(in) :: group, key, value
          integer, intent(in) :: first, final
          character(len=:), allocatable :: allowed, largest
-         type(scene_type) :: probe
-         type(error_type), allocatable :: probe_error
-         integer :: at
+         allowed = range_named(group, key, cleaned(:first - 1)//key//' = '//clamped_list(value)//' '// &
+            & cleaned(final + 1:))
+         if (len(allowed) > 0) return
          largest = itoa(huge(1))
          allowed = key//' = whole numbers from -'//largest//' to '//largest
-         call scene_from_text(cleaned(:first - 1)//key//' = '//clamped_list(value)//' '//cleaned(final + 1:), source, &
-            & probe, probe_error)
+      end function list_range
+
+      !> What validate_scene allows of the key when it refuses the key in `probe`, a scene's text
+      !> ('' when it does not: the text is read, or another key is refused first).
+      function range_named(group, key, probe) result(range)
+         character(len=*), intent(in) :: group, key, probe
+         character(len=:), allocatable :: range
+         type(scene_type) :: scene
+         type(error_type), allocatable :: probe_error
+         integer :: at
+         range = ''
+         call scene_from_text(probe, source, scene, probe_error)
          if (.not. allocated(probe_error)) return
          at = index(probe_error%message, '; allowed: ')
          if (at == 0) return
          if (index(probe_error%message, '&'//group//' '//key//' ') > 0 .or. &
             & index(probe_error%message, '&'//group//' '//key//'(') > 0) &
-            & allowed = probe_error%message(at + len('; allowed: '):)
-      end function list_range
-
-      !> What validate_scene allows of the key, refusing it at `extreme` given alone ('' if it does not).
-      function range_named(group, key, extreme) result(range)
-         character(len=*), intent(in) :: group, key, extreme
-         character(len=:), allocatable :: range
-         type(scene_type) :: probe
-         type(error_type), allocatable :: probe_error
-         integer :: at
-         range = ''
-         call scene_from_text('&'//group//' '//key//' = '//extreme//' /', source, probe, probe_error)
-         if (.not. allocated(probe_error)) return
-         at = index(probe_error%message, '; allowed: ')
-         if (at > 0 .and. index(probe_error%message, '&'//group//' '//key//' ') > 0) &
             & range = probe_error%message(at + len('; allowed: '):)
       end function range_named
    end subroutine scene_from_text
@@ -771,21 +766,14 @@ contains
    function value_count(text) result(count)
       character(len=*), intent(in) :: text
       integer :: count
-      integer :: i, first, star, r, stat
+      integer :: pos, first, last, star, r, stat
       character(len=:), allocatable :: item
       count = 0
-      i = 1
-      do while (i <= len(text))
-         if (scan(text(i:i), ', ') > 0) then
-            i = i + 1
-            cycle
-         end if
-         first = i
-         do while (i <= len(text))
-            if (scan(text(i:i), ', ') > 0) exit
-            i = i + 1
-         end do
-         item = text(first:i - 1)
+      pos = 1
+      do
+         call next_item(text, pos, first, last)
+         if (first == 0) exit
+         item = text(first:last)
          star = index(item, '*')
          r = 1
          if (star > 1) then
