@@ -113,8 +113,11 @@ contains
 
    !> The records' columns, in one pass over their rows. Picking each series out of the rows
    !> (nine passes, each a copy with a stride of 64 bytes) took the writer thread 17-20 ms of the
-   !> Figure 4 run, and the time loop on the other CPU ran 3-4 ns a step slower meanwhile (the
-   !> least and median of 20 alternated runs, with the disk space reserved in both).
+   !> Figure 4 run, and the time loop on the other CPU read 3-4 ns a step slower meanwhile (the
+   !> least and median of 20 alternated runs, with the disk space reserved in both). A later
+   !> prototype without any pick-out (the rows written as they are, timing only) left the loop and
+   !> the process's CPU time where they were: the memory reads move to pwrite's copy
+   !> (docs/performance_notes.md, "The writer thread on the loop's CPU").
    subroutine to_columns(order)
       type(write_order), intent(inout) :: order
       integer :: r
