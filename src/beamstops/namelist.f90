@@ -32,6 +32,8 @@ module beamstops_namelist
    real(wp), parameter :: unset = -huge(1.0_wp)
    integer, parameter :: unset_node = -huge(1)
    integer, parameter :: text_len = 4096
+   !> Length of the variables of the word keys (law, mass, load_rule, start).
+   integer, parameter :: word_len = 64
 
 contains
 
@@ -131,7 +133,7 @@ contains
       ! &stops: lower, upper one value (the tip) or one per stop along the span (nodes or x)
       real(wp) :: lower(max_stops), upper(max_stops), x(max_stops), stiffness, stiffness_per_mass
       integer :: nodes(max_stops)
-      character(len=64) :: law, mass
+      character(len=word_len) :: law, mass
       real(wp) :: restitution
       ! &damping: Rayleigh coefficients, or ratios at two modes
       real(wp) :: mass_coefficient, stiffness_coefficient, ratio(2)
@@ -144,7 +146,7 @@ contains
       integer :: elements, mesh_modes
       ! &time
       real(wp) :: dt, t_end, beta
-      character(len=64) :: load_rule, start
+      character(len=word_len) :: load_rule, start
       logical :: allow_unstable
       ! &output
       character(len=text_len) :: file
@@ -443,7 +445,8 @@ contains
          do i = 1, size(starts)
             key = key_at(body, starts(i))
             j = starts(i) + len(key)
-            j = j - 1 + verify(body(j:)//'=', ' ')
+            if (verify(body(j:), ' ') == 0) cycle
+            j = j - 1 + verify(body(j:), ' ')
             if (body(j:j) /= '=') cycle
             last = len(body)
             if (i < size(starts)) last = starts(i + 1) - 1
@@ -452,6 +455,18 @@ contains
                   & key//' = '//value_kind(key))
                return
             end if
+            ! a text longer than its variable: gfortran would keep its start without a word (a
+            ! path of 5,000 characters became another one of 4,096)
+            if (value_kind(key) == "a quoted text, e.g. 'name'") then
+               if (text_length(body(j + 1:last)) > text_capacity(key)) then
+                  call fatal_error(error, source//': &'//trim(group_names(g))//' '//key//' is '// &
+                     & itoa(text_length(body(j + 1:last)))//' characters long, out of range; allowed: at most '// &
+                     & itoa(text_capacity(key))//' characters')
+                  return
+               end if
+            end if
+            ! (an unknown key is told by the read; `seen` holds the group's keys at most once)
+            if (.not. known_key(g, key)) cycle
             if (index(seen, ' '//key//' ') > 0) then
                call fatal_error(error, source//': &'//trim(group_names(g))//' '//key// &
                   & ' is given twice; allowed: each key once in a group')
@@ -801,8 +816,11 @@ contains
       character(len=*), intent(in) :: body
       integer, intent(in) :: start
       character(len=:), allocatable :: key
-      key = lower(body(start:start - 2 + verify(body(start:)//'=', &
-         & 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_')))
+      integer :: past
+      ! (not verify(body(start:)//'=', ...): a copy of the rest of the body for every key)
+      past = verify(body(start:), 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_')
+      if (past == 0) past = len(body) - start + 2
+      key = lower(body(start:start + past - 2))
    end function key_at
 
    !> &mesh: elements and modes (a scope of its own: &damping has a key `modes` too).
@@ -832,6 +850,38 @@ contains
       known_key = index(', '//trim(group_keys(g))//',', ', '//key//',') > 0
    end function known_key
 
+   !> The characters a text key holds: a path for &output file, a word for the others.
+   pure integer function text_capacity(key)
+      character(len=*), intent(in) :: key
+      text_capacity = merge(text_len, word_len, key == 'file') - 1
+   end function text_capacity
+
+   !> The length of a text value as gfortran reads it: between its quotes ('' or "" inside
+   !> counting one), or up to a blank, comma or / when it has none.
+   pure integer function text_length(value)
+      character(len=*), intent(in) :: value
+      integer :: first, i
+      character :: quote
+      first = verify(value, ' ')
+      text_length = 0
+      if (first == 0) return
+      quote = value(first:first)
+      if (quote /= "'" .and. quote /= '"') then
+         text_length = scan(value(first:)//' ', ' ,/') - 1
+         return
+      end if
+      i = first + 1
+      do while (i <= len(value))
+         if (value(i:i) == quote) then
+            if (i == len(value)) exit
+            if (value(i + 1:i + 1) /= quote) exit
+            i = i + 1
+         end if
+         text_length = text_length + 1
+         i = i + 1
+      end do
+   end function text_length
+
    !> The kind of value a key takes, for messages.
    function value_kind(key) result(kind)
       character(len=*), intent(in) :: key
@@ -859,8 +909,7 @@ contains
    !> The text of a group in `cleaned` after its name, up to its closing / (outside quotes).
    function group_body(cleaned, name) result(body)
       character(len=*), intent(in) :: cleaned, name
-      character(len=:), allocatable :: body
-      character(len=len(cleaned)) :: low
+      character(len=:), allocatable :: body, low
       integer :: start, i
       logical :: quoted
       character :: quote
@@ -894,11 +943,13 @@ contains
    !> Where each `key = ` (or `key(i) = `) of a group's body starts, outside quotes.
    function assignment_starts(body) result(starts)
       character(len=*), intent(in) :: body
-      integer, allocatable :: starts(:)
-      integer :: i, j
+      integer, allocatable :: starts(:), found(:)
+      integer :: i, j, count
       logical :: quoted
       character :: quote
-      allocate (starts(0))
+      ! grown by doubling: one element at a time, 200,000 assignments took 3 s
+      allocate (found(16))
+      count = 0
       quoted = .false.
       quote = ' '
       do i = 1, len(body)
@@ -930,8 +981,13 @@ contains
             if (scan(body(j:j), 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_') == 0) exit
             j = j - 1
          end do
-         if (j + 1 <= i - 1) starts = [starts, j + 1]
+         if (j + 1 <= i - 1) then
+            if (count == size(found)) found = [found, found]
+            count = count + 1
+            found(count) = j + 1
+         end if
       end do
+      starts = found(:count)
    end function assignment_starts
 
    !> The stops of &stops: without nodes or x, lower and upper (one value each) are the tip stops;
@@ -1133,13 +1189,18 @@ contains
       character(len=*), intent(out) :: texts(:)
       character(len=:), allocatable, intent(out) :: cleaned
       type(error_type), allocatable, intent(out) :: error
-      character(len=:), allocatable :: line, name
-      integer :: i, j, g, current, line_no, used(size(present)), first, last
+      character(len=:), allocatable :: line, name, joined
+      integer :: i, j, g, current, line_no, used(size(present)), first, last, filled
       logical :: quoted
       character :: quote
       present = .false.
       texts = ''
       used = 0
+      ! the lines joined into one buffer (a line and its blank take no more than the line and its
+      ! newline): appended line after line to a growing string, a text of 200,000 short lines
+      ! took 31 s
+      allocate (character(len=len(text) + 1) :: joined)
+      filled = 0
       cleaned = ''
       current = 0
       ! Binary characters anywhere (an HDF5 output or an image given for the namelist) are told
@@ -1177,7 +1238,7 @@ contains
                quoted = .true.
                quote = line(i:i)
             else if (line(i:i) == '!') then
-               cleaned = cleaned//line(:i - 1)//' '
+               call join(line(:i - 1))
                exit
             else if (line(i:i) == '/' .and. current > 0) then
                call append_text(current, '/')
@@ -1225,9 +1286,10 @@ contains
             if (current > 0) call append_text(current, line(i:i))
             i = i + 1
          end do
-         if (i > len_trim(line)) cleaned = cleaned//trim(line)//' '
+         if (i > len_trim(line)) call join(trim(line))
          if (current > 0) call append_text(current, ' ')
       end do
+      cleaned = joined(:filled)
       if (current > 0) then
          call fatal_error(error, source//': group &'//trim(group_names(current))//' is not closed by / '// &
             & '(the text ends inside it); allowed: each group ends with / (e.g. `&time dt = 1e-5 /`)')
@@ -1246,6 +1308,13 @@ contains
             & trim(adjustl(line(:min(len(line), 200))))//'`; allowed outside groups: blanks and comments '// &
             & 'after ! (a group starts with &name, e.g. `&time dt = 1e-5 /`)')
       end subroutine outside
+
+      !> Append a line (without its comment) and a blank to the joined text.
+      subroutine join(piece)
+         character(len=*), intent(in) :: piece
+         joined(filled + 1:filled + len(piece) + 1) = piece//' '
+         filled = filled + len(piece) + 1
+      end subroutine join
 
       !> Append to a group's text (kept short for messages; runs of blanks folded).
       subroutine append_text(g, piece)

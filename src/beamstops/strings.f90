@@ -147,7 +147,9 @@ contains
    pure function lower(s) result(t)
       !> Text.
       character(len=*), intent(in) :: s
-      character(len=len(s)) :: t
+      ! allocatable: on the heap (a result of the text's length on the stack overflowed it for a
+      ! namelist file of 16 MB)
+      character(len=:), allocatable :: t
       integer :: i
       t = s
       do i = 1, len(s)

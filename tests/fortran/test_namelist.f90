@@ -58,7 +58,9 @@ contains
          & test_tiny_time_step), &
          & new_unittest('a dt refused for stability is beyond the limit as shown', test_stability_limit_shown), &
          & new_unittest('both springs of the compliance law are told as both given', test_two_springs), &
-         & new_unittest('a FIFO is read to its end and gives no output name', test_fifo) &
+         & new_unittest('a FIFO is read to its end and gives no output name', test_fifo), &
+         & new_unittest('a path or a word longer than its key holds is out of range, not cut short', test_long_texts), &
+         & new_unittest('a text of 16 MB: 2,000,000 assignments or list values, each told at once', test_huge_texts) &
          & ]
    end subroutine collect_namelist
 
@@ -508,6 +510,63 @@ contains
       call expect_error('many.nml', [character(len=ll) :: '&damping ratio = 0.1, 0.2, 0.3 /'], &
          & [character(len=64) :: '&damping ratio has 3 values, out of range', 'at most two values'], error)
    end subroutine test_too_many_values
+
+   !> gfortran keeps the start of a text longer than its variable without a word: a path of
+   !> 5,000 characters was read as its first 4,096, a word padded past 64 characters as the word.
+   subroutine test_long_texts(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(error_type), allocatable :: failure
+      call scene_from_text("&output file = '"//repeat('b', 5000)//".h5' /", 'long', scene, failure)
+      call check(error, allocated(failure), 'a path of 5,003 characters refused')
+      if (allocated(error)) return
+      call check(error, index(failure%message, '&output file is 5003 characters long, out of range; allowed: at most '// &
+         & '4095 characters') > 0, failure%message(:min(200, len(failure%message))))
+      if (allocated(error)) return
+      deallocate (failure)
+      call scene_from_text("&time load_rule = 'paper"//repeat(' ', 70)//"x' /", 'padded', scene, failure)
+      call check(error, allocated(failure), 'a word padded past its 64 characters refused')
+      if (allocated(error)) return
+      call check(error, index(failure%message, '&time load_rule is 76 characters long, out of range; allowed: at most '// &
+         & '63 characters') > 0, failure%message)
+      if (allocated(error)) return
+      deallocate (failure)
+      ! at the limit: read whole (a quote doubled inside counts one)
+      call scene_from_text("&output file = '"//repeat('c', 4090)//"''s.h5' /", 'limit', scene, failure)
+      call check(error, .not. allocated(failure), 'a path of 4,095 characters read')
+      if (allocated(error)) return
+      call check(error, len(scene%output_file), 4095, 'the whole path kept')
+   end subroutine test_long_texts
+
+   !> Texts far larger than any scene (the reader takes up to 64 MB): each is refused with its
+   !> message rather than a crash (a line of 16 MB overflowed the stack) or minutes of copying
+   !> (the lines and the assignments were gathered one by one into growing strings).
+   subroutine test_huge_texts(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: many = 2000000
+      type(scene_type) :: scene
+      type(error_type), allocatable :: failure
+      character(len=:), allocatable :: text
+      text = '&time '//repeat('dt=1e-5 ', many)//'/'
+      call scene_from_text(text, 'keys', scene, failure)
+      call check(error, allocated(failure), 'dt given 2,000,000 times refused')
+      if (allocated(error)) return
+      call check(error, index(failure%message, '&time dt is given twice') > 0, failure%message)
+      if (allocated(error)) return
+      deallocate (failure)
+      text = '&stops nodes = '//repeat('5,'//new_line('a'), many)//'/'
+      call scene_from_text(text, 'lines', scene, failure)
+      call check(error, allocated(failure), '2,000,000 nodes on as many lines refused')
+      if (allocated(error)) return
+      call check(error, index(failure%message, '&stops nodes has 2000000 values, out of range') > 0, failure%message)
+      if (allocated(error)) return
+      deallocate (failure)
+      text = '&time '//repeat('dt0=1e-5 ', many/10)//'/'
+      call scene_from_text(text, 'unknown', scene, failure)
+      call check(error, allocated(failure), '200,000 unknown keys refused')
+      if (allocated(error)) return
+      call check(error, index(failure%message, '&time: unknown key dt0') > 0, failure%message)
+   end subroutine test_huge_texts
 
    !> A malformed logical left gfortran's reader in a state where the next text's &stops was
    !> not read: law = 'glue' was then accepted as 'signorini'.
