@@ -11,7 +11,7 @@ module beamstops_scene
    public :: scene_type, validate_scene, steps_of, record_count, snapshot_count, output_bytes
    public :: tube_section, tube_beam, fmt_real, fmt_int
    public :: law_none, law_signorini, law_compliance, law_name, law_code
-   public :: max_elements, max_stops, stop_count, scene_table, canonical_text
+   public :: max_elements, max_stops, max_members, stop_count, scene_table, canonical_text
    public :: min_stiffness_per_mass, max_stiffness_per_mass, k2_range, mass_per_length_range
 
    !> Contact law codes.
@@ -20,6 +20,12 @@ module beamstops_scene
    integer, parameter :: max_elements = 1000000
    !> Most stops along the span (&stops nodes or x).
    integer, parameter :: max_stops = 1000
+   !> Most members of an ensemble (&ensemble members).
+   integer, parameter :: max_members = 10000
+   !> Most memory an ensemble's members may take together (GB): each keeps its statistics (bins
+   !> x batches values of its histograms) and its state (about 16 values an unknown in lockstep).
+   !> Beyond it the allocations failed with a backtrace, or succeeded and filled the machine.
+   real(wp), parameter :: max_ensemble_gb = 16
    !> Range of the compliance spring per unit mass (1/s^2); &stops stiffness (N/m) is told in it
    !> times mass_per_length.
    real(wp), parameter :: min_stiffness_per_mass = 1.0e-12_wp, max_stiffness_per_mass = 1.0e20_wp
@@ -396,8 +402,24 @@ contains
          call say('output', 'max_output_gb', fmt_real(scene%max_output_gb), '0 < max_output_gb <= 1e+06 (GB)'); return
       end if
       call output_fits(); if (allocated(error)) return
+      call ensemble_fits(); if (allocated(error)) return
 
    contains
+
+      !> Refuse an ensemble whose members' tables would not fit in max_ensemble_gb of memory,
+      !> saying how many members would.
+      subroutine ensemble_fits()
+         real(wp) :: member_bytes
+         if (scene%members < 2 .or. scene%members > max_members) return
+         member_bytes = 8*(real(scene%bins, wp)*real(scene%batches, wp) + 16*2*real(scene%elements, wp))
+         if (member_bytes*scene%members <= max_ensemble_gb*1.0e9_wp) return
+         call say('ensemble', 'members', fmt_int(int(scene%members, ik)), 'members <= '// &
+            & fmt_int(int(max_ensemble_gb*1.0e9_wp/member_bytes, ik))//' for this scene: the members take '// &
+            & fmt_real(member_bytes*scene%members/1.0e9_wp, 5)//' GB of memory together, 8 bytes x members x '// &
+            & '(bins x batches + 16 x 2 elements) with bins = '//fmt_int(int(scene%bins, ik))//', batches = '// &
+            & fmt_int(int(scene%batches, ik))//', elements = '//fmt_int(int(scene%elements, ik))//'; at most '// &
+            & fmt_real(max_ensemble_gb)//' GB')
+      end subroutine ensemble_fits
 
       !> The stops along the span: as many bounds as nodes, nodes distinct in 1..J, lower < 0 < upper,
       !> and the Signorini law (or none); the compliance spring is at the tip only.

@@ -142,6 +142,14 @@ def test_ensembles_identical_members_and_decorrelated_members(physics: dict[str,
     ("&statistics batches = 100000000 /", "&statistics batches = 100000000 is out of range; allowed: 2 <= batches <= 1000"),
     ("&statistics bins = 2000000000 /", "&statistics bins = 2000000000 is out of range; allowed: 1 <= bins <= 1000000"),
     ("&ensemble members = 2000000000 /", "&ensemble members = 2000000000 is out of range; allowed: 1 <= members <= 10000"),
+    # members whose tables together pass 16 GB (8 bytes x members x (bins x batches + 16 x 2 elements)):
+    # allocated one by one they filled the machine, or failed with a backtrace
+    ("&ensemble members = 1000 /\n&statistics bins = 10000, batches = 1000 /",
+     f"&ensemble members = 1000 is out of range; allowed: members <= {int(16e9 // (8 * (10000 * 1000 + 32 * 19)))} "
+     "for this scene"),
+    ("&ensemble members = 10000 /\n&mesh elements = 1000000 /\n&time dt = 1e-15, t_end = 1e-14 /",
+     f"&ensemble members = 10000 is out of range; allowed: members <= {int(16e9 // (8 * (40 * 20 + 32 * 10**6)))} "
+     "for this scene"),
 ])
 def test_bad_statistics_inputs(text: str, needle: str, tmp_path: Path) -> None:
     path = tmp_path / "bad.nml"

@@ -38,7 +38,7 @@ module beamstops_observe_statistics
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite, ieee_is_nan
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
-   use beamstops_scene, only: fmt_real, fmt_int
+   use beamstops_scene, only: fmt_real, fmt_int, max_members
    use beamstops_observe_pack, only: put, take_header, take_real, take_reals, take_int, take_ik, take_iks
    use beamstops_observe_shocks, only: shock_row
    implicit none
@@ -146,10 +146,10 @@ module beamstops_observe_statistics
       procedure, private :: new_run
    end type statistics_type
 
-   !> Largest numbers of batches, of histogram bins, of both together (every batch keeps its
-   !> histogram) and of members of an ensemble: beyond them the tables did not fit in memory (a
-   !> failed allocation ended the program with a backtrace).
-   integer, parameter :: max_batches = 1000, max_bins = 1000000, max_members = 10000
+   !> Largest numbers of batches, of histogram bins and of both together (every batch keeps its
+   !> histogram; the members of an ensemble: beamstops_scene's max_members): beyond them the
+   !> tables did not fit in memory (a failed allocation ended the program with a backtrace).
+   integer, parameter :: max_batches = 1000, max_bins = 1000000
    integer(ik), parameter :: max_batch_bins = 10000000_ik
    !> Longest rest time (s): the longest run (t_end <= 1e9 s); beyond it every contact phase of
    !> a stop is one shock anyway.
