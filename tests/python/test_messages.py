@@ -1,0 +1,35 @@
+"""Every refusal is one line: a control character in what a message quotes (a file name with a
+newline or a tab, a key's text) is written as an escape, in the program and in Python alike."""
+
+from __future__ import annotations
+
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from beamstops import Scene
+
+
+def test_a_file_name_with_a_newline_is_told_on_one_line(program: str, tmp_path: Path) -> None:
+    bad = tmp_path / "bad\nname.nml"
+    bad.write_text("&time dt = -1 /\n")
+    done = subprocess.run([program, "run", bad.name], cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    assert done.returncode == 1 and done.stdout == ""
+    assert done.stderr.count("\n") == 1, done.stderr
+    assert done.stderr.startswith("beamstops: error: bad\\nname.nml: &time dt = -1 is out of range")
+
+
+def test_an_output_name_with_control_characters_is_told_on_one_line(program: str, tmp_path: Path) -> None:
+    (tmp_path / "scene.nml").write_text("&time dt = 1e-4, t_end = 1e-3 /\n")
+    done = subprocess.run([program, "run", "scene.nml", "-o", "no\tsuch\r/dir\n/out.h5"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode != 0 and done.stderr.count("\n") == 1, done.stderr
+    assert "no\\tsuch\\r/dir\\n/out.h5" in done.stderr
+
+
+def test_python_raises_the_same_one_line_message() -> None:
+    with pytest.raises(ValueError) as caught:
+        Scene.from_text("&output file = 'a\x01b.h5' /\n&time dt = -1 /\n", source="scene\nfrom text")
+    message = str(caught.value)
+    assert "\n" not in message and "\x01" not in message
