@@ -456,6 +456,28 @@ def test_an_image_never_overwrites_an_hdf5_file(output: Path, tmp_path: Path, re
     assert output.read_bytes() == data
 
 
+def test_an_image_overwrites_only_an_image(output: Path, tmp_path: Path, result: beamstops.Result) -> None:
+    """A text, a namelist or a table at -o is refused and left as it was (the plot had replaced
+    it); a plot drawn before, of any format, and an empty file are written over."""
+    precious = {"notes.png": b"precious notes\n", "scene.pdf": b"&time dt = 1e-5 /\n", "table.svg": b"t,u\n0,1\n"}
+    for name, content in precious.items():
+        (tmp_path / name).write_bytes(content)
+        done = plot_command(str(output), "-o", name, cwd=tmp_path)
+        assert done.returncode == 1 and done.stdout == "", done.stderr
+        assert done.stderr.strip() == (f"beamstops: error: {name}: exists and is not an image (not PNG, PDF, SVG, "
+                                       "PostScript, JPEG, GIF, TIFF, WebP or MP4); refusing to overwrite it with an "
+                                       "image; name another file or remove it")
+        assert (tmp_path / name).read_bytes() == content
+    for name in ("again.png", "again.pdf", "again.svg"):
+        assert plot_command(str(output), "-o", name, cwd=tmp_path).returncode == 0
+        first = (tmp_path / name).stat().st_mtime_ns
+        assert plot_command(str(output), "-o", name, "--kind", "energy", cwd=tmp_path).returncode == 0
+        assert (tmp_path / name).stat().st_mtime_ns >= first
+    (tmp_path / "empty.png").write_bytes(b"")
+    plots.save(result, tmp_path / "empty.png", kind="energy")
+    assert (tmp_path / "empty.png").read_bytes()[:8] == PNG
+
+
 @pytest.mark.parametrize("dpi", ["0", "-5", "100000", "abc"])
 def test_a_resolution_out_of_range_is_refused_by_the_command_line(dpi: str, output: Path, tmp_path: Path) -> None:
     """--dpi 100000 ended in a MemoryError traceback from the renderer; 0 in matplotlib's words."""

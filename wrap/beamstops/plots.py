@@ -357,15 +357,34 @@ def save(result: Result, path: str | os.PathLike[str], kind: str = "tip", dpi: i
 #: The first bytes of an HDF5 file.
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
+#: The first bytes of the images and animations matplotlib writes: what an existing file must
+#: start with to be written over (PostScript, PNG, PDF, JPEG, GIF, TIFF, WebP, MP4; SVG, text,
+#: is told apart by its first tag).
+_IMAGE_SIGNATURES = (b"%!PS", b"\x89PNG\r\n\x1a\n", b"%PDF", b"\xff\xd8\xff", b"GIF87a", b"GIF89a", b"II*\x00",
+                     b"MM\x00*", b"\xc5\xd0\xd3\xc6")
+
+
+def _is_image(head: bytes) -> bool:
+    if head.startswith(_IMAGE_SIGNATURES) or (head[:4] == b"RIFF" and head[8:12] == b"WEBP") or head[4:8] == b"ftyp":
+        return True
+    text = head.lstrip(b"\xef\xbb\xbf \t\r\n")
+    return text.startswith((b"<?xml", b"<svg", b"<!DOCTYPE svg"))
+
 
 def refuse_data_file(path: Path) -> None:
-    """Refuse to write an image over an HDF5 file (a run's output, the very file plotted under
-    another name or a link): FileExistsError naming it."""
+    """Refuse to write an image over a file that is not an image: an HDF5 file (a run's output,
+    the very file plotted under another name or a link) or anything else (a text, a namelist, a
+    table): FileExistsError naming it. An empty file or an image (a plot drawn before) is
+    written over."""
     try:
         with open(path, "rb") as f:
-            head = f.read(len(_HDF5_SIGNATURE))
+            head = f.read(64)
     except OSError:
         return  # not there (or unreadable): savefig says what is wrong when it writes
-    if head == _HDF5_SIGNATURE:
+    if head.startswith(_HDF5_SIGNATURE):
         raise FileExistsError(f"{path}: exists and is an HDF5 file (a run's output?); refusing to overwrite it "
                               f"with an image; name another file")
+    if head and not _is_image(head):
+        raise FileExistsError(f"{path}: exists and is not an image (not PNG, PDF, SVG, PostScript, JPEG, GIF, "
+                              f"TIFF, WebP or MP4); refusing to overwrite it with an image; name another file or "
+                              f"remove it")
