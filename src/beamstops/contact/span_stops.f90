@@ -24,7 +24,8 @@
 !> work the moving support does through the stops, -1/2 sum r_i h_i (phi^{n+1} - phi^{n-1}),
 !> counted with the work of the load. Both vanish at the tip's h = 0 but for D^n.
 module beamstops_contact_span_stops
-   use beamstops_kinds, only: wp
+   use beamstops_kinds, only: wp, ik
+   use beamstops_strings, only: fmt_real, fmt_int
    use beamstops_error, only: error_type, fatal_error
    use beamstops_band, only: cholesky_solve
    use beamstops_band_solve, only: band_solver, fused_solve
@@ -124,7 +125,10 @@ contains
       self%upper = upper
       allocate (self%z(n, m), self%c(m, m), stat=stat)
       if (stat /= 0) then
-         call fatal_error(error, 'not enough memory for the columns A^-1 P of the stops along the span')
+         call fatal_error(error, 'not enough memory for the columns A^-1 P of the stops along the span: '// &
+            & fmt_int(int(m, ik))//' stops x '//fmt_int(int(n, ik))//' unknowns, '// &
+            & fmt_real(8*real(m, wp)*real(n, wp)/1.0e9_wp, 4)//' GB (&stops nodes or x, &mesh elements); allowed: '// &
+            & 'fewer stops or elements')
          return
       end if
       do j = 1, m
