@@ -432,8 +432,9 @@ contains
 
       !> The assignments of group g, before gfortran reads it: a key given twice (`key = ...` both
       !> times; the elements of an array, `key(i) =`, may each be given once), where gfortran would
-      !> let the last one win unsaid, and a key given no value (`dt = /`, `dt = , beta = 0.5`), where
-      !> gfortran would keep the default unsaid, are refused.
+      !> let the last one win unsaid, a key given no value (`dt = /`, `dt = , beta = 0.5`), where
+      !> gfortran would keep the default unsaid, and a logical other than the forms logical_text
+      !> names, which gfortran reads by its first letter, are refused.
       subroutine check_assignments(g)
          integer, intent(in) :: g
          character(len=:), allocatable :: body, key, seen
@@ -467,6 +468,16 @@ contains
             end if
             ! (an unknown key is told by the read; `seen` holds the group's keys at most once)
             if (.not. known_key(g, key)) cycle
+            ! a logical is one of the forms a user means: gfortran reads the first letter of any
+            ! word (`allow_unstable = trash` was .true., `enabled = fish` .false.)
+            if (value_kind(key) == '.true. or .false.') then
+               if (.not. logical_text(body(j + 1:last))) then
+                  call fatal_error(error, source//': &'//trim(group_names(g))//' '// &
+                     & assignment_text(body(starts(i):min(last, starts(i) + 120)))//' is malformed; allowed: '// &
+                     & key//' = '//value_kind(key))
+                  return
+               end if
+            end if
             if (index(seen, ' '//key//' ') > 0) then
                call fatal_error(error, source//': &'//trim(group_names(g))//' '//key// &
                   & ' is given twice; allowed: each key once in a group')
@@ -571,13 +582,6 @@ contains
                end if
             end if
             call read_group(g, '&'//trim(group_names(g))//' '//body(starts(i):last)//' /', one_stat, one_msg)
-            ! A logical is T or F, with an optional leading dot (gfortran reads `3,` alone without a word).
-            if (value_kind(key) == '.true. or .false.' .and. .not. logical_text(value)) then
-               call fatal_error(error, source//': &'//trim(group_names(g))//' '// &
-                  & assignment_text(body(starts(i):min(last, starts(i) + 120)))//' is malformed; allowed: '//key// &
-                  & ' = '//value_kind(key))
-               return
-            end if
             ! (gfortran may read alone what it refuses in the group: then a lone assignment is the culprit)
             if (one_stat == 0 .and. size(starts) > 1) cycle
             if (index(one_msg, 'Cannot match namelist object name') > 0 .and. .not. known_key(g, key)) then
@@ -799,16 +803,18 @@ contains
       end do
    end function value_count
 
-   !> Whether the value text of a logical key starts as a logical does: T or F, after an optional dot.
+   !> Whether the value text of a logical key is a logical as a user means it: .true., .false.,
+   !> T, F, .t., .f., true or false, in any case (blanks and a trailing comma aside). gfortran
+   !> reads any word by its first letter after an optional dot (`trash` is .true., `.false.xyz`
+   !> .false.); the reader refuses every other word.
    pure logical function logical_text(text)
+      !> Value text of the assignment.
       character(len=*), intent(in) :: text
+      character(len=*), parameter :: forms(8) = [character(len=7) :: '.true.', '.false.', 't', 'f', '.t.', '.f.', &
+         & 'true', 'false']
       character(len=:), allocatable :: v
-      v = adjustl(text)
-      if (len_trim(v) > 0) then
-         if (v(1:1) == '.') v = v(2:)
-      end if
-      logical_text = .false.
-      if (len(v) > 0) logical_text = scan(v(1:1), 'tTfF') > 0
+      v = lower(assignment_text(text))
+      logical_text = len(v) > 0 .and. len(v) <= len(forms) .and. any(forms == v)
    end function logical_text
 
    !> The key (lower case) that starts at position `start` of a group's body.

@@ -60,7 +60,9 @@ contains
          & new_unittest('both springs of the compliance law are told as both given', test_two_springs), &
          & new_unittest('a FIFO is read to its end and gives no output name', test_fifo), &
          & new_unittest('a path or a word longer than its key holds is out of range, not cut short', test_long_texts), &
-         & new_unittest('a text of 16 MB: 2,000,000 assignments or list values, each told at once', test_huge_texts) &
+         & new_unittest('a text of 16 MB: 2,000,000 assignments or list values, each told at once', test_huge_texts), &
+         & new_unittest('a logical is one of the forms a user means, not any word by its first letter', &
+         & test_logical_forms) &
          & ]
    end subroutine collect_namelist
 
@@ -796,4 +798,36 @@ contains
       if (allocated(error)) return
       call check(error, scene%output_file == 'named.h5', 'named.nml gives named.h5, got '//scene%output_file)
    end subroutine test_fifo
+   !> gfortran reads a logical by the first letter of any word: `allow_unstable = trash` was
+   !> .true. (the stability refusal turned off), `enabled = fish` .false.. Only .true., .false.,
+   !> T, F, .t., .f., true and false (any case) are read; every other word is malformed.
+   subroutine test_logical_forms(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: bad(6) = [character(len=48) :: '&time allow_unstable=trash /', &
+         & '&statistics enabled=Tuesday /', '&statistics enabled=fish /', '&statistics enabled=.frobnicate. /', &
+         & '&statistics enabled=.false.xyz /', '&time allow_unstable = .t, dt = 1e-5 /']
+      character(len=*), parameter :: shown(6) = [character(len=32) :: 'allow_unstable=trash', 'enabled=Tuesday', &
+         & 'enabled=fish', 'enabled=.frobnicate.', 'enabled=.false.xyz', 'allow_unstable = .t']
+      character(len=*), parameter :: keys(6) = [character(len=14) :: 'allow_unstable', 'enabled', 'enabled', &
+         & 'enabled', 'enabled', 'allow_unstable']
+      character(len=*), parameter :: good(8) = [character(len=8) :: '.true.', '.FALSE.', 'T', 'f', '.t.', '.F.', &
+         & 'True', 'false']
+      type(scene_type) :: scene
+      character(len=64) :: needles(3)
+      integer :: i
+      do i = 1, size(bad)
+         needles(1) = trim(shown(i))//' is malformed'
+         needles(2) = 'allowed: '//trim(keys(i))//' ='
+         needles(3) = '.true. or .false.'
+         call expect_text_error(trim(bad(i)), needles, error)
+         if (allocated(error)) return
+      end do
+      do i = 1, size(good)
+         call scene_from_text('&statistics enabled = '//trim(good(i))//' /', 'in.nml', scene, error)
+         if (allocated(error)) return
+         call check(error, scene%statistics .eqv. scan(good(i)(1:2), 'tT') > 0, 'enabled = '//trim(good(i)))
+         if (allocated(error)) return
+      end do
+   end subroutine test_logical_forms
+
 end module test_namelist
