@@ -437,9 +437,9 @@ contains
       !> names, which gfortran reads by its first letter, are refused.
       subroutine check_assignments(g)
          integer, intent(in) :: g
-         character(len=:), allocatable :: body, key, seen
+         character(len=:), allocatable :: body, key, seen, subscript
          integer, allocatable :: starts(:)
-         integer :: i, j, last
+         integer :: i, j, last, close
          body = group_body(cleaned, trim(group_names(g)))
          starts = assignment_starts(body)
          seen = ' '
@@ -448,12 +448,32 @@ contains
             j = starts(i) + len(key)
             if (verify(body(j:), ' ') == 0) cycle
             j = j - 1 + verify(body(j:), ' ')
+            ! an element or a section, `key(i) =`, `key(i:j) =`
+            subscript = ''
+            if (body(j:j) == '(') then
+               close = index(body(j:), ')')
+               if (close == 0) cycle
+               subscript = body(j:j + close - 1)
+               j = j + close
+               if (verify(body(j:), ' ') == 0) cycle
+               j = j - 1 + verify(body(j:), ' ')
+            end if
             if (body(j:j) /= '=') cycle
             last = len(body)
             if (i < size(starts)) last = starts(i + 1) - 1
             if (verify(body(j + 1:last), ' ,'//new_line('a')//achar(9)) == 0) then
-               call fatal_error(error, source//': &'//trim(group_names(g))//' '//key//' has no value; allowed: '// &
-                  & key//' = '//value_kind(key))
+               call fatal_error(error, source//': &'//trim(group_names(g))//' '//key//subscript//' has no value; '// &
+                  & 'allowed: '//key//' = '//value_kind(key, g))
+               return
+            end if
+            ! (an unknown key is told by the read)
+            if (.not. known_key(g, key)) cycle
+            ! a null value (`nodes = 2*`, `5,, 10`, `modes = , 3`): gfortran would leave the element
+            ! as it was, without a word (`nodes = 2*` read as no stops along the span)
+            if (has_null(body(j + 1:last))) then
+               call fatal_error(error, source//': &'//trim(group_names(g))//' '// &
+                  & trim(adjustl(body(starts(i):min(last, starts(i) + 120))))//' has an empty value (r* with no '// &
+                  & 'value after it, or nothing before a comma); allowed: '//key//' = '//value_kind(key, g))
                return
             end if
             ! a text longer than its variable: gfortran would keep its start without a word (a
@@ -466,8 +486,6 @@ contains
                   return
                end if
             end if
-            ! (an unknown key is told by the read; `seen` holds the group's keys at most once)
-            if (.not. known_key(g, key)) cycle
             ! a logical is one of the forms a user means: gfortran reads the first letter of any
             ! word (`allow_unstable = trash` was .true., `enabled = fish` .false.)
             if (value_kind(key) == '.true. or .false.') then
@@ -593,7 +611,7 @@ contains
                   & assignment_text(body(starts(i):min(last, starts(i) + 120)))//' is out of range; allowed: '// &
                   & list_range(trim(group_names(g)), key, index(cleaned, body) + starts(i) - 1, &
                   & index(cleaned, body) + last - 1, value))
-            else if (value_kind(key) == 'a whole number' .and. whole_number_text(value)) then
+            else if (value_kind(key, g) == 'a whole number' .and. whole_number_text(value)) then
                ! a whole number too large for the key's integer kind: out of range, not malformed
                call fatal_error(error, source//': &'//trim(group_names(g))//' '// &
                   & assignment_text(body(starts(i):min(last, starts(i) + 120)))//' is out of range; allowed: '// &
@@ -601,7 +619,7 @@ contains
             else
                call fatal_error(error, source//': &'//trim(group_names(g))//' '// &
                   & assignment_text(body(starts(i):min(last, starts(i) + 120)))//' is malformed; allowed: '//key// &
-                  & ' = '//value_kind(key))
+                  & ' = '//value_kind(key, g))
             end if
             return
          end do
@@ -803,6 +821,51 @@ contains
       end do
    end function value_count
 
+   !> Whether the value text of an assignment holds a null value, one Fortran's namelist leaves
+   !> as it was: an `r*` with nothing after the star, nothing (or blanks) between two commas, or
+   !> a comma before the first value. (A comma after the last value only separates it from the
+   !> next key or the /.)
+   pure logical function has_null(text)
+      !> Value text of the assignment (after its =).
+      character(len=*), intent(in) :: text
+      integer :: i, first
+      logical :: expecting, quoted
+      character :: quote
+      has_null = .true.
+      expecting = .true.
+      quote = ' '
+      i = 1
+      do while (i <= len(text))
+         if (text(i:i) == ' ' .or. text(i:i) == achar(9)) then
+            i = i + 1
+         else if (text(i:i) == ',') then
+            if (expecting) return
+            expecting = .true.
+            i = i + 1
+         else
+            ! an item: up to a blank or a comma outside quotes
+            first = i
+            quoted = .false.
+            do while (i <= len(text))
+               if (quoted) then
+                  if (text(i:i) == quote) quoted = .false.
+               else if (text(i:i) == '"' .or. text(i:i) == "'") then
+                  quoted = .true.
+                  quote = text(i:i)
+               else if (text(i:i) == ' ' .or. text(i:i) == ',' .or. text(i:i) == achar(9)) then
+                  exit
+               end if
+               i = i + 1
+            end do
+            if (i - 1 > first .and. text(i - 1:i - 1) == '*') then
+               if (verify(text(first:i - 2), '0123456789') == 0) return
+            end if
+            expecting = .false.
+         end if
+      end do
+      has_null = .false.
+   end function has_null
+
    !> Whether the value text of a logical key is a logical as a user means it: .true., .false.,
    !> T, F, .t., .f., true or false, in any case (blanks and a trailing comma aside). gfortran
    !> reads any word by its first letter after an optional dot (`trash` is .true., `.false.xyz`
@@ -889,9 +952,18 @@ contains
    end function text_length
 
    !> The kind of value a key takes, for messages.
-   function value_kind(key) result(kind)
+   function value_kind(key, group) result(kind)
+      !> Key (lower case).
       character(len=*), intent(in) :: key
+      !> Index of its group in group_names (&mesh modes is a whole number, &damping modes a list).
+      integer, intent(in), optional :: group
       character(len=:), allocatable :: kind
+      if (present(group)) then
+         if (trim(group_names(group)) == 'mesh' .and. key == 'modes') then
+            kind = 'a whole number'
+            return
+         end if
+      end if
       select case (key)
       case ('elements', 'record_every', 'snapshot_every', 'checkpoint_every', 'batches', 'bins', 'members', 'seed')
          kind = 'a whole number'

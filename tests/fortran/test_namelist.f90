@@ -62,7 +62,9 @@ contains
          & new_unittest('a path or a word longer than its key holds is out of range, not cut short', test_long_texts), &
          & new_unittest('a text of 16 MB: 2,000,000 assignments or list values, each told at once', test_huge_texts), &
          & new_unittest('a logical is one of the forms a user means, not any word by its first letter', &
-         & test_logical_forms) &
+         & test_logical_forms), &
+         & new_unittest('a null value (r* alone, nothing before a comma) is refused, not read as not given', &
+         & test_null_values) &
          & ]
    end subroutine collect_namelist
 
@@ -830,4 +832,31 @@ contains
       end do
    end subroutine test_logical_forms
 
+   !> A null value leaves its element as it was: `nodes = 2*` was read as no stops along the
+   !> span (where `nodes = /` is refused), `modes = , 3` as one mode. Every null is refused.
+   subroutine test_null_values(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: bad(7) = [character(len=64) :: '&stops nodes=2* /', &
+         & '&stops nodes=5, 10, 5*, lower=-0.1, upper=0.1 /', '&damping ratio=0.01, modes=, 3 /', &
+         & '&stops nodes=5,,10 /', '&stops nodes=5, 10, , lower=-0.1 /', '&time dt=1*, beta=0.25 /', &
+         & '&damping ratio(1)=2* /']
+      character(len=*), parameter :: shown(7) = [character(len=32) :: '&stops nodes=2*', '&stops nodes=5, 10, 5*', &
+         & '&damping modes=, 3', '&stops nodes=5,,10', '&stops nodes=5, 10, ,', '&time dt=1*', '&damping ratio(1)=2*']
+      character(len=*), parameter :: allowed(7) = [character(len=48) :: 'allowed: nodes = whole numbers', &
+         & 'allowed: nodes = whole numbers', 'allowed: modes = whole numbers', 'allowed: nodes = whole numbers', &
+         & 'allowed: nodes = whole numbers', 'allowed: dt = a real number', 'allowed: ratio = one or two real']
+      character(len=64) :: needles(3)
+      integer :: i
+      do i = 1, size(bad)
+         needles(1) = shown(i)
+         needles(2) = 'has an empty value'
+         needles(3) = allowed(i)
+         call expect_text_error(trim(bad(i)), needles, error)
+         if (allocated(error)) return
+      end do
+      ! a comma after the last value separates it from the next key or the /; a quoted comma is text
+      call expect_read('&stops nodes = 5 , 10 , lower = -0.1, upper = 0.1, / &output file = ''a,,b.h5'', /', error)
+      if (allocated(error)) return
+      call expect_read('&stops nodes = 5, 10, lower = 2*-0.1 /', error)
+   end subroutine test_null_values
 end module test_namelist

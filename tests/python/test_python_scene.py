@@ -90,7 +90,6 @@ ACCEPTED = [
     "&time dt=.5e-4, beta=.25 /",
     "&time t_end=1 dt=1e-5 /",
     "&time dt = 1e-5 ! a comment / not the end\n beta=0.3 /",
-    "&time dt=1e-5,, /",
     "&time dt=1e-5; beta=0.3 /",
     "&time dt=1e-5 /\n&end\n&beam length=2 /",
     "&time\n dt=1e-5\n&end\n&beam length=2 /",
@@ -127,6 +126,8 @@ REFUSED = [
     ("&time dtt=1e-5 /", ["&time", "dtt"]),
     ("&time dt=abc /", ["&time", "abc"]),
     ("&time dt= /", ["&time dt has no value", "allowed: dt = a real number"]),
+    # a null after the value (two commas) is an empty value, like `nodes = 2*`
+    ("&time dt=1e-5,, /", ["&time dt=1e-5,, has an empty value", "allowed: dt = a real number"]),
     ("&time dt=1.0_8 /", ["&time", "_8"]),
     ("&time dt=1e-5, 2e-5 /", ["&time", "2e-5"]),
     ("&time dt=1e-5 /\n&time dt=2e-5 /", ["&time", "twice"]),
