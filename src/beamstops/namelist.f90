@@ -430,19 +430,25 @@ contains
          end select
       end subroutine read_group
 
-      !> The assignments of group g, before gfortran reads it: a key given twice (`key = ...` both
-      !> times; the elements of an array, `key(i) =`, may each be given once), where gfortran would
-      !> let the last one win unsaid, a key given no value (`dt = /`, `dt = , beta = 0.5`), where
-      !> gfortran would keep the default unsaid, and a logical other than the forms logical_text
-      !> names, which gfortran reads by its first letter, are refused.
+      !> The assignments of group g, before gfortran reads it; refused are: a key given twice, or an
+      !> element of a list (`key = a, b`, `key(i) = a`, `key(i:j) = a, b`) given twice, where gfortran
+      !> would let the last one win unsaid (distinct elements are fine); a key given no value (`dt =
+      !> /`, `dt = , beta = 0.5`) or a null value (`nodes = 2*`, `5,, 10`), where gfortran would keep
+      !> the default unsaid; a subscript or substring on a key of one value (`load_rule(1:2) =
+      !> 'pa'` was read into the default, 'pantered'); and a logical other than the forms
+      !> logical_text names, which gfortran reads by its first letter.
       subroutine check_assignments(g)
          integer, intent(in) :: g
          character(len=:), allocatable :: body, key, seen, subscript
          integer, allocatable :: starts(:)
-         integer :: i, j, last, close
+         integer :: i, j, last, paren, slot, capacity, first, final, step, k, n, values
+         ! how each element of the group's lists was given: 0 not, 1 by `key =`, 2 by `key(...) =`
+         integer :: given_by(max_stops, 4)
+         logical :: ok
          body = group_body(cleaned, trim(group_names(g)))
          starts = assignment_starts(body)
          seen = ' '
+         given_by = 0
          do i = 1, size(starts)
             key = key_at(body, starts(i))
             j = starts(i) + len(key)
@@ -451,10 +457,10 @@ contains
             ! an element or a section, `key(i) =`, `key(i:j) =`
             subscript = ''
             if (body(j:j) == '(') then
-               close = index(body(j:), ')')
-               if (close == 0) cycle
-               subscript = body(j:j + close - 1)
-               j = j + close
+               paren = index(body(j:), ')')
+               if (paren == 0) cycle
+               subscript = body(j:j + paren - 1)
+               j = j + paren
                if (verify(body(j:), ' ') == 0) cycle
                j = j - 1 + verify(body(j:), ' ')
             end if
@@ -468,6 +474,15 @@ contains
             end if
             ! (an unknown key is told by the read)
             if (.not. known_key(g, key)) cycle
+            call list_key(trim(group_names(g)), key, slot, capacity)
+            ! a subscript on a key of one value: gfortran would read `load_rule(1:2) = 'pa'` into
+            ! the default, 'pantered'
+            if (len(subscript) > 0 .and. capacity == 0) then
+               call fatal_error(error, source//': &'//trim(group_names(g))//' '// &
+                  & assignment_text(body(starts(i):min(last, starts(i) + 120)))//' is malformed; allowed: '// &
+                  & key//' = '//value_kind(key, g))
+               return
+            end if
             ! a null value (`nodes = 2*`, `5,, 10`, `modes = , 3`): gfortran would leave the element
             ! as it was, without a word (`nodes = 2*` read as no stops along the span)
             if (has_null(body(j + 1:last))) then
@@ -496,12 +511,41 @@ contains
                   return
                end if
             end if
-            if (index(seen, ' '//key//' ') > 0) then
-               call fatal_error(error, source//': &'//trim(group_names(g))//' '//key// &
-                  & ' is given twice; allowed: each key once in a group')
-               return
+            if (capacity == 0) then
+               if (index(seen, ' '//key//' ') > 0) then
+                  call fatal_error(error, source//': &'//trim(group_names(g))//' '//key// &
+                     & ' is given twice; allowed: each key once in a group')
+                  return
+               end if
+               seen = seen//key//' '
+               cycle
             end if
-            seen = seen//key//' '
+            ! the elements of a list the assignment gives: `key =` from the first, `key(i) =` from
+            ! i on, `key(i:j:s) =` along its section; each may be given once (gfortran would let
+            ! the last win: `ratio = 0.01, 0.03, ratio(2) = 0.02` was 0.01, 0.02)
+            first = 1; final = capacity; step = 1; ok = .true.
+            if (len(subscript) > 0) call section_of(subscript, capacity, first, final, step, ok)
+            if (.not. ok) cycle
+            values = value_count(body(j + 1:last))
+            k = first
+            n = 0
+            do while (n < values .and. k >= 1 .and. k <= capacity)
+               if ((step > 0 .and. k > final) .or. (step < 0 .and. k < final)) exit
+               if (given_by(k, slot) /= 0) then
+                  if (given_by(k, slot) == 1 .and. len(subscript) == 0) then
+                     call fatal_error(error, source//': &'//trim(group_names(g))//' '//key// &
+                        & ' is given twice; allowed: each key once in a group')
+                  else
+                     call fatal_error(error, source//': &'//trim(group_names(g))//' '//key//'('//itoa(k)// &
+                        & ') is given twice; allowed: each key once in a group, each element of a list at most '// &
+                        & 'once (e.g. '//key//' = a, b or '//key//'(1) = a, '//key//'(2) = b)')
+                  end if
+                  return
+               end if
+               given_by(k, slot) = merge(1, 2, len(subscript) == 0)
+               k = k + step
+               n = n + 1
+            end do
          end do
       end subroutine check_assignments
 
@@ -820,6 +864,77 @@ contains
          count = count + r
       end do
    end function value_count
+
+   !> Where a list key of a group is kept among the group's lists (slot 1, 2, ...) and how many
+   !> values it holds (capacity); capacity 0 for a key of one value.
+   pure subroutine list_key(group, key, slot, capacity)
+      !> Group name.
+      character(len=*), intent(in) :: group
+      !> Key (lower case).
+      character(len=*), intent(in) :: key
+      !> Its list among the group's.
+      integer, intent(out) :: slot
+      !> Values it holds.
+      integer, intent(out) :: capacity
+      slot = 0
+      capacity = 0
+      select case (group)
+      case ('stops')
+         slot = findloc([character(len=5) :: 'lower', 'upper', 'nodes', 'x'], key, dim=1)
+         if (slot > 0) capacity = max_stops
+      case ('damping')
+         slot = findloc([character(len=5) :: 'ratio', 'modes'], key, dim=1)
+         if (slot > 0) capacity = 2
+      end select
+   end subroutine list_key
+
+   !> The elements of a list of `capacity` values that a subscript gives, from `first` toward
+   !> `final` by `step`: `(i)` starts a run of values at i (to the end of the list), `(i:j)` and
+   !> `(i:j:s)` a section, any part left out taking its default (1, capacity, 1). ok = .false.
+   !> when a part is not a whole number or the step is 0 (gfortran tells such a subscript).
+   subroutine section_of(subscript, capacity, first, final, step, ok)
+      !> The subscript with its parentheses.
+      character(len=*), intent(in) :: subscript
+      !> Values the list holds.
+      integer, intent(in) :: capacity
+      !> First element, the one not passed, and the step.
+      integer, intent(out) :: first, final, step
+      !> Whether the subscript is read.
+      logical, intent(out) :: ok
+      character(len=:), allocatable :: inner
+      integer :: colon, second
+      first = 1; final = capacity; step = 1
+      inner = subscript(2:len(subscript) - 1)
+      colon = index(inner, ':')
+      if (colon == 0) then
+         ok = part(inner, first)
+         return
+      end if
+      second = index(inner(colon + 1:), ':')
+      if (second == 0) then
+         ok = part(inner(:colon - 1), first) .and. part(inner(colon + 1:), final)
+      else
+         second = colon + second
+         ok = part(inner(:colon - 1), first) .and. part(inner(colon + 1:second - 1), final) .and. &
+            & part(inner(second + 1:), step)
+         ok = ok .and. step /= 0
+      end if
+
+   contains
+
+      !> A part of the subscript into `value` (kept when the part is blank); whether it is read.
+      logical function part(text, value)
+         character(len=*), intent(in) :: text
+         integer, intent(inout) :: value
+         integer :: stat
+         part = .true.
+         if (len_trim(text) == 0) return
+         part = whole_number_text(text)
+         if (.not. part) return
+         read (text, *, iostat=stat) value
+         part = stat == 0
+      end function part
+   end subroutine section_of
 
    !> Whether the value text of an assignment holds a null value, one Fortran's namelist leaves
    !> as it was: an `r*` with nothing after the star, nothing (or blanks) between two commas, or

@@ -64,7 +64,9 @@ contains
          & new_unittest('a logical is one of the forms a user means, not any word by its first letter', &
          & test_logical_forms), &
          & new_unittest('a null value (r* alone, nothing before a comma) is refused, not read as not given', &
-         & test_null_values) &
+         & test_null_values), &
+         & new_unittest('an element of a list given twice is refused; distinct elements are read', test_elements_twice), &
+         & new_unittest('a subscript or a substring on a key of one value is malformed', test_scalar_subscript) &
          & ]
    end subroutine collect_namelist
 
@@ -859,4 +861,61 @@ contains
       if (allocated(error)) return
       call expect_read('&stops nodes = 5, 10, lower = 2*-0.1 /', error)
    end subroutine test_null_values
+   !> A key given twice is refused, but an element of a list given twice was overwritten unsaid:
+   !> `ratio = 0.01, 0.03, ratio(2) = 0.02` was read as 0.01, 0.02. Each element is given at most
+   !> once, by the whole list or by its subscript; distinct elements are read.
+   subroutine test_elements_twice(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: bad(6) = [character(len=64) :: '&damping ratio(1)=0.01, ratio(1)=0.02 /', &
+         & '&damping ratio=0.01, 0.03, ratio(2)=0.02 /', '&stops nodes=5,10, nodes(2)=12 /', &
+         & '&stops nodes=5,10, lower=-0.1,-0.2, lower(2)=-0.3 /', '&stops nodes(2:3)=5,10, nodes(3)=12 /', &
+         & '&stops nodes(2)=10, nodes=5, 12 /']
+      character(len=*), parameter :: shown(6) = [character(len=32) :: '&damping ratio(1)', '&damping ratio(2)', &
+         & '&stops nodes(2)', '&stops lower(2)', '&stops nodes(3)', '&stops nodes(2)']
+      character(len=64) :: needles(3)
+      type(scene_type) :: scene
+      integer :: i
+      do i = 1, size(bad)
+         needles(1) = trim(shown(i))//' is given twice'
+         needles(2) = 'allowed: each key once in a group'
+         needles(3) = 'each element of a list at most once'
+         call expect_text_error(trim(bad(i)), needles, error)
+         if (allocated(error)) return
+      end do
+      ! the whole key twice keeps its message
+      call expect_text_error('&stops nodes=5, nodes=10 /', [character(len=48) :: '&stops nodes is given twice'], error)
+      if (allocated(error)) return
+      ! distinct elements, in any order, are read
+      call scene_from_text('&stops nodes(2) = 10, nodes(1) = 5, lower(1:2) = -0.1, -0.2 / &damping ratio(2) = '// &
+         & '0.02, ratio(1) = 0.01 /', 'in.nml', scene, error)
+      if (allocated(error)) return
+      call check(error, all(scene%stop_nodes == [5, 10]), 'nodes 5, 10')
+      if (allocated(error)) return
+      call check(error, scene%stop_lower(2), -0.2_wp, 'lower(2)')
+      if (allocated(error)) return
+      call check(error, scene%damping_ratio(1), 0.01_wp, 'ratio(1)')
+      if (allocated(error)) return
+      call check(error, scene%damping_ratio(2), 0.02_wp, 'ratio(2)')
+   end subroutine test_elements_twice
+
+   !> `load_rule(1:2) = 'pa'` was read as a substring of the default: load_rule = 'pantered'.
+   !> A key of one value takes no subscript or substring.
+   subroutine test_scalar_subscript(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: bad(5) = [character(len=48) :: "&time load_rule(1:2)='pa' /", &
+         & "&stops law(1:4) = 'none' /", '&time dt(1)=1e-5 /', '&mesh modes(1) = 2 /', '&statistics enabled(1)=T /']
+      character(len=*), parameter :: shown(5) = [character(len=32) :: "&time load_rule(1:2)='pa'", &
+         & "&stops law(1:4) = 'none'", '&time dt(1)=1e-5', '&mesh modes(1) = 2', '&statistics enabled(1)=T']
+      character(len=*), parameter :: allowed(5) = [character(len=48) :: 'allowed: load_rule = a quoted text', &
+         & 'allowed: law = a quoted text', 'allowed: dt = a real number', 'allowed: modes = a whole number', &
+         & 'allowed: enabled = .true. or .false.']
+      character(len=64) :: needles(2)
+      integer :: i
+      do i = 1, size(bad)
+         needles(1) = trim(shown(i))//' is malformed'
+         needles(2) = allowed(i)
+         call expect_text_error(trim(bad(i)), needles, error)
+         if (allocated(error)) return
+      end do
+   end subroutine test_scalar_subscript
 end module test_namelist
