@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import re
 from pathlib import Path
 
 import pytest
@@ -258,6 +259,40 @@ def test_none_empty_or_control_characters_are_refused(changes: dict, kind: type)
     with pytest.raises(kind, match="scene key"):
         Scene(**changes)
     assert Scene(file=None).file is None and Scene(nodes=()).nodes == ()
+
+
+@pytest.mark.parametrize("changes, allowed", [
+    ({"dt": [1e-5]}, "&time dt(1:1) = 1e-05 is malformed; allowed: dt = a real number, e.g. 1e-5"),
+    ({"dt": [[1e-5]]}, "&time dt(1:1) = 1e-05 is malformed; allowed: dt = a real number, e.g. 1e-5"),
+    ({"dt": (1e-5, 2e-5)}, "&time dt(1:2) = 1e-05, 2e-05 is malformed; allowed: dt = a real number"),
+    ({"elements": [7]}, "&mesh elements(1:1) = 7 is malformed; allowed: elements = a whole number"),
+    ({"modes": [2]}, "&mesh modes(1:1) = 2 is malformed; allowed: modes = a whole number"),
+    ({"law": ["none"]}, "&stops law(1:1) = 'none' is malformed; allowed: law = a quoted text"),
+    ({"allow_unstable": [True]}, "&time allow_unstable(1:1) = .true. is malformed; allowed: allow_unstable = .true. "
+                                 "or .false."),
+])
+def test_a_list_for_a_key_of_one_value_is_refused_by_the_engine(changes: dict, allowed: str) -> None:
+    """Scene(dt=[1e-5]) and Scene(dt=[[1e-5]]) were written `dt = 1e-05` and ran at 1e-5 s: a list
+    is written with its section, which the engine refuses on a key of one value."""
+    with pytest.raises(ValueError, match="^scene: " + re.escape(allowed)):
+        Scene(**changes)
+    with pytest.raises(ValueError, match="^scene: " + re.escape(allowed)):
+        Scene().replace(**changes)
+    np = pytest.importorskip("numpy")
+    key, value = next(iter(changes.items()))
+    if not isinstance(value[0], (str, bool)):
+        with pytest.raises(ValueError, match="^scene: " + re.escape(allowed)):
+            Scene(**{key: np.array(value)})
+
+
+def test_lists_for_list_keys_are_read_as_before() -> None:
+    scene = Scene(nodes=[5, 10], lower=(-0.1, -0.2), upper=[0.1], ratio=[0.01], damping_modes=[1, 3])
+    assert scene.nodes == (5, 10) and scene.lower == (-0.1, -0.2) and scene.upper == (0.1, 0.1)
+    assert scene.ratio == (0.01, 0.01) and scene.damping_modes == (1, 3)
+    assert Scene(nodes=[[5, 10]]).nodes == (5, 10)
+    assert scene.replace(nodes=(4, 8, 12), lower=[-0.1], upper=[0.1]).nodes == (4, 8, 12)
+    with pytest.raises(ValueError, match=r"^scene: &stops nodes has 1001 values, out of range"):
+        Scene(nodes=list(range(1, 1002)), elements=2000)
 
 
 def test_replace_leaves_out_a_spring_or_modes_the_change_makes_useless() -> None:

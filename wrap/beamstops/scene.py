@@ -283,7 +283,7 @@ def namelist_value(value: Any, key: str = "value") -> str:
         return str(int(value))
     if isinstance(value, numbers.Real):
         return repr(float(value))
-    if isinstance(value, (list, tuple)) or (hasattr(value, "ndim") and getattr(value, "ndim", 0) > 0):
+    if _is_list(value):
         return ", ".join(namelist_value(v, key) for v in value)
     raise TypeError(f"scene key {key} cannot hold {value!r} (a number, a text, a logical or a list of them)")
 
@@ -299,8 +299,23 @@ def _namelist(values: Mapping[str, Any]) -> str:
         if key in defaults and type(value) is type(defaults[key]) and value == defaults[key]:
             continue
         group, name = _group_key(key)
+        if _is_list(value):
+            # A list is written with its section, `key(1:n) = ...`: the engine reads it into the
+            # first n elements of a list key and refuses it for a key of one value (`dt(1:1) = 1e-05`
+            # is malformed), where `dt = 1e-05` would have taken [1e-5] for 1e-5.
+            name = f"{name}(1:{_count(value)})"
         groups.setdefault(group, []).append(f"  {name} = {namelist_value(value, key)}")
     return "".join(f"&{group}\n" + "\n".join(lines) + "\n/\n" for group, lines in groups.items()) or "&time /\n"
+
+
+def _is_list(value: Any) -> bool:
+    """Whether namelist_value writes the value as a list (a list, a tuple or an array)."""
+    return isinstance(value, (list, tuple)) or (hasattr(value, "ndim") and getattr(value, "ndim", 0) > 0)
+
+
+def _count(value: Any) -> int:
+    """Number of values namelist_value writes for a value (nested lists flattened)."""
+    return sum(_count(v) for v in value) if _is_list(value) else 1
 
 
 def _group_key(field: str) -> tuple[str, str]:
