@@ -676,16 +676,20 @@ contains
       !> else the one it names for the other extreme with the kind's limit added, else the kind's range.
       function whole_range(group, key, value) result(allowed)
          character(len=*), intent(in) :: group, key, value
-         character(len=:), allocatable :: allowed, largest, beyond, other
+         character(len=:), allocatable :: allowed, largest, smallest, beyond, other
+         ! (the kind's range is not symmetric: -2147483648 is read, and a key without a range of
+         ! its own, &ensemble seed, takes it)
          if (key == 'checkpoint_every') then
             largest = fmt_int(huge(1_ik))
+            smallest = fmt_int(-huge(1_ik) - 1_ik)
          else
             largest = itoa(huge(1))
+            smallest = itoa(-huge(1) - 1)
          end if
          if (value(1:1) == '-') then
-            beyond = '-'//largest; other = largest
+            beyond = smallest; other = largest
          else
-            beyond = largest; other = '-'//largest
+            beyond = largest; other = smallest
          end if
          allowed = range_named(group, key, '&'//group//' '//key//' = '//beyond//' /')
          if (len(allowed) > 0) return
@@ -697,7 +701,7 @@ contains
                allowed = allowed//', and at most '//beyond
             end if
          else
-            allowed = key//' = a whole number from -'//largest//' to '//largest
+            allowed = key//' = a whole number from '//smallest//' to '//largest
          end if
       end function whole_range
 
@@ -713,7 +717,7 @@ contains
             & cleaned(final + 1:))
          if (len(allowed) > 0) return
          largest = itoa(huge(1))
-         allowed = key//' = whole numbers from -'//largest//' to '//largest
+         allowed = key//' = whole numbers from '//itoa(-huge(1) - 1)//' to '//largest
       end function list_range
 
       !> What validate_scene allows of the key when it refuses the key in `probe`, a scene's text

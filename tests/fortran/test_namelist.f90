@@ -66,7 +66,8 @@ contains
          & new_unittest('a null value (r* alone, nothing before a comma) is refused, not read as not given', &
          & test_null_values), &
          & new_unittest('an element of a list given twice is refused; distinct elements are read', test_elements_twice), &
-         & new_unittest('a subscript or a substring on a key of one value is malformed', test_scalar_subscript) &
+         & new_unittest('a subscript or a substring on a key of one value is malformed', test_scalar_subscript), &
+         & new_unittest('&ensemble seed: the range a refused seed names is the range read', test_seed_range) &
          & ]
    end subroutine collect_namelist
 
@@ -918,4 +919,27 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_scalar_subscript
+   !> seed = -2147483648 was read, while a seed beyond the integer was told "from -2147483647 to
+   !> 2147483647": the message names the integer's whole range, both ends read.
+   subroutine test_seed_range(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: beyond(2) = [character(len=40) :: '&ensemble seed=2147483648 /', &
+         & '&ensemble seed=-2147483649 /']
+      character(len=64) :: needles(2)
+      type(scene_type) :: scene
+      integer :: i
+      do i = 1, size(beyond)
+         needles(1) = trim(beyond(i)(:index(beyond(i), ' /') - 1))//' is out of range'
+         needles(2) = 'seed = a whole number from -2147483648 to 2147483647'
+         call expect_text_error(trim(beyond(i)), needles, error)
+         if (allocated(error)) return
+      end do
+      call scene_from_text('&ensemble seed=-2147483648 /', 'in.nml', scene, error)
+      if (allocated(error)) return
+      call check(error, scene%seed == -huge(1) - 1, 'seed -2147483648 read')
+      if (allocated(error)) return
+      call scene_from_text('&ensemble seed=2147483647 /', 'in.nml', scene, error)
+      if (allocated(error)) return
+      call check(error, scene%seed, huge(1), 'seed 2147483647 read')
+   end subroutine test_seed_range
 end module test_namelist

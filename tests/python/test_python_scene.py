@@ -138,7 +138,7 @@ REFUSED = [
     ("&output record_every=-2147483649 /", ["&output record_every=-2147483649 is out of range", "record_every >= 1"]),
     ("&output snapshot_every=2147483648 /", ["is out of range", "snapshot_every >= 0 (0: none), and at most 2147483647"]),
     ("&ensemble seed=-9999999999 /", ["&ensemble seed=-9999999999 is out of range",
-                                      "a whole number from -2147483647 to 2147483647"]),
+                                      "a whole number from -2147483648 to 2147483647"]),
     ("&mesh elements=2147483648a /", ["&mesh elements=2147483648a is malformed", "a whole number"]),
     ("&stops nodes=5, 99999999999999999999 lower=-0.1 upper=0.1 /",
      ["&stops nodes=5, 99999999999999999999 is out of range", "1 <= nodes <= elements = 19"]),
