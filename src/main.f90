@@ -11,8 +11,8 @@ program beamstops_main
       & c_null_char, c_ptr, c_null_ptr, c_loc
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use beamstops
-   use beamstops_checkpoint, only: checkpoint_path, temporary_path, read_checkpoint, is_checkpoint
-   use beamstops_files, only: file_exists, remove_file, same_file, same_path, creation_error
+   use beamstops_checkpoint, only: checkpoint_path, temporary_path, read_checkpoint, foreign_checkpoint
+   use beamstops_files, only: file_exists, remove_file, same_file, same_path, creation_error, not_writable_here
    use beamstops_namelist, only: default_output
    use beamstops_recorder_hdf5, only: partial_path, check_output_path
    use beamstops_run, only: continue_run, continue_reduced
@@ -458,26 +458,39 @@ contains
    end function run_to_file
 
    !> Refuse, before anything is written, the output of a scene that the run cannot write or that
-   !> would destroy data (check_output_path), a checkpoint path that holds something else than a
-   !> beamstops checkpoint, and with checkpoint_every > 0 a checkpoint the system will not let the
-   !> run create; the messages say where the output's name came from (output_origin).
+   !> would destroy data (check_output_path), what the run may not write at its checkpoint or the
+   !> checkpoint's temporary file (the input file, a symbolic link, anything but a regular file, a
+   !> file other than a beamstops checkpoint: foreign_checkpoint; a checkpoint is saved on SIGINT
+   !> or SIGTERM even without checkpoint_every), and with checkpoint_every > 0 a checkpoint the
+   !> system will not let the run create; the messages say where the output's name came from
+   !> (output_origin).
    subroutine check_outputs(scene, input, error)
       type(scene_type), intent(in) :: scene
       character(len=*), intent(in) :: input
       type(error_type), allocatable, intent(out) :: error
-      character(len=:), allocatable :: origin, checkpoint, why
+      character(len=:), allocatable :: origin, checkpoint, why, named
       origin = output_origin(scene, input)
       call check_output_path(scene%output_file, input, origin, error)
       if (allocated(error)) return
+      named = scene%output_file//' ('//origin//'): '
       checkpoint = checkpoint_path(scene%output_file)
-      if (file_exists(checkpoint) .and. .not. is_checkpoint(checkpoint)) then
-         call fatal_error(error, scene%output_file//' ('//origin//'): '//checkpoint//', where the run saves its '// &
-            & 'checkpoints, exists and is not a beamstops checkpoint; refusing to overwrite it (move it away)')
+      why = not_writable_here(checkpoint, input)
+      if (len(why) == 0) why = foreign_checkpoint(checkpoint, temporary=.false.)
+      if (len(why) > 0) then
+         call fatal_error(error, named//checkpoint//', where the run saves its checkpoints, '//why// &
+            & '; refusing to overwrite it (move it away)')
+         return
+      end if
+      why = not_writable_here(temporary_path(checkpoint), input)
+      if (len(why) == 0) why = foreign_checkpoint(temporary_path(checkpoint), temporary=.true.)
+      if (len(why) > 0) then
+         call fatal_error(error, named//temporary_path(checkpoint)//', where the run writes a checkpoint before '// &
+            & 'it moves it into place, '//why//'; refusing to overwrite it (move it away)')
          return
       end if
       if (scene%checkpoint_every == 0) return
       why = creation_error(temporary_path(checkpoint))
-      if (len(why) > 0) call fatal_error(error, scene%output_file//' ('//origin//'): cannot create '// &
+      if (len(why) > 0) call fatal_error(error, named//'cannot create '// &
          & temporary_path(checkpoint)//', where the run saves its checkpoints (&output checkpoint_every): '//why)
    end subroutine check_outputs
 

@@ -11,14 +11,19 @@ module beamstops_checkpoint
    use beamstops_state, only: state_type
    use beamstops_loop_scalars, only: n_loop_scalars, loop_scalars_vector, restore_loop_scalars
    use beamstops_observe_observer, only: observer_type
-   use beamstops_files, only: rename_file, remove_file
+   use beamstops_files, only: rename_file, remove_file, file_exists, not_writable_here
    use beamstops_recorder_hdf5_vector, only: write_vector, read_vector
    implicit none
    private
    public :: write_checkpoint, read_checkpoint, checkpoint_path, temporary_path, scene_signature, is_checkpoint
+   public :: foreign_checkpoint
    ! (the reduced model's checkpoints, beamstops_reduced_checkpoint, share the file's frame)
    public :: create_checkpoint, commit_checkpoint, open_checkpoint, close_checkpoint, write_observer, read_observer
    public :: write_scene_text
+
+   !> What checkpoint_state finds: not HDF5 (or HDF5 without a signature), HDF5 that cannot be
+   !> opened, a checkpoint.
+   integer, parameter :: checkpoint_other = 0, checkpoint_unopened = 1, checkpoint_found = 2
 
 contains
 
@@ -197,20 +202,54 @@ contains
       !> File.
       character(len=*), intent(in) :: path
       logical :: yes
+      yes = checkpoint_state(path) == checkpoint_found
+   end function is_checkpoint
+
+   !> Why what is at the checkpoint `path` (or, `temporary`, at the checkpoint's temporary file)
+   !> must not be replaced: '' when nothing is there or a checkpoint, and with `temporary` an
+   !> empty file or an HDF5 file that cannot be opened too (what a run killed while it wrote a
+   !> checkpoint leaves); else what it is ('is a symbolic link, ...', 'exists and is not a
+   !> beamstops checkpoint'). Anything but a regular file is named, not opened.
+   function foreign_checkpoint(path, temporary) result(why)
+      !> Checkpoint file, or its temporary file.
+      character(len=*), intent(in) :: path
+      !> Whether `path` is the temporary file.
+      logical, intent(in) :: temporary
+      character(len=:), allocatable :: why
+      integer :: state
+      integer(ik) :: bytes
+      why = not_writable_here(path, '')
+      if (len(why) > 0 .or. .not. file_exists(path)) return
+      state = checkpoint_state(path)
+      if (state == checkpoint_found) return
+      if (temporary) then
+         if (state == checkpoint_unopened) return
+         inquire (file=path, size=bytes)
+         if (bytes == 0) return
+      end if
+      why = 'exists and is not a beamstops checkpoint'
+   end function foreign_checkpoint
+
+   !> What the regular file `path` is: not HDF5, an HDF5 file that cannot be opened, an HDF5 file
+   !> without a scene signature, or a checkpoint.
+   integer function checkpoint_state(path) result(state)
+      character(len=*), intent(in) :: path
       integer(hid_t) :: file
       integer :: hdferr, closing
-      logical :: hdf5_file
-      yes = .false.
+      logical :: hdf5_file, found
+      state = checkpoint_other
       call h5open_f(hdferr)
       call h5eset_auto_f(0, hdferr)
       call h5fis_hdf5_f(path, hdf5_file, hdferr)
       if (hdferr /= 0 .or. .not. hdf5_file) return
+      state = checkpoint_unopened
       call h5fopen_f(path, H5F_ACC_RDONLY_F, file, hdferr)
       if (hdferr /= 0) return
-      call h5lexists_f(file, 'signature', yes, hdferr)
-      yes = yes .and. hdferr == 0
+      state = checkpoint_other
+      call h5lexists_f(file, 'signature', found, hdferr)
+      if (found .and. hdferr == 0) state = checkpoint_found
       call h5fclose_f(file, closing)
-   end function is_checkpoint
+   end function checkpoint_state
 
    !> Write the checkpoint `path` atomically.
    subroutine write_checkpoint(path, scene, state, records, snapshots, error)
@@ -287,7 +326,16 @@ contains
       integer(hid_t), intent(out) :: file
       !> Set when it cannot be created.
       type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: why
       integer :: hdferr
+      file = -1
+      ! checked when the run started, and again here: a file put there since is not written over
+      why = foreign_checkpoint(temporary_path(path), temporary=.true.)
+      if (len(why) > 0) then
+         call fatal_error(error, path//': cannot create the checkpoint: '//temporary_path(path)//', where it is '// &
+            & 'written before it is moved into place, '//why//'; refusing to write it (move it away)')
+         return
+      end if
       call h5open_f(hdferr)
       call h5eset_auto_f(0, hdferr)
       call h5fcreate_f(temporary_path(path), H5F_ACC_TRUNC_F, file, hdferr)

@@ -27,6 +27,29 @@ int beamstops_is_directory(const char *path)
     return stat(path, &s) == 0 && S_ISDIR(s.st_mode);
 }
 
+/* What is at path, the link itself when it is a symbolic link (lstat), or with `follow` what it
+   leads to (stat): 0 nothing (or nothing the process can see), 1 a regular file, 2 a symbolic
+   link, 3 a folder, 4 a FIFO, 5 a socket, 6 a device, 7 anything else. */
+int beamstops_path_kind(const char *path, int follow)
+{
+    struct stat s;
+    if ((follow ? stat(path, &s) : lstat(path, &s)) != 0)
+        return 0;
+    if (S_ISREG(s.st_mode))
+        return 1;
+    if (S_ISLNK(s.st_mode))
+        return 2;
+    if (S_ISDIR(s.st_mode))
+        return 3;
+    if (S_ISFIFO(s.st_mode))
+        return 4;
+    if (S_ISSOCK(s.st_mode))
+        return 5;
+    if (S_ISCHR(s.st_mode) || S_ISBLK(s.st_mode))
+        return 6;
+    return 7;
+}
+
 /* The folder part of a path (".", "/" or the path up to its last slash) into dir, and a
    pointer to its last component. */
 static const char *split_path(const char *path, char *dir, size_t size)

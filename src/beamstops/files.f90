@@ -7,6 +7,8 @@ module beamstops_files
    private
    public :: file_exists, is_directory, same_file, same_path, rename_file, replace_file, remove_file, creation_error
    public :: raise_hdf5_eoa
+   public :: path_kind, kind_name, path_missing, path_regular, path_link, path_folder
+   public :: not_writable_here
    public :: read_whole_file, read_ok, read_missing, read_folder, read_too_big, read_unopened, read_failed
 
    !> Outcomes of read_whole_file: read, no such file, a folder, more bytes than allowed, not
@@ -14,7 +16,18 @@ module beamstops_files
    integer, parameter :: read_ok = 0, read_missing = 1, read_folder = 2, read_too_big = 3, read_unopened = 4, &
       & read_failed = 5
 
+   !> What is at a path (path_kind): nothing, a regular file, a symbolic link, a folder, a FIFO,
+   !> a socket, a device, anything else.
+   integer, parameter :: path_missing = 0, path_regular = 1, path_link = 2, path_folder = 3, path_fifo = 4, &
+      & path_socket = 5, path_device = 6
+
    interface
+      function c_path_kind(path, follow) bind(c, name='beamstops_path_kind') result(kind)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int), value :: follow
+         integer(c_int) :: kind
+      end function c_path_kind
       function c_rename(from, to) bind(c, name='rename') result(status)
          import :: c_char, c_int
          character(kind=c_char), intent(in) :: from(*), to(*)
@@ -136,6 +149,68 @@ contains
       logical :: directory
       directory = c_is_directory(path//c_null_char) == 1
    end function is_directory
+
+   !> What is at `path`: path_missing, path_regular, path_link, path_folder, or a FIFO, a socket, a
+   !> device (kind_name names them); the link itself unless `follow` (then what it leads to).
+   integer function path_kind(path, follow)
+      !> Path.
+      character(len=*), intent(in) :: path
+      !> Whether a symbolic link is followed.
+      logical, intent(in) :: follow
+      path_kind = c_path_kind(path//c_null_char, merge(1_c_int, 0_c_int, follow))
+   end function path_kind
+
+   !> What a path_kind is, in words: 'a symbolic link', 'a FIFO (named pipe)', ...
+   function kind_name(kind) result(name)
+      !> A path_kind.
+      integer, intent(in) :: kind
+      character(len=:), allocatable :: name
+      select case (kind)
+      case (path_missing)
+         name = 'nothing'
+      case (path_regular)
+         name = 'a regular file'
+      case (path_link)
+         name = 'a symbolic link'
+      case (path_folder)
+         name = 'a folder'
+      case (path_fifo)
+         name = 'a FIFO (named pipe)'
+      case (path_socket)
+         name = 'a socket'
+      case (path_device)
+         name = 'a device'
+      case default
+         name = 'not a regular file'
+      end select
+   end function kind_name
+
+   !> Why a run must not write a file at `path` whatever it holds ('' when nothing is there, or a
+   !> regular file that is not the input): 'is the input file IN.nml', 'is a symbolic link, which
+   !> the run would write through', 'is a FIFO (named pipe), not a regular file', ... Nothing is
+   !> opened (a FIFO would block the opening).
+   function not_writable_here(path, input) result(why)
+      !> File the run writes.
+      character(len=*), intent(in) :: path
+      !> Input file of the run ('' for none).
+      character(len=*), intent(in) :: input
+      character(len=:), allocatable :: why
+      integer :: kind
+      why = ''
+      kind = path_kind(path, follow=.false.)
+      if (kind == path_missing) return
+      if (len(input) > 0) then
+         if (same_file(path, input)) then
+            why = 'is the input file '//input
+            return
+         end if
+      end if
+      if (kind == path_link) then
+         why = 'is a symbolic link, which the run would write through'
+      else if (kind /= path_regular) then
+         why = 'is '//kind_name(kind)//', not a regular file'
+      end if
+   end function not_writable_here
 
    !> Whether two existing paths name the same file (same device and inode), however spelt.
    function same_file(a, b) result(same)

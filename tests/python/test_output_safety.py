@@ -6,16 +6,103 @@ exit status 4."""
 
 from __future__ import annotations
 
+import os
+import signal
 import subprocess
 import time
 from pathlib import Path
 
 import h5py
+import numpy as np
 import pytest
 
-from test_cli import PROGRAM, SHORT, complete_output, write
+from test_cli import PROGRAM, SHORT, beamstops, complete_output, one_error_line, write
 
 pytestmark = pytest.mark.skipif(PROGRAM is None, reason="the beamstops program is not on PATH")
+
+def wait_for(path: Path, process: subprocess.Popen[str], size: int = 1) -> bool:
+    """Whether `path` reached `size` bytes while `process` still runs."""
+    deadline = time.time() + 60
+    while process.poll() is None and time.time() < deadline:
+        if path.exists() and path.stat().st_size >= size:
+            return True
+        time.sleep(0.005)
+    return False
+
+
+def victim(tmp_path: Path) -> tuple[Path, bytes]:
+    """A file of the user's that a link may lead to."""
+    path = tmp_path / "victim.txt"
+    path.write_text("the user's own file\n")
+    return path, path.read_bytes()
+
+
+@pytest.mark.parametrize("suffix", [".partial", ".checkpoint", ".checkpoint.tmp"])
+@pytest.mark.parametrize("kind", ["input", "symbolic link", "FIFO", "text"])
+def test_what_is_at_a_file_the_run_writes_is_refused_untouched(suffix: str, kind: str, tmp_path: Path) -> None:
+    """The input itself, a symbolic link (to the user's file), a FIFO (opening it would block) or a
+    foreign file at OUT.h5.partial, OUT.h5.checkpoint or OUT.h5.checkpoint.tmp (where a checkpoint
+    is written, with checkpoint_every or on SIGINT): refused in one line, nothing written."""
+    target, before = victim(tmp_path)
+    there = tmp_path / f"out.h5{suffix}"
+    scene = SHORT + "&output checkpoint_every=1000 /\n"
+    if kind == "input":
+        there.write_text(scene)
+        name = there.name
+    else:
+        name = write(tmp_path, scene).name
+        if kind == "symbolic link":
+            there.symlink_to(target.name)
+        elif kind == "FIFO":
+            os.mkfifo(there)
+        else:
+            there.write_text("not HDF5\n")
+    done = subprocess.run([PROGRAM, "run", name, "-o", "out.h5"], cwd=tmp_path, capture_output=True, text=True,
+                          timeout=30)
+    assert done.returncode == 4, done.stderr
+    line = one_error_line(done)
+    assert line.startswith(f"beamstops: error: out.h5 (-o): out.h5{suffix}, where the run "), line
+    why = {"input": f"is the input file out.h5{suffix}", "symbolic link": "is a symbolic link",
+           "FIFO": "is a FIFO (named pipe), not a regular file", "text": "not "}[kind]
+    assert why in line, line
+    assert target.read_bytes() == before
+    if kind == "input":
+        assert there.read_text() == scene
+    assert not (tmp_path / "out.h5").exists()
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith("out.h5")) == [there.name]
+
+
+def test_a_link_put_at_the_checkpoints_temporary_file_during_the_run_is_not_written_through(
+        tmp_path: Path) -> None:
+    """SIGTERM saves a checkpoint through OUT.h5.checkpoint.tmp: a link put there after the run
+    started is refused then too."""
+    target, before = victim(tmp_path)
+    scene = write(tmp_path, "&time dt=1e-6, t_end=30 /\n&output record_every=100 /\n")
+    process = subprocess.Popen([PROGRAM, "run", scene.name, "-o", "out.h5"], cwd=tmp_path, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    try:
+        if not wait_for(tmp_path / "out.h5.partial", process, 1 << 20):
+            pytest.skip("the run ended before the link was made")
+        (tmp_path / "out.h5.checkpoint.tmp").symlink_to(target.name)
+        process.send_signal(signal.SIGTERM)
+        _, err = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+    assert process.returncode == 4, err
+    assert "out.h5.checkpoint.tmp" in err and "symbolic link" in err and err.count("\n") == 1, err
+    assert target.read_bytes() == before
+    assert not (tmp_path / "out.h5").exists() and not (tmp_path / "out.h5.checkpoint").exists()
+
+
+def test_a_link_at_the_partial_file_to_another_output_is_refused(tmp_path: Path) -> None:
+    other, before = complete_output(tmp_path, "other.h5")
+    (tmp_path / "out.h5.partial").symlink_to(other.name)
+    done = beamstops("run", write(tmp_path, SHORT), "-o", "out.h5", cwd=tmp_path)
+    assert done.returncode == 4
+    assert "out.h5.partial, where the run writes until it is done, is a symbolic link" in one_error_line(done)
+    assert other.read_bytes() == before and not (tmp_path / "out.h5").exists()
 
 
 def test_a_file_at_the_hidden_name_of_the_replaced_output_is_kept(tmp_path: Path) -> None:
@@ -34,3 +121,18 @@ def test_a_file_at_the_hidden_name_of_the_replaced_output_is_kept(tmp_path: Path
     assert list(tmp_path.glob(".out.h5.replaced-*")) == hidden
     with h5py.File(tmp_path / "out.h5") as f:
         assert f.attrs["status"] == b"complete"
+
+
+@pytest.mark.parametrize("kind", ["FIFO", "link to a FIFO", "device"])
+def test_an_output_that_is_not_a_regular_file_is_refused_without_opening_it(kind: str, tmp_path: Path) -> None:
+    scene = write(tmp_path, SHORT)
+    out = {"FIFO": "ff", "link to a FIFO": "link.h5", "device": "/dev/null"}[kind]
+    if kind != "device":
+        os.mkfifo(tmp_path / "ff")
+    if kind == "link to a FIFO":
+        (tmp_path / "link.h5").symlink_to("ff")
+    done = beamstops("run", scene, "-o", out, cwd=tmp_path)
+    assert done.returncode == 4
+    why = {"FIFO": "is a FIFO (named pipe), not a regular file", "link to a FIFO": "is a symbolic link to a FIFO",
+           "device": "is a device, not a regular file"}[kind]
+    assert one_error_line(done).startswith(f"beamstops: error: {out} (-o): {why}")

@@ -20,7 +20,8 @@ module beamstops_recorder_hdf5
    use beamstops_scene, only: scene_type, law_name, law_compliance, stop_count, steps_of
    use beamstops_model, only: model_type
    use beamstops_summary, only: run_summary, status_running, status_complete, status_diverged, status_failed
-   use beamstops_files, only: file_exists, is_directory, same_file, replace_file, creation_error, raise_hdf5_eoa
+   use beamstops_files, only: same_file, replace_file, creation_error, raise_hdf5_eoa, &
+      & path_kind, kind_name, path_missing, path_regular, path_link, path_folder, not_writable_here
    use beamstops_recorder_hdf5_vector, only: write_vector
    use beamstops_recorder, only: recorder_type, n_columns, col_t, all_finite
    use beamstops_attributes, only: attribute_list, kind_real, kind_int, kind_logical, kind_text
@@ -445,13 +446,16 @@ contains
 
    !> Refuse, before anything is written, an output the run cannot write or that would destroy
    !> data: a name ending in '/' (a folder's, not a file's); the input file itself (under any
-   !> name: same device and inode); an existing file at the output path that is not a beamstops
-   !> output (an HDF5 file with the root attributes `version` and `status`); a file at the partial
-   !> path that is neither empty nor HDF5 (an empty or HDF5 file there is taken for the partial
-   !> output of an earlier run, which a kill may have left empty and a failed write unreadable);
-   !> a partial file the system will not let the run create (the message gives its reason:
-   !> name too long, no such folder, permission denied, read-only file system, ...). The message
-   !> names the output and where its name came from (`origin`), and says why.
+   !> name: same device and inode); an existing file at the output path that is not a regular
+   !> file (a FIFO, a socket, a device: refused without being opened) or not a beamstops output
+   !> (an HDF5 file with the root attributes `version` and `status`; a symbolic link there is
+   !> replaced as a name, what it leads to is tested); at the partial path, the input file, a
+   !> symbolic link, anything but a regular file, and a file that is neither empty nor HDF5 (an
+   !> empty or HDF5 file there is taken for the partial output of an earlier run, which a kill
+   !> may have left empty and a failed write unreadable); a partial file the system
+   !> will not let the run create (the message gives its reason: name too long, no such folder,
+   !> permission denied, read-only file system, ...). The message names the output and where its
+   !> name came from (`origin`), and says why.
    subroutine check_output_path(output, input, origin, error)
       !> Output file.
       character(len=*), intent(in) :: output
@@ -461,7 +465,8 @@ contains
       character(len=*), intent(in) :: origin
       !> Set when the output must not be written.
       type(error_type), allocatable, intent(out) :: error
-      character(len=:), allocatable :: why, named, example
+      character(len=:), allocatable :: why, named, example, partial
+      integer :: kind
       if (len(output) == 0) then
          call fatal_error(error, input//': a namelist read from a pipe, a device or an open descriptor (/dev/stdin, '// &
             & '/dev/fd/N, <(...)) gives no output name; allowed: name the output, -o OUT.h5 or &output file = ''OUT.h5''')
@@ -480,37 +485,58 @@ contains
             & 'destroy it (name another output: -o OUT.h5, or &output file)')
          return
       end if
+      kind = path_kind(output, follow=.true.)
+      if (kind /= path_missing .and. kind /= path_regular .and. kind /= path_folder) then
+         why = 'is '//kind_name(kind)
+         if (path_kind(output, follow=.false.) == path_link) why = 'is a symbolic link to '//kind_name(kind)
+         call fatal_error(error, named//why//', not a regular file; refusing to write it (name another output: '// &
+            & '-o OUT.h5, or &output file)')
+         return
+      end if
       why = not_an_output(output, strict=.true.)
       if (len(why) > 0) then
          call fatal_error(error, named//'exists and is not a beamstops output ('//why//'); refusing to '// &
             & 'overwrite it (name another output: -o OUT.h5, or &output file)')
          return
       end if
-      why = not_an_output(partial_path(output), strict=.false.)
+      partial = partial_path(output)
+      why = not_writable_here(partial, input)
       if (len(why) > 0) then
-         call fatal_error(error, named//partial_path(output)//', where the run writes until it is done, exists '// &
+         call fatal_error(error, named//partial//', where the run writes until it is done, '//why// &
+            & '; refusing to write it (move it away)')
+         return
+      end if
+      why = not_an_output(partial, strict=.false.)
+      if (len(why) > 0) then
+         call fatal_error(error, named//partial//', where the run writes until it is done, exists '// &
             & 'and is not the partial output of a beamstops run ('//why//'); refusing to overwrite it (move it away)')
          return
       end if
-      why = creation_error(partial_path(output))
-      if (len(why) > 0) call fatal_error(error, named//'cannot create '//partial_path(output)//', where the run '// &
+      why = creation_error(partial)
+      if (len(why) > 0) call fatal_error(error, named//'cannot create '//partial//', where the run '// &
          & 'writes until it is done: '//why)
    end subroutine check_output_path
 
    !> Why an existing `path` is not a beamstops output ('' when it is one, or does not exist);
-   !> not `strict`: any HDF5 file passes, and an empty file.
+   !> not `strict`: any HDF5 file passes, and an empty file. Anything but a regular file is named,
+   !> not opened.
    function not_an_output(path, strict) result(why)
       character(len=*), intent(in) :: path
       logical, intent(in) :: strict
       character(len=:), allocatable :: why
       integer(hid_t) :: file
-      integer :: hdferr, closing
+      integer :: hdferr, closing, kind
       integer(ik) :: bytes
       logical :: hdf5_file, has_version, has_status
       why = ''
-      if (.not. file_exists(path)) return
-      if (is_directory(path)) then
+      kind = path_kind(path, follow=.true.)
+      if (kind == path_missing) return
+      if (kind == path_folder) then
          why = 'a folder'
+         return
+      end if
+      if (kind /= path_regular) then
+         why = kind_name(kind)
          return
       end if
       inquire (file=path, size=bytes)
