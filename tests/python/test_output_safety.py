@@ -105,6 +105,44 @@ def test_a_link_at_the_partial_file_to_another_output_is_refused(tmp_path: Path)
     assert other.read_bytes() == before and not (tmp_path / "out.h5").exists()
 
 
+def lookalike(path: Path) -> bytes:
+    """An HDF5 file with the root attributes version and status, that beamstops did not write."""
+    with h5py.File(path, "w") as f:
+        f["data"] = np.arange(3.0)
+        f.attrs["version"] = "2.1"
+        f.attrs["status"] = "complete"
+    return path.read_bytes()
+
+
+@pytest.mark.parametrize("name", ["out.h5", "out.h5.partial"])
+def test_an_hdf5_file_with_version_and_status_that_beamstops_did_not_write_is_refused(name: str,
+                                                                                      tmp_path: Path) -> None:
+    before = lookalike(tmp_path / name)
+    done = beamstops("run", write(tmp_path, SHORT), "-o", "out.h5", cwd=tmp_path)
+    assert done.returncode == 4
+    line = one_error_line(done)
+    assert "without the root attributes version, status and scene and the dataset /tip/t" in line, line
+    assert (tmp_path / name).read_bytes() == before
+
+
+def test_every_kind_of_beamstops_file_is_taken_as_its_own(tmp_path: Path) -> None:
+    """A complete, a diverged, a failed and an interrupted output (the last two as partial files)
+    are replaced by a re-run, as before the signature was strengthened."""
+    scene = write(tmp_path, SHORT)
+    diverged = write(tmp_path, "&time dt=2e-5, beta=0, t_end=0.5, allow_unstable=.true. /\n"
+                               "&output record_every=100 /\n", name="diverged.nml")
+    assert beamstops("run", diverged, "-o", "d.h5", cwd=tmp_path).returncode == 3
+    assert beamstops("run", scene, "-o", "d.h5", cwd=tmp_path).returncode == 0
+    for status in (b"failed", b"interrupted", b"running"):
+        complete_output(tmp_path, "p.h5")
+        with h5py.File(tmp_path / "p.h5", "a") as f:
+            f.attrs["status"] = status
+        (tmp_path / "p.h5").rename(tmp_path / "out.h5.partial")
+        done = beamstops("run", scene, "-o", "out.h5", cwd=tmp_path)
+        assert done.returncode == 0, done.stderr
+        assert beamstops("run", scene, "-o", "out.h5", cwd=tmp_path).returncode == 0
+
+
 def test_a_file_at_the_hidden_name_of_the_replaced_output_is_kept(tmp_path: Path) -> None:
     """The earlier output is moved aside to .OUT.h5.replaced-PID before it is removed; a file of
     that name (the shell's PID is the program's after exec) is not overwritten."""

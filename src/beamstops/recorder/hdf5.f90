@@ -448,11 +448,12 @@ contains
    !> data: a name ending in '/' (a folder's, not a file's); the input file itself (under any
    !> name: same device and inode); an existing file at the output path that is not a regular
    !> file (a FIFO, a socket, a device: refused without being opened) or not a beamstops output
-   !> (an HDF5 file with the root attributes `version` and `status`; a symbolic link there is
-   !> replaced as a name, what it leads to is tested); at the partial path, the input file, a
-   !> symbolic link, anything but a regular file, and a file that is neither empty nor HDF5 (an
-   !> empty or HDF5 file there is taken for the partial output of an earlier run, which a kill
-   !> may have left empty and a failed write unreadable); a partial file the system
+   !> (an HDF5 file with the root attributes `version`, `status` and `scene` and the dataset
+   !> /tip/t; a symbolic link there is replaced as a name, what it leads to is tested); at the
+   !> partial path, the input file, a symbolic link, anything but a regular file, and a file that
+   !> is neither empty, nor an HDF5 file that cannot be opened, nor a beamstops output (an empty
+   !> or unreadable HDF5 file there is taken for the partial output of an earlier run, which a
+   !> kill may have left empty and a failed write unreadable); a partial file the system
    !> will not let the run create (the message gives its reason: name too long, no such folder,
    !> permission denied, read-only file system, ...). The message names the output and where its
    !> name came from (`origin`), and says why.
@@ -517,9 +518,11 @@ contains
          & 'writes until it is done: '//why)
    end subroutine check_output_path
 
-   !> Why an existing `path` is not a beamstops output ('' when it is one, or does not exist);
-   !> not `strict`: any HDF5 file passes, and an empty file. Anything but a regular file is named,
-   !> not opened.
+   !> Why an existing `path` is not a beamstops output ('' when it is one, or does not exist): a
+   !> beamstops output is an HDF5 file with the root attributes `version`, `status` and `scene`
+   !> and the dataset /tip/t, which every output and partial file of the program has from its
+   !> first flush. Not `strict`: an empty file passes too, and an HDF5 file that cannot be opened
+   !> (what a kill or a failed write may leave). Anything but a regular file is named, not opened.
    function not_an_output(path, strict) result(why)
       character(len=*), intent(in) :: path
       logical, intent(in) :: strict
@@ -527,7 +530,7 @@ contains
       integer(hid_t) :: file
       integer :: hdferr, closing, kind
       integer(ik) :: bytes
-      logical :: hdf5_file, has_version, has_status
+      logical :: hdf5_file
       why = ''
       kind = path_kind(path, follow=.true.)
       if (kind == path_missing) return
@@ -543,19 +546,14 @@ contains
       if (.not. strict .and. bytes == 0) return
       call h5open_f(hdferr)
       call h5eset_auto_f(0, hdferr)
-      ! strict: one opening of the file when it opens (h5fis_hdf5_f opens it too; each opening
-      ! builds a metadata cache of ~1 MB), the test only to name what is wrong when it does not
-      if (strict) then
-         call h5fopen_f(path, H5F_ACC_RDONLY_F, file, hdferr)
-         if (hdferr == 0) then
-            call h5aexists_f(file, 'version', has_version, hdferr)
-            if (hdferr /= 0) has_version = .false.
-            call h5aexists_f(file, 'status', has_status, hdferr)
-            if (hdferr /= 0) has_status = .false.
-            call h5fclose_f(file, closing)
-            if (.not. (has_version .and. has_status)) why = 'an HDF5 file without the root attributes version and status'
-            return
-         end if
+      ! one opening of the file when it opens (h5fis_hdf5_f opens it too; each opening builds a
+      ! metadata cache of ~1 MB), the test only to name what is wrong when it does not
+      call h5fopen_f(path, H5F_ACC_RDONLY_F, file, hdferr)
+      if (hdferr == 0) then
+         if (.not. has_signature(file)) why = 'an HDF5 file without the root attributes version, status and '// &
+            & 'scene and the dataset /tip/t that beamstops writes'
+         call h5fclose_f(file, closing)
+         return
       end if
       call h5fis_hdf5_f(path, hdf5_file, hdferr)
       if (hdferr /= 0) then
@@ -567,6 +565,25 @@ contains
          return
       end if
       if (strict) why = 'an HDF5 file that cannot be opened'
+
+   contains
+
+      !> Whether the open file has what every beamstops output has.
+      logical function has_signature(file)
+         integer(hid_t), intent(in) :: file
+         character(len=*), parameter :: names(3) = [character(len=7) :: 'version', 'status', 'scene']
+         logical :: found
+         integer :: i
+         has_signature = .false.
+         do i = 1, size(names)
+            call h5aexists_f(file, trim(names(i)), found, hdferr)
+            if (hdferr /= 0 .or. .not. found) return
+         end do
+         call h5lexists_f(file, 'tip', found, hdferr)
+         if (hdferr /= 0 .or. .not. found) return
+         call h5lexists_f(file, 'tip/t', found, hdferr)
+         has_signature = hdferr == 0 .and. found
+      end function has_signature
    end function not_an_output
 
    !> What opening and reopening share: the run's names and sizes, the buffers, the HDF5
