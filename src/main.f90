@@ -432,9 +432,10 @@ contains
          call recorder%reopen(output, scene, model, records, snapshots, error)
          if (reported(error, exit_output, status)) return
       else
-         call remove_file(checkpoint)
+         ! the checkpoint of an earlier run goes once the recorder holds the partial file
          call recorder%open(output, scene, model, error)
          if (reported(error, exit_output, status)) return
+         call remove_file(checkpoint)
       end if
       recorder%show_progress = progress
       if (.not. resume) then
@@ -720,9 +721,9 @@ contains
       do k = 1, size(members)
          i = members(k)
          recorders(k)%writer = writer
-         call remove_file(checkpoint_path(scenes(i)%output_file))
          call recorders(k)%open(scenes(i)%output_file, scenes(i), models(i), error)
          opened(k) = .not. reported(error, exit_output, status(i))
+         if (opened(k)) call remove_file(checkpoint_path(scenes(i)%output_file))
       end do
       ids = pack(members, opened)
       if (size(ids) == 0) return

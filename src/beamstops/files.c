@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
@@ -48,6 +49,55 @@ int beamstops_path_kind(const char *path, int follow)
     if (S_ISCHR(s.st_mode) || S_ISBLK(s.st_mode))
         return 6;
     return 7;
+}
+
+/* An exclusive flock lock on the regular file at path, taken without waiting (LOCK_NB) on a
+   descriptor of its own, opened read-only, never through a symbolic link (O_NOFOLLOW), never
+   waiting on a FIFO (O_NONBLOCK), never truncated; with `create`, a missing file is created
+   empty. Returns the descriptor that holds the lock (>= 0; closing it releases the lock), -1 when
+   another open file holds a lock on the file (HDF5 locks every file it has open: another run
+   writing it, or a program reading it), -2 when the file cannot be opened or locked otherwise
+   (missing, a file system without locks: no lock is held). */
+int beamstops_lock_file(const char *path, int create)
+{
+    int fd, busy;
+    do
+        fd = open(path, O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC | (create ? O_CREAT : 0), 0666);
+    while (fd < 0 && errno == EINTR);
+    if (fd < 0)
+        return -2;
+    while (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        if (errno == EINTR)
+            continue;
+        busy = errno == EWOULDBLOCK;
+        close(fd);
+        return busy ? -1 : -2;
+    }
+    return fd;
+}
+
+/* Release a lock of beamstops_lock_file (close its descriptor). */
+void beamstops_unlock_file(int fd)
+{
+    if (fd >= 0)
+        close(fd);
+}
+
+/* 1 when another open file holds a flock lock on the existing file at path (beamstops_lock_file
+   would give -1), 0 otherwise; the probe's own lock is released at once. */
+int beamstops_file_in_use(const char *path)
+{
+    int fd = beamstops_lock_file(path, 0);
+    beamstops_unlock_file(fd);
+    return fd == -1;
+}
+
+/* 0 when HDF5 will not lock the files it opens: HDF5_USE_FILE_LOCKING set to FALSE or 0 (HDF5
+   1.10.7 and later read both; earlier ones FALSE only), else 1. */
+int beamstops_hdf5_locks(void)
+{
+    const char *value = getenv("HDF5_USE_FILE_LOCKING");
+    return value == NULL || (strcmp(value, "FALSE") != 0 && strcmp(value, "0") != 0);
 }
 
 /* The folder part of a path (".", "/" or the path up to its last slash) into dir, and a

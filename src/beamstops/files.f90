@@ -8,7 +8,7 @@ module beamstops_files
    public :: file_exists, is_directory, same_file, same_path, rename_file, replace_file, remove_file, creation_error
    public :: raise_hdf5_eoa
    public :: path_kind, kind_name, path_missing, path_regular, path_link, path_folder
-   public :: not_writable_here
+   public :: lock_file, unlock_file, file_in_use, hdf5_locks, lock_busy, not_writable_here
    public :: read_whole_file, read_ok, read_missing, read_folder, read_too_big, read_unopened, read_failed
 
    !> Outcomes of read_whole_file: read, no such file, a folder, more bytes than allowed, not
@@ -21,6 +21,9 @@ module beamstops_files
    integer, parameter :: path_missing = 0, path_regular = 1, path_link = 2, path_folder = 3, path_fifo = 4, &
       & path_socket = 5, path_device = 6
 
+   !> lock_file's result when another open file holds a lock on the file.
+   integer, parameter :: lock_busy = -1
+
    interface
       function c_path_kind(path, follow) bind(c, name='beamstops_path_kind') result(kind)
          import :: c_char, c_int
@@ -28,6 +31,25 @@ module beamstops_files
          integer(c_int), value :: follow
          integer(c_int) :: kind
       end function c_path_kind
+      function c_lock_file(path, create) bind(c, name='beamstops_lock_file') result(fd)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int), value :: create
+         integer(c_int) :: fd
+      end function c_lock_file
+      subroutine c_unlock_file(fd) bind(c, name='beamstops_unlock_file')
+         import :: c_int
+         integer(c_int), value :: fd
+      end subroutine c_unlock_file
+      function c_file_in_use(path) bind(c, name='beamstops_file_in_use') result(busy)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int) :: busy
+      end function c_file_in_use
+      function c_hdf5_locks() bind(c, name='beamstops_hdf5_locks') result(locks)
+         import :: c_int
+         integer(c_int) :: locks
+      end function c_hdf5_locks
       function c_rename(from, to) bind(c, name='rename') result(status)
          import :: c_char, c_int
          character(kind=c_char), intent(in) :: from(*), to(*)
@@ -211,6 +233,39 @@ contains
          why = 'is '//kind_name(kind)//', not a regular file'
       end if
    end function not_writable_here
+
+   !> An exclusive lock (flock) on the regular file `path`, on a descriptor of its own, taken
+   !> without waiting, never through a symbolic link, never truncating the file (files.c,
+   !> beamstops_lock_file): the descriptor that holds it (>= 0, for unlock_file); lock_busy when
+   !> another open file holds a lock on it (HDF5 locks the files it has open); another negative
+   !> value when it cannot be locked otherwise (no lock held).
+   integer function lock_file(path, create)
+      !> File.
+      character(len=*), intent(in) :: path
+      !> Whether a missing file is created (empty).
+      logical, intent(in) :: create
+      lock_file = c_lock_file(path//c_null_char, merge(1_c_int, 0_c_int, create))
+   end function lock_file
+
+   !> Release a lock_file lock (nothing for a negative `fd`).
+   subroutine unlock_file(fd)
+      !> What lock_file gave.
+      integer, intent(in) :: fd
+      call c_unlock_file(int(fd, c_int))
+   end subroutine unlock_file
+
+   !> Whether another open file holds a lock on the existing file `path` (HDF5 locks every file it
+   !> has open: another run writing it, or a program reading it). Nothing is written.
+   logical function file_in_use(path)
+      !> File.
+      character(len=*), intent(in) :: path
+      file_in_use = c_file_in_use(path//c_null_char) == 1
+   end function file_in_use
+
+   !> Whether HDF5 locks the files it opens (not when HDF5_USE_FILE_LOCKING is FALSE or 0).
+   logical function hdf5_locks()
+      hdf5_locks = c_hdf5_locks() == 1
+   end function hdf5_locks
 
    !> Whether two existing paths name the same file (same device and inode), however spelt.
    function same_file(a, b) result(same)

@@ -20,6 +20,10 @@ from test_cli import PROGRAM, SHORT, beamstops, complete_output, one_error_line,
 
 pytestmark = pytest.mark.skipif(PROGRAM is None, reason="the beamstops program is not on PATH")
 
+#: A run of several seconds (30,000,000 steps), checkpointed.
+LONG = "&time dt=1e-6, t_end=30 /\n&output record_every=100, checkpoint_every=1000000 /\n"
+
+
 def wait_for(path: Path, process: subprocess.Popen[str], size: int = 1) -> bool:
     """Whether `path` reached `size` bytes while `process` still runs."""
     deadline = time.time() + 60
@@ -28,6 +32,57 @@ def wait_for(path: Path, process: subprocess.Popen[str], size: int = 1) -> bool:
             return True
         time.sleep(0.005)
     return False
+
+
+@pytest.mark.parametrize("locking", [None, "FALSE"], ids=["HDF5 locks", "HDF5_USE_FILE_LOCKING=FALSE"])
+def test_a_second_run_to_a_live_output_is_refused_before_it_touches_anything(locking: str | None,
+                                                                             tmp_path: Path) -> None:
+    env = dict(os.environ)
+    if locking is not None:
+        env["HDF5_USE_FILE_LOCKING"] = locking
+    scene = write(tmp_path, LONG, name="s.nml")
+    partial, checkpoint = tmp_path / "s.h5.partial", tmp_path / "s.h5.checkpoint"
+    first = subprocess.Popen([PROGRAM, "run", scene.name], cwd=tmp_path, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        if not (wait_for(partial, first, 1 << 20) and wait_for(checkpoint, first)):
+            pytest.skip("the first run ended before the second started")
+        for args in (["run", scene.name], ["run", scene.name, "--restart"]):
+            second = subprocess.run([PROGRAM, *args], cwd=tmp_path, capture_output=True, text=True, timeout=60,
+                                    env=env)
+            assert second.returncode == 4, second.stderr
+            assert one_error_line(second) == (
+                "beamstops: error: s.h5 (&output file of s.nml, by default the input's name with .h5): s.h5.partial "
+                "is being written by another run (a process holds a lock on it: another beamstops run, or a program "
+                "reading it); allowed: wait for it to end, or choose another output (-o OUT.h5, or &output file)")
+            assert checkpoint.exists()  # the first run's checkpoint is left to it
+        if first.poll() is not None:
+            pytest.skip("the first run ended while the second ran")
+        out, err = first.communicate(timeout=120)
+    finally:
+        if first.poll() is None:
+            first.kill()
+            first.wait()
+    assert first.returncode == 0, err
+    with h5py.File(tmp_path / "s.h5") as f:  # the first run's file, whole
+        assert f.attrs["status"] == b"complete"
+        t = f["tip/t"][:]
+        assert t.shape == (300001,) and t[0] == 0 and np.all(np.diff(t) > 0)
+
+
+def test_a_partial_file_another_process_holds_is_refused_untouched(tmp_path: Path) -> None:
+    """HDF5 holds a lock on every file it has open (here h5py, reading the partial file of an
+    interrupted run): the run does not open it for writing, which would empty it."""
+    partial = tmp_path / "out.h5.partial"
+    earlier, _ = complete_output(tmp_path, "earlier.h5")
+    earlier.rename(partial)
+    before = partial.read_bytes()
+    scene = write(tmp_path, SHORT)
+    with h5py.File(partial, "r"):
+        done = beamstops("run", scene, "-o", "out.h5", cwd=tmp_path)
+    assert done.returncode == 4
+    assert "out.h5.partial is being written by another run" in one_error_line(done)
+    assert partial.read_bytes() == before and not (tmp_path / "out.h5").exists()
 
 
 def victim(tmp_path: Path) -> tuple[Path, bytes]:

@@ -21,7 +21,8 @@ module beamstops_recorder_hdf5
    use beamstops_model, only: model_type
    use beamstops_summary, only: run_summary, status_running, status_complete, status_diverged, status_failed
    use beamstops_files, only: same_file, replace_file, creation_error, raise_hdf5_eoa, &
-      & path_kind, kind_name, path_missing, path_regular, path_link, path_folder, not_writable_here
+      & path_kind, kind_name, path_missing, path_regular, path_link, path_folder, lock_file, unlock_file, &
+      & file_in_use, hdf5_locks, lock_busy, not_writable_here
    use beamstops_recorder_hdf5_vector, only: write_vector
    use beamstops_recorder, only: recorder_type, n_columns, col_t, all_finite
    use beamstops_attributes, only: attribute_list, kind_real, kind_int, kind_logical, kind_text
@@ -48,6 +49,11 @@ module beamstops_recorder_hdf5
       character(len=:), allocatable :: path
       !> The file written as the run goes (partial_path(path)).
       character(len=:), allocatable :: partial
+      !> The descriptor of the recorder's own lock on the partial file (lock_file; -1: none), taken
+      !> before the file is created or reopened. Kept until the end when HDF5 does not lock its
+      !> files (HDF5_USE_FILE_LOCKING=FALSE), else released just before HDF5 opens the file and
+      !> takes its own lock (two locks of one process on one file would conflict).
+      integer :: lock = -1
       integer(hid_t) :: file = -1
       integer(hsize_t) :: written = 0, snaps_written = 0
       integer :: fill = 0
@@ -105,6 +111,8 @@ contains
       !> Set when the file cannot be created (with no writer thread; else the first wait tells).
       type(error_type), allocatable, intent(out) :: error
       call prepare(self, path, scene, model)
+      call hold_partial(self, .true., error)
+      if (allocated(error)) return
       call allocate_stops_buffer(self)
       select type (self)
       type is (hdf5_recorder)
@@ -140,6 +148,7 @@ contains
       integer(hid_t) :: group
       logical :: ok
       associate (scene => self%scene)
+         if (hdf5_locks()) call release_partial(self)
          call h5fcreate_f(self%partial, H5F_ACC_TRUNC_F, self%file, hdferr)
          if (hdferr /= 0) then
             self%file = -1
@@ -275,6 +284,7 @@ contains
       ! the file's creation, when the writer thread carries it out, is waited for here at the latest
       call wait_orders(self%writer)
       if (self%file < 0) then
+         call release_partial(self)
          if (self%failed) call fatal_error(error, self%message)
          return
       end if
@@ -301,6 +311,7 @@ contains
       end if
       call close_file(self)
       if (self%failed) then
+         call release_partial(self)
          call fatal_error(error, self%message)
          return
       end if
@@ -308,7 +319,38 @@ contains
          call replace_file(self%partial, self%path, ok)
          if (.not. ok) call fatal_error(error, self%path//': cannot move '//self%partial//' onto it')
       end if
+      call release_partial(self)
    end subroutine finish
+
+   !> Take the recorder's own lock on its partial file (created empty when missing and `create`)
+   !> before anything is written to it: a partial file another process holds a lock on (another
+   !> run writing it) is refused, untouched. A file system without locks takes none.
+   subroutine hold_partial(self, create, error)
+      class(hdf5_recorder), intent(inout) :: self
+      logical, intent(in) :: create
+      type(error_type), allocatable, intent(out) :: error
+      self%lock = lock_file(self%partial, create)
+      if (self%lock == lock_busy) then
+         call fail(self, busy_partial(self%partial))
+         call fatal_error(error, self%message)
+      end if
+   end subroutine hold_partial
+
+   !> Release the recorder's own lock on its partial file, if it holds one.
+   subroutine release_partial(self)
+      class(hdf5_recorder), intent(inout) :: self
+      call unlock_file(self%lock)
+      self%lock = -1
+   end subroutine release_partial
+
+   !> What a partial file another process holds a lock on says.
+   pure function busy_partial(partial) result(what)
+      character(len=*), intent(in) :: partial
+      character(len=:), allocatable :: what
+      what = partial//' is being written by another run (a process holds a lock on it: another beamstops run, '// &
+         & 'or a program reading it); allowed: wait for it to end, or choose another output (-o OUT.h5, or '// &
+         & '&output file)'
+   end function busy_partial
 
    !> Close the datasets and the file (so that closing writes everything and says so), once the
    !> writer is done with them.
@@ -361,12 +403,16 @@ contains
       integer :: hdferr, i
       logical :: stale, raised
       call prepare(self, path, scene, model)
+      call hold_partial(self, .false., error)
+      if (allocated(error)) return
       ! a run killed while HDF5 flushed may have left indexes past the allocation the file records
       raised = raise_hdf5_eoa(self%partial)
+      if (hdf5_locks()) call release_partial(self)
       call h5fopen_f(self%partial, H5F_ACC_RDWR_F, self%file, hdferr)
       if (hdferr /= 0) then
          call fail(self, 'cannot reopen '//self%partial//', the output of the interrupted run (a run killed while '// &
             & 'HDF5 wrote it may leave it unreadable); run without --restart to start over')
+         call release_partial(self)
          call fatal_error(error, self%message)
          return
       end if
@@ -400,6 +446,7 @@ contains
          if (hdferr /= 0) call fail(self, 'cannot clear /'//trim(end_groups(i))//' of the killed attempt in '// &
             & self%partial)
       end do
+      if (self%failed) call release_partial(self)
       if (self%failed) call fatal_error(error, self%message)
 
    contains
@@ -450,10 +497,11 @@ contains
    !> file (a FIFO, a socket, a device: refused without being opened) or not a beamstops output
    !> (an HDF5 file with the root attributes `version`, `status` and `scene` and the dataset
    !> /tip/t; a symbolic link there is replaced as a name, what it leads to is tested); at the
-   !> partial path, the input file, a symbolic link, anything but a regular file, and a file that
-   !> is neither empty, nor an HDF5 file that cannot be opened, nor a beamstops output (an empty
-   !> or unreadable HDF5 file there is taken for the partial output of an earlier run, which a
-   !> kill may have left empty and a failed write unreadable); a partial file the system
+   !> partial path, the input file, a symbolic link, anything but a regular file, a file another
+   !> process holds a lock on (another run writing it: HDF5 locks the files it has open), and a
+   !> file that is neither empty, nor an HDF5 file that cannot be opened, nor a beamstops output
+   !> (an empty or unreadable HDF5 file there is taken for the partial output of an earlier run,
+   !> which a kill may have left empty and a failed write unreadable); a partial file the system
    !> will not let the run create (the message gives its reason: name too long, no such folder,
    !> permission denied, read-only file system, ...). The message names the output and where its
    !> name came from (`origin`), and says why.
@@ -505,6 +553,10 @@ contains
       if (len(why) > 0) then
          call fatal_error(error, named//partial//', where the run writes until it is done, '//why// &
             & '; refusing to write it (move it away)')
+         return
+      end if
+      if (file_in_use(partial)) then
+         call fatal_error(error, named//busy_partial(partial))
          return
       end if
       why = not_an_output(partial, strict=.false.)
