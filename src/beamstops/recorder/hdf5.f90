@@ -20,7 +20,7 @@ module beamstops_recorder_hdf5
    use beamstops_scene, only: scene_type, law_name, law_compliance, stop_count, steps_of
    use beamstops_model, only: model_type
    use beamstops_summary, only: run_summary, status_running, status_complete, status_diverged, status_failed
-   use beamstops_files, only: same_file, replace_file, creation_error, raise_hdf5_eoa, &
+   use beamstops_files, only: same_file, replace_file, remove_file, creation_error, raise_hdf5_eoa, &
       & path_kind, kind_name, path_missing, path_regular, path_link, path_folder, lock_file, unlock_file, &
       & file_in_use, hdf5_locks, lock_busy, not_writable_here
    use beamstops_recorder_hdf5_vector, only: write_vector
@@ -111,8 +111,15 @@ contains
       !> Set when the file cannot be created (with no writer thread; else the first wait tells).
       type(error_type), allocatable, intent(out) :: error
       call prepare(self, path, scene, model)
-      call hold_partial(self, .true., error)
+      ! A partial file of an earlier run (check_output_path found it one, or empty) is removed
+      ! under the recorder's lock, and HDF5 creates the file anew, exclusively: never truncated. A
+      ! file truncated and then written makes ext4 write it back when it is closed (its
+      ! auto_da_alloc), 50 ms of the Figure 4 run's end; and two runs started at once cannot both
+      ! create it.
+      call hold_partial(self, error)
       if (allocated(error)) return
+      if (path_kind(self%partial, follow=.false.) /= path_missing) call remove_file(self%partial)
+      call release_partial(self)
       call allocate_stops_buffer(self)
       select type (self)
       type is (hdf5_recorder)
@@ -148,14 +155,20 @@ contains
       integer(hid_t) :: group
       logical :: ok
       associate (scene => self%scene)
-         if (hdf5_locks()) call release_partial(self)
-         call h5fcreate_f(self%partial, H5F_ACC_TRUNC_F, self%file, hdferr)
+         call h5fcreate_f(self%partial, H5F_ACC_EXCL_F, self%file, hdferr)
          if (hdferr /= 0) then
             self%file = -1
-            call fail(self, 'cannot create '//self%partial//': '//creation_failure(self%partial))
+            if (path_kind(self%partial, follow=.false.) /= path_missing) then
+               call fail(self, busy_partial(self%partial))
+            else
+               call fail(self, 'cannot create '//self%partial//': '//creation_failure(self%partial))
+            end if
             self%order%failed = .true.
             return
          end if
+         ! HDF5 holds a lock on the file it has open; without it (HDF5_USE_FILE_LOCKING=FALSE),
+         ! the recorder's own, for the whole run
+         if (.not. hdf5_locks()) call hold_partial_quietly(self)
          call open_reservation(self%order%space, self%partial)
          do i = 1, 3
             call h5gcreate_f(self%file, trim(group_names(i)), group, hdferr)
@@ -322,19 +335,25 @@ contains
       call release_partial(self)
    end subroutine finish
 
-   !> Take the recorder's own lock on its partial file (created empty when missing and `create`)
-   !> before anything is written to it: a partial file another process holds a lock on (another
-   !> run writing it) is refused, untouched. A file system without locks takes none.
-   subroutine hold_partial(self, create, error)
+   !> Take the recorder's own lock on its partial file, when there is one, before anything is
+   !> done to it: a partial file another process holds a lock on (another run writing it) is
+   !> refused, untouched. A file system without locks takes none.
+   subroutine hold_partial(self, error)
       class(hdf5_recorder), intent(inout) :: self
-      logical, intent(in) :: create
       type(error_type), allocatable, intent(out) :: error
-      self%lock = lock_file(self%partial, create)
+      self%lock = lock_file(self%partial, .false.)
       if (self%lock == lock_busy) then
          call fail(self, busy_partial(self%partial))
          call fatal_error(error, self%message)
       end if
    end subroutine hold_partial
+
+   !> Take the recorder's own lock on its partial file, just created by this run (nothing to
+   !> refuse: another run that created it would have made the creation fail).
+   subroutine hold_partial_quietly(self)
+      class(hdf5_recorder), intent(inout) :: self
+      self%lock = lock_file(self%partial, .false.)
+   end subroutine hold_partial_quietly
 
    !> Release the recorder's own lock on its partial file, if it holds one.
    subroutine release_partial(self)
@@ -403,7 +422,7 @@ contains
       integer :: hdferr, i
       logical :: stale, raised
       call prepare(self, path, scene, model)
-      call hold_partial(self, .false., error)
+      call hold_partial(self, error)
       if (allocated(error)) return
       ! a run killed while HDF5 flushed may have left indexes past the allocation the file records
       raised = raise_hdf5_eoa(self%partial)
