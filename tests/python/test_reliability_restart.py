@@ -298,3 +298,36 @@ def test_an_unreadable_partial_output_is_refused_and_a_plain_run_starts_over(tmp
     again = run("run", scene, cwd=tmp_path)
     assert again.returncode == 0, again.stderr
     assert beamstops.load(tmp_path / "cut.h5").attrs["steps"] == 200000
+
+
+def test_a_partial_output_older_than_its_checkpoint_is_refused(tmp_path: Path) -> None:
+    """A partial file with fewer records than its checkpoint counts (restored from a copy, or
+    left by a power cut) is refused by --restart, untouched: it had been extended with zeros and
+    called complete."""
+    scene = write_scene(tmp_path, "old", t_end=4.0)
+    partial, checkpoint = tmp_path / "old.h5.partial", tmp_path / "old.h5.checkpoint"
+    kill_after_first_checkpoint(scene, checkpoint)
+    early = tmp_path / "early.partial"
+    shutil.copy2(partial, early)
+    with h5py.File(early) as f:
+        early_records = f["tip/t"].shape[0]
+    # the resumed run moves on past its next checkpoint, which then counts more records
+    first = checkpoint.stat().st_mtime_ns
+    process = subprocess.Popen([PROGRAM, "run", str(scene), "--restart"], cwd=tmp_path, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+    deadline = time.time() + 60
+    while process.poll() is None and (stat_or_none(checkpoint) is None or checkpoint.stat().st_mtime_ns == first) \
+            and time.time() < deadline:
+        time.sleep(0.001)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    if not checkpoint.exists() or checkpoint.stat().st_mtime_ns == first:
+        pytest.skip("the resumed run ended before its next checkpoint")
+    shutil.copy2(early, partial)
+    before = partial.read_bytes()
+    done = run("run", scene, "--restart", cwd=tmp_path)
+    assert done.returncode == 4 and done.stdout == ""
+    assert done.stderr.count("\n") == 1, done.stderr
+    assert f"holds {early_records} rows of /tip/t, fewer than the " in done.stderr
+    assert "run without --restart to start over" in done.stderr
+    assert partial.read_bytes() == before and not (tmp_path / "old.h5").exists()

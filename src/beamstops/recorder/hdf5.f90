@@ -17,7 +17,7 @@ module beamstops_recorder_hdf5
    use hdf5
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
-   use beamstops_scene, only: scene_type, law_name, law_compliance, stop_count, steps_of
+   use beamstops_scene, only: scene_type, law_name, law_compliance, stop_count, steps_of, fmt_int
    use beamstops_model, only: model_type
    use beamstops_summary, only: run_summary, status_running, status_complete, status_diverged, status_failed
    use beamstops_files, only: same_file, replace_file, remove_file, creation_error, raise_hdf5_eoa, &
@@ -474,12 +474,36 @@ contains
          character(len=*), intent(in) :: name
          integer(hid_t), intent(out) :: dset
          integer(ik), intent(in) :: dims(:)
-         integer(hid_t) :: access
-         integer :: ignored
+         integer(hid_t) :: access, space
+         integer(hsize_t) :: held(2), most(2)
+         integer :: ignored, rank
          access = direct_access()
          call h5dopen_f(self%file, name, dset, hdferr, access)
          call h5pclose_f(access, ignored)
-         if (hdferr == 0) call h5dset_extent_f(dset, int(dims, hsize_t), hdferr)
+         if (hdferr /= 0) then
+            call fail(self, self%partial//', the output of the interrupted run, has no series '//name)
+            return
+         end if
+         ! the file must hold at least the rows its checkpoint counts (a partial file older than
+         ! the checkpoint, restored or copied, would be extended with zeros and called complete)
+         held = 0
+         call h5dget_space_f(dset, space, hdferr)
+         if (hdferr == 0) call h5sget_simple_extent_ndims_f(space, rank, hdferr)
+         if (hdferr == 0 .and. rank == size(dims)) call h5sget_simple_extent_dims_f(space, held(:rank), most(:rank), hdferr)
+         call h5sclose_f(space, ignored)
+         if (hdferr < 0 .or. rank /= size(dims)) then
+            call fail(self, self%partial//', the output of the interrupted run, has no series '//name)
+            return
+         end if
+         if (held(rank) < int(dims(size(dims)), hsize_t)) then
+            call fail(self, self%partial//', the output of the interrupted run, holds '// &
+               & fmt_int(int(held(rank), ik))//' rows of '//name//', fewer than the '//fmt_int(dims(size(dims)))// &
+               & ' its checkpoint counts (the file is older than the checkpoint: restored or copied?); run '// &
+               & 'without --restart to start over')
+            hdferr = -1
+            return
+         end if
+         call h5dset_extent_f(dset, int(dims, hsize_t), hdferr)
          if (hdferr /= 0) call fail(self, self%partial//', the output of the interrupted run, has no series '//name)
       end subroutine reopen_series
    end subroutine reopen
