@@ -995,7 +995,13 @@ contains
       character(len=*), parameter :: forms(8) = [character(len=7) :: '.true.', '.false.', 't', 'f', '.t.', '.f.', &
          & 'true', 'false']
       character(len=:), allocatable :: v
+      integer :: star
       v = lower(assignment_text(text))
+      ! a repeat count before it (1*T) is Fortran's, as for any other value
+      star = index(v, '*')
+      if (star > 1) then
+         if (verify(v(:star - 1), '0123456789') == 0) v = v(star + 1:)
+      end if
       logical_text = len(v) > 0 .and. len(v) <= len(forms) .and. any(forms == v)
    end function logical_text
 
@@ -1045,10 +1051,11 @@ contains
    end function text_capacity
 
    !> The length of a text value as gfortran reads it: between its quotes ('' or "" inside
-   !> counting one), or up to a blank, comma or / when it has none.
+   !> counting one) up to its last character not a blank, or up to a blank, comma or / when it
+   !> has none.
    pure integer function text_length(value)
       character(len=*), intent(in) :: value
-      integer :: first, i
+      integer :: first, i, count
       character :: quote
       first = verify(value, ' ')
       text_length = 0
@@ -1058,14 +1065,17 @@ contains
          text_length = scan(value(first:)//' ', ' ,/') - 1
          return
       end if
+      ! blanks at its end do not count: the reader drops them (trim), and so may gfortran
       i = first + 1
+      count = 0
       do while (i <= len(value))
          if (value(i:i) == quote) then
             if (i == len(value)) exit
             if (value(i + 1:i + 1) /= quote) exit
             i = i + 1
          end if
-         text_length = text_length + 1
+         count = count + 1
+         if (value(i:i) /= ' ') text_length = count
          i = i + 1
       end do
    end function text_length

@@ -538,6 +538,10 @@ contains
          & '63 characters') > 0, failure%message)
       if (allocated(error)) return
       deallocate (failure)
+      ! blanks at the end of a word do not count (the reader drops them)
+      call scene_from_text("&time load_rule = 'centered"//repeat(' ', 70)//"' /", 'blanks', scene, failure)
+      call check(error, .not. allocated(failure), 'a word with 70 blanks after it read')
+      if (allocated(error)) return
       ! at the limit: read whole (a quote doubled inside counts one)
       call scene_from_text("&output file = '"//repeat('c', 4090)//"''s.h5' /", 'limit', scene, failure)
       call check(error, .not. allocated(failure), 'a path of 4,095 characters read')
@@ -833,6 +837,11 @@ contains
          call check(error, scene%statistics .eqv. scan(good(i)(1:2), 'tT') > 0, 'enabled = '//trim(good(i)))
          if (allocated(error)) return
       end do
+      if (allocated(error)) return
+      ! a repeat count before a logical, as before any value
+      call expect_read('&statistics enabled = 1*T /', error)
+      if (allocated(error)) return
+      call expect_read('&time allow_unstable = 1*.false. /', error)
    end subroutine test_logical_forms
 
    !> A null value leaves its element as it was: `nodes = 2*` was read as no stops along the

@@ -478,6 +478,15 @@ def test_an_image_overwrites_only_an_image(output: Path, tmp_path: Path, result:
     assert (tmp_path / "empty.png").read_bytes()[:8] == PNG
 
 
+def test_an_image_is_never_written_to_a_fifo(output: Path, tmp_path: Path) -> None:
+    """-o naming a FIFO: refused at once (reading its first bytes to tell what it is had hung)."""
+    os.mkfifo(tmp_path / "pipe.png")
+    done = plot_command(str(output), "-o", "pipe.png", cwd=tmp_path)
+    assert done.returncode == 1 and done.stdout == "", done.stderr
+    assert done.stderr.strip() == ("beamstops: error: pipe.png: exists and is not a regular file (a FIFO, a device or "
+                                   "a socket); refusing to write an image there; name another file")
+
+
 @pytest.mark.parametrize("dpi", ["0", "-5", "100000", "abc"])
 def test_a_resolution_out_of_range_is_refused_by_the_command_line(dpi: str, output: Path, tmp_path: Path) -> None:
     """--dpi 100000 ended in a MemoryError traceback from the renderer; 0 in matplotlib's words."""

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 import os
+import stat
 from pathlib import Path
 from typing import Any, Callable, Optional
 
@@ -377,10 +378,17 @@ def refuse_data_file(path: Path) -> None:
     table): FileExistsError naming it. An empty file or an image (a plot drawn before) is
     written over."""
     try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return  # not there (or unreachable): savefig says what is wrong when it writes
+    if not stat.S_ISREG(mode):  # a FIFO or a terminal would hang the read, a device take the image
+        raise FileExistsError(f"{path}: exists and is not a regular file (a FIFO, a device or a socket); refusing "
+                              f"to write an image there; name another file")
+    try:
         with open(path, "rb") as f:
             head = f.read(64)
     except OSError:
-        return  # not there (or unreadable): savefig says what is wrong when it writes
+        return  # unreadable: savefig says what is wrong when it writes
     if head.startswith(_HDF5_SIGNATURE):
         raise FileExistsError(f"{path}: exists and is an HDF5 file (a run's output?); refusing to overwrite it "
                               f"with an image; name another file")
