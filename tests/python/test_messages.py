@@ -33,3 +33,10 @@ def test_python_raises_the_same_one_line_message() -> None:
         Scene.from_text("&output file = 'a\x01b.h5' /\n&time dt = -1 /\n", source="scene\nfrom text")
     message = str(caught.value)
     assert "\n" not in message and "\x01" not in message
+
+
+def test_a_nul_in_python_text_is_refused_as_in_a_file() -> None:
+    """Scene.from_text read a text only up to a NUL (the &mesh after it was dropped unsaid); the
+    program refuses such a file as binary, and so does Python now."""
+    with pytest.raises(ValueError, match="holds binary characters"):
+        Scene.from_text("&time dt=1e-4 /\x00&mesh elements=5 /")

@@ -407,6 +407,55 @@ def test_the_lock_of_a_dead_sweep_is_taken_over(tmp_path: Path, write_spec: Call
     assert f"took over the lock of a sweep that is no longer running (pid {dead.pid} host elsewhere)" in log.getvalue()
 
 
+def children(pid: int) -> list[int]:
+    """The processes whose parent is `pid` (/proc)."""
+    found = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            found.append(int(stat.parent.name))
+    return found
+
+
+def test_a_sweep_killed_with_sigkill_takes_its_workers_with_it(tmp_path: Path,
+                                                                write_spec: Callable[..., Path]) -> None:
+    """SIGKILL to the sweep's own process (an out-of-memory killer, `kill -9`): its workers get
+    SIGTERM from the kernel and end (they went on idle for good, holding the folder's lock they
+    inherited, and every resume was refused), and a resume then runs."""
+    text = """
+[scene]
+elements = 10
+dt = 2e-5
+t_end = 4000.0
+record_every = 100000
+[axes]
+amplitude = { start = 0.10, stop = 0.13, step = 0.01 }
+"""
+    spec_path = write_spec(text)
+    out = tmp_path / "out"
+    command = [sys.executable, "-m", "beamstops", "sweep", str(spec_path), "-o", str(out), "-j", "2"]
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 60
+    while not list((out / "points").glob("*.nml")) and time.monotonic() < deadline:
+        time.sleep(0.01)
+    time.sleep(0.5)
+    workers = children(process.pid)
+    assert workers, "the sweep has no worker processes"
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    deadline = time.monotonic() + 60
+    while any(Path(f"/proc/{pid}").exists() for pid in workers) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not any(Path(f"/proc/{pid}").exists() for pid in workers), "workers outlived their sweep"
+    from beamstops.sweep.runner import FolderLock
+
+    with FolderLock(out):  # taken: no worker holds it any more
+        pass
+
+
 def test_without_flock_the_pid_in_the_lock_file_decides(tmp_path: Path, write_spec: Callable[..., Path],
                                                         monkeypatch: pytest.MonkeyPatch) -> None:
     import errno

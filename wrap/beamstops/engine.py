@@ -85,7 +85,10 @@ def canonical(text: str, source: str = "scene", carried: Iterable[str] = ()) -> 
     than gives anew; the engine drops such a key where it would do nothing (a spring without the
     compliance law, ``&damping modes`` without ``ratio``) instead of refusing it."""
     words = " ".join(carried) or " "
-    result, status, message = engine_call(_engine.bs_scene, text.encode("utf-8"), os.fsencode(source),
+    # f2py hands the engine a text up to its first NUL (what follows was dropped unsaid): a NUL
+    # goes as another control character, which the engine refuses as binary as it refuses NUL
+    result, status, message = engine_call(_engine.bs_scene, text.replace("\x00", "\x01").encode("utf-8"),
+                                          os.fsencode(source),
                                           words.encode("utf-8"))
     _check(status, message)
     return _text(result)

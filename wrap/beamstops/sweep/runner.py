@@ -45,7 +45,7 @@ from typing import Any, Optional, TextIO
 
 from .reductions import columns as reduction_columns
 from .spec import Spec
-from .worker import FINISHED, read_status, run_batch
+from .worker import FINISHED, arm, read_status, run_batch
 
 __all__ = ["run_sweep", "read_summary", "find_program", "make_executor", "Outcome", "FolderLock", "MANIFEST",
            "LOCK", "EXECUTORS"]
@@ -139,7 +139,8 @@ def make_executor(kind: str = "auto", jobs: Optional[int] = None) -> tuple[Execu
         raise ValueError(f"-j {jobs}: the number of workers must be >= 1")
     if kind == "local":
         workers = jobs or os.cpu_count() or 1
-        return ProcessPoolExecutor(max_workers=workers), f"{workers} local process{'es' if workers > 1 else ''}", workers
+        return (ProcessPoolExecutor(max_workers=workers, initializer=arm),
+                f"{workers} local process{'es' if workers > 1 else ''}", workers)
     if kind == "mpi":
         try:
             from mpi4py import MPI

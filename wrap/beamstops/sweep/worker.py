@@ -129,8 +129,9 @@ def _run(command: list[str], *, timeout: Optional[float],
     return subprocess.CompletedProcess(command, process.returncode, stdout, stderr)
 
 
-def _arm() -> None:
-    """Make SIGTERM stop this worker and its running program (the sweep stops its workers so)."""
+def arm() -> None:
+    """Make SIGTERM stop this worker and its running program (the sweep stops its workers so),
+    and the sweep's own death send it (the local pool's initializer, and every point's start)."""
     global _ARMED
     if _ARMED:
         return
@@ -138,14 +139,32 @@ def _arm() -> None:
     import threading
 
     # only in a worker process of a local pool (never in the caller's own process)
-    if multiprocessing.parent_process() is not None and threading.current_thread() is threading.main_thread():
+    parent = multiprocessing.parent_process()
+    if parent is not None and threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _on_term)
+        _die_with(parent.pid)
     _ARMED = True
+
+
+def _die_with(parent: Optional[int]) -> None:
+    """SIGTERM to this worker when the sweep's process dies (Linux's PR_SET_PDEATHSIG): a sweep
+    killed with SIGKILL cannot stop its workers, which went on idle, holding the folder's lock
+    (inherited when they were forked) so that no resume could start."""
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        if libc.prctl(1, int(signal.SIGTERM), 0, 0, 0) != 0:  # 1: PR_SET_PDEATHSIG
+            return
+    except (OSError, AttributeError):
+        return  # not Linux: the workers end with their pool
+    if parent is not None and os.getppid() != parent:  # the sweep died before the request
+        os.kill(os.getpid(), signal.SIGTERM)
 
 
 def run_point(task: dict[str, Any]) -> dict[str, Any]:
     """Run (or, with ``task['reduce_only']``, only reduce) one point; never raises an Exception."""
-    _arm()
+    arm()
     folder = Path(task["folder"])
     name = task["name"]
     nml, h5, record_path = folder / f"{name}.nml", folder / f"{name}.h5", folder / f"{name}.json"
@@ -228,7 +247,7 @@ def run_batch(tasks: list[dict[str, Any]]) -> dict[str, Any]:
     that share A in lockstep), then reduce each; the points that did not end with a finished
     output run again one at a time (run_point). Returns ``{"records": [...], "lockstep": n}``
     with n the points the engine ran in lockstep groups. Never raises an Exception."""
-    _arm()
+    arm()
     if len(tasks) == 1:
         return {"records": [run_point(tasks[0])], "lockstep": 0}
     lockstep = 0
