@@ -356,8 +356,9 @@ int beamstops_creation_errno(const char *path)
     int fd, code = 0;
     if (access(path, F_OK) != 0) {
         fd = open(path, O_WRONLY | O_CREAT | O_EXCL, 0666);
-        if (fd < 0)
-            return errno;
+        if (fd < 0) /* created since by another process (a run started at the same time): the
+                       recorder's exclusive creation tells who has it */
+            return errno == EEXIST ? 0 : errno;
         close(fd);
         unlink(path);
         return 0;
