@@ -176,8 +176,9 @@ contains
    end subroutine continue_run
 
    !> What follows the time loop of a run (continue_run's, or a lockstep group's for each of its
-   !> members): a complete run of an &ensemble runs its members 2..K; a recorder that could not
-   !> write makes the run 'failed' with the recorder's message.
+   !> members): a complete run of an &ensemble runs its members 2..K (members that cannot run make
+   !> it 'failed' with their message); a recorder that could not write makes the run 'failed' with
+   !> the recorder's message.
    subroutine close_run(scene, model, recorder, summary, error)
       !> Validated scene.
       type(scene_type), intent(in) :: scene
@@ -192,7 +193,12 @@ contains
       if (summary%status == status_complete .and. scene%members > 1 .and. scene%statistics .and. &
          & .not. recorder%failed) then
          call run_members(scene, model, summary, error)
-         if (allocated(error)) return
+         if (allocated(error)) then
+            ! the output says so: its status was written 'complete' though the run failed
+            summary%status = status_failed
+            summary%message = error%message
+            return
+         end if
       end if
       call recorder_outcome(recorder, summary, error)
    end subroutine close_run

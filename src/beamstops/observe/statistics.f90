@@ -246,7 +246,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       !> Where the values came from, for messages (default 'statistics').
       character(len=*), intent(in), optional :: source
-      integer :: j, b, m
+      integer :: j, b, m, status
       if (present(source)) then
          call validate_statistics(transient, t_end, batches, bins, 0.0_wp, lower, upper, source, error)
       else
@@ -276,7 +276,15 @@ contains
       stats%next_edge = transient
       allocate (stats%hist(0:bins - 1), stats%contact(m), stats%sr(m), stats%srr(m), stats%rmax(m), stats%se(m))
       call reset(stats)
-      allocate (stats%bn(b), stats%bsu(b), stats%bsuu(b), stats%bumin(b), stats%bumax(b), stats%bhist(bins, b))
+      allocate (stats%bn(b), stats%bsu(b), stats%bsuu(b), stats%bumin(b), stats%bumax(b), stats%bhist(bins, b), &
+         & stat=status)
+      if (status /= 0) then
+         ! the histograms of the batches are the statistics' largest table (an ensemble keeps one a member)
+         call fatal_error(error, 'not enough memory for the histograms of the statistics: bins x batches = '// &
+            & fmt_int(int(bins, ik)*b)//' values, '//fmt_real(8*real(bins, wp)*b/1.0e9_wp, 4)// &
+            & ' GB (&statistics bins, batches; &ensemble members keep one each); allowed: fewer bins, batches or members')
+         return
+      end if
       allocate (stats%bcontact(m, b), stats%bsr(m, b), stats%bsrr(m, b), stats%brmax(m, b), stats%bse(m, b))
       allocate (stats%bshocks(m, b), stats%brebounds(m, b), stats%bdur(m, b), stats%bdurmin(m, b), &
          & stats%bdurmax(m, b), stats%bimp(m, b))
