@@ -971,9 +971,11 @@ contains
          end if
          first = last + 1
          line_no = line_no + 1
-         if (len(line) > 0) then
-            if (line(len(line):) == achar(13)) line = line(:len(line) - 1)
-         end if
+         ! a line's end may carry carriage returns (\r\n, or \r\r\n from a file converted twice)
+         do while (len(line) > 0)
+            if (line(len(line):) /= achar(13)) exit
+            line = line(:len(line) - 1)
+         end do
          quoted = .false.
          quote = ' '
          i = 1

@@ -67,7 +67,8 @@ contains
          & test_null_values), &
          & new_unittest('an element of a list given twice is refused; distinct elements are read', test_elements_twice), &
          & new_unittest('a subscript or a substring on a key of one value is malformed', test_scalar_subscript), &
-         & new_unittest('&ensemble seed: the range a refused seed names is the range read', test_seed_range) &
+         & new_unittest('&ensemble seed: the range a refused seed names is the range read', test_seed_range), &
+         & new_unittest('lines ending in several carriage returns are read', test_carriage_returns) &
          & ]
    end subroutine collect_namelist
 
@@ -548,6 +549,19 @@ contains
       if (allocated(error)) return
       call check(error, len(scene%output_file), 4095, 'the whole path kept')
    end subroutine test_long_texts
+
+   !> A file converted to \r\n twice ends its lines in \r\r\n: its groups were told as text
+   !> outside any group.
+   subroutine test_carriage_returns(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: ends = achar(13)//achar(13)//new_line('a')
+      type(scene_type) :: scene
+      type(error_type), allocatable :: failure
+      call scene_from_text('&time dt = 1e-4 /'//ends//ends//'&mesh elements = 5 /'//ends, 'crcr', scene, failure)
+      call check(error, .not. allocated(failure), 'read')
+      if (allocated(error)) return
+      call check(error, scene%elements, 5, 'elements of the group after the blank line')
+   end subroutine test_carriage_returns
 
    !> Texts far larger than any scene (the reader takes up to 64 MB): each is refused with its
    !> message rather than a crash (a line of 16 MB overflowed the stack) or minutes of copying

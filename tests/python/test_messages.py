@@ -40,3 +40,13 @@ def test_a_nul_in_python_text_is_refused_as_in_a_file() -> None:
     program refuses such a file as binary, and so does Python now."""
     with pytest.raises(ValueError, match="holds binary characters"):
         Scene.from_text("&time dt=1e-4 /\x00&mesh elements=5 /")
+
+
+@pytest.mark.parametrize("capacity", [-1, 0, 2.5, True, 10**12])
+def test_run_refuses_a_shock_capacity_out_of_range(capacity: object) -> None:
+    """beamstops.run's room for the shock log: a whole number from 1 to 1e8 (10**12 had ended in
+    numpy's MemoryError, -1 and 2.5 passed)."""
+    import beamstops
+
+    with pytest.raises(ValueError, match=r"shock_capacity = .* is out of range; allowed: a whole number"):
+        beamstops.run(Scene(t_end=1e-3, dt=1e-4), shock_capacity=capacity)  # type: ignore[arg-type]

@@ -208,6 +208,11 @@ def _observations(scene: Scene, fields: list[str], shocks: np.ndarray, value: np
             "ensemble": tables["ensemble"]}
 
 
+#: Most rows of the shock log :func:`run` makes room for at first (each row a few values; a run
+#: with more shocks runs again with room for every one).
+MAX_SHOCK_CAPACITY = 100_000_000
+
+
 def run(scene: Scene, *, allow_incomplete: bool = False, shock_capacity: int = 4096) -> Result:
     """Run a scene in memory and return its :class:`Result` (no file is written).
 
@@ -217,10 +222,15 @@ def run(scene: Scene, *, allow_incomplete: bool = False, shock_capacity: int = 4
     (a ValueError holding the partial result) unless ``allow_incomplete``. ``shock_capacity``: rows
     of the shock log to make room for (a run with more shocks runs again, with room for every one).
     """
+    if (isinstance(shock_capacity, bool) or not isinstance(shock_capacity, (int, np.integer))
+            or not 1 <= shock_capacity <= MAX_SHOCK_CAPACITY):
+        raise ValueError(f"run: shock_capacity = {shock_capacity!r} is out of range; allowed: a whole number, "
+                         f"1 <= shock_capacity <= {MAX_SHOCK_CAPACITY} (rows of the shock log to make room for; a "
+                         "run with more shocks runs again, with room for every one)")
     text = _scene_text(scene)
     records, snapshots, nodes, stops = sizes(scene)
     width = max(stops, 1, scene.bins + 1)
-    capacity = max(int(shock_capacity), 1)
+    capacity = int(shock_capacity)
     stoppable = interruptible()
     while True:
         (t, tip_u, tip_v, reaction, energy, work, dissipated, damped, snapshot_t, snapshot_x, snapshot_u, stops_x,
