@@ -53,16 +53,15 @@ int beamstops_path_kind(const char *path, int follow)
 
 /* An exclusive flock lock on the regular file at path, taken without waiting (LOCK_NB) on a
    descriptor of its own, opened read-only, never through a symbolic link (O_NOFOLLOW), never
-   waiting on a FIFO (O_NONBLOCK), never truncated; with `create`, a missing file is created
-   empty. Returns the descriptor that holds the lock (>= 0; closing it releases the lock), -1 when
+   waiting on a FIFO (O_NONBLOCK), never created nor truncated. Returns the descriptor that holds the lock (>= 0; closing it releases the lock), -1 when
    another open file holds a lock on the file (HDF5 locks every file it has open: another run
    writing it, or a program reading it), -2 when the file cannot be opened or locked otherwise
    (missing, a file system without locks: no lock is held). */
-int beamstops_lock_file(const char *path, int create)
+int beamstops_lock_file(const char *path)
 {
     int fd, busy;
     do
-        fd = open(path, O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC | (create ? O_CREAT : 0), 0666);
+        fd = open(path, O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
     while (fd < 0 && errno == EINTR);
     if (fd < 0)
         return -2;
@@ -87,7 +86,7 @@ void beamstops_unlock_file(int fd)
    would give -1), 0 otherwise; the probe's own lock is released at once. */
 int beamstops_file_in_use(const char *path)
 {
-    int fd = beamstops_lock_file(path, 0);
+    int fd = beamstops_lock_file(path);
     beamstops_unlock_file(fd);
     return fd == -1;
 }

@@ -31,10 +31,9 @@ module beamstops_files
          integer(c_int), value :: follow
          integer(c_int) :: kind
       end function c_path_kind
-      function c_lock_file(path, create) bind(c, name='beamstops_lock_file') result(fd)
+      function c_lock_file(path) bind(c, name='beamstops_lock_file') result(fd)
          import :: c_char, c_int
          character(kind=c_char), intent(in) :: path(*)
-         integer(c_int), value :: create
          integer(c_int) :: fd
       end function c_lock_file
       subroutine c_unlock_file(fd) bind(c, name='beamstops_unlock_file')
@@ -235,16 +234,14 @@ contains
    end function not_writable_here
 
    !> An exclusive lock (flock) on the regular file `path`, on a descriptor of its own, taken
-   !> without waiting, never through a symbolic link, never truncating the file (files.c,
+   !> without waiting, never through a symbolic link, never creating nor truncating the file (files.c,
    !> beamstops_lock_file): the descriptor that holds it (>= 0, for unlock_file); lock_busy when
    !> another open file holds a lock on it (HDF5 locks the files it has open); another negative
    !> value when it cannot be locked otherwise (no lock held).
-   integer function lock_file(path, create)
+   integer function lock_file(path)
       !> File.
       character(len=*), intent(in) :: path
-      !> Whether a missing file is created (empty).
-      logical, intent(in) :: create
-      lock_file = c_lock_file(path//c_null_char, merge(1_c_int, 0_c_int, create))
+      lock_file = c_lock_file(path//c_null_char)
    end function lock_file
 
    !> Release a lock_file lock (nothing for a negative `fd`).

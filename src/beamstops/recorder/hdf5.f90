@@ -49,10 +49,11 @@ module beamstops_recorder_hdf5
       character(len=:), allocatable :: path
       !> The file written as the run goes (partial_path(path)).
       character(len=:), allocatable :: partial
-      !> The descriptor of the recorder's own lock on the partial file (lock_file; -1: none), taken
-      !> before the file is created or reopened. Kept until the end when HDF5 does not lock its
-      !> files (HDF5_USE_FILE_LOCKING=FALSE), else released just before HDF5 opens the file and
-      !> takes its own lock (two locks of one process on one file would conflict).
+      !> The descriptor of the recorder's own lock on the partial file (lock_file; -1: none): held
+      !> on an earlier run's partial file while it is removed or reopened, released before HDF5
+      !> opens the file and takes its own lock (two locks of one process on one file would
+      !> conflict); taken again on the created file, for the whole run, when HDF5 does not lock its
+      !> files (HDF5_USE_FILE_LOCKING=FALSE).
       integer :: lock = -1
       integer(hid_t) :: file = -1
       integer(hsize_t) :: written = 0, snaps_written = 0
@@ -341,7 +342,7 @@ contains
    subroutine hold_partial(self, error)
       class(hdf5_recorder), intent(inout) :: self
       type(error_type), allocatable, intent(out) :: error
-      self%lock = lock_file(self%partial, .false.)
+      self%lock = lock_file(self%partial)
       if (self%lock == lock_busy) then
          call fail(self, busy_partial(self%partial))
          call fatal_error(error, self%message)
@@ -352,7 +353,7 @@ contains
    !> refuse: another run that created it would have made the creation fail).
    subroutine hold_partial_quietly(self)
       class(hdf5_recorder), intent(inout) :: self
-      self%lock = lock_file(self%partial, .false.)
+      self%lock = lock_file(self%partial)
    end subroutine hold_partial_quietly
 
    !> Release the recorder's own lock on its partial file, if it holds one.
