@@ -12,7 +12,7 @@ program beamstops_main
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use beamstops
    use beamstops_checkpoint, only: checkpoint_path, temporary_path, read_checkpoint, foreign_checkpoint
-   use beamstops_files, only: file_exists, remove_file, same_file, same_path, creation_error, not_writable_here
+   use beamstops_files, only: file_exists, remove_file, same_file, same_path, creation_error
    use beamstops_namelist, only: default_output
    use beamstops_recorder_hdf5, only: partial_path, check_output_path
    use beamstops_run, only: continue_run, continue_reduced
@@ -475,15 +475,13 @@ contains
       if (allocated(error)) return
       named = scene%output_file//' ('//origin//'): '
       checkpoint = checkpoint_path(scene%output_file)
-      why = not_writable_here(checkpoint, input)
-      if (len(why) == 0) why = foreign_checkpoint(checkpoint, temporary=.false.)
+      why = foreign_checkpoint(checkpoint, input, temporary=.false.)
       if (len(why) > 0) then
          call fatal_error(error, named//checkpoint//', where the run saves its checkpoints, '//why// &
             & '; refusing to overwrite it (move it away)')
          return
       end if
-      why = not_writable_here(temporary_path(checkpoint), input)
-      if (len(why) == 0) why = foreign_checkpoint(temporary_path(checkpoint), temporary=.true.)
+      why = foreign_checkpoint(temporary_path(checkpoint), input, temporary=.true.)
       if (len(why) > 0) then
          call fatal_error(error, named//temporary_path(checkpoint)//', where the run writes a checkpoint before '// &
             & 'it moves it into place, '//why//'; refusing to overwrite it (move it away)')

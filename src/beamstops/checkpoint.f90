@@ -209,16 +209,19 @@ contains
    !> must not be replaced: '' when nothing is there or a checkpoint, and with `temporary` an
    !> empty file or an HDF5 file that cannot be opened too (what a run killed while it wrote a
    !> checkpoint leaves); else what it is ('is a symbolic link, ...', 'exists and is not a
-   !> beamstops checkpoint'). Anything but a regular file is named, not opened.
-   function foreign_checkpoint(path, temporary) result(why)
+   !> beamstops checkpoint', 'is the input file IN.nml'). Anything but a regular file is named,
+   !> not opened.
+   function foreign_checkpoint(path, input, temporary) result(why)
       !> Checkpoint file, or its temporary file.
       character(len=*), intent(in) :: path
+      !> Input file of the run ('' for none).
+      character(len=*), intent(in) :: input
       !> Whether `path` is the temporary file.
       logical, intent(in) :: temporary
       character(len=:), allocatable :: why
       integer :: state
       integer(ik) :: bytes
-      why = not_writable_here(path, '')
+      why = not_writable_here(path, input)
       if (len(why) > 0 .or. .not. file_exists(path)) return
       state = checkpoint_state(path)
       if (state == checkpoint_found) return
@@ -330,7 +333,7 @@ contains
       integer :: hdferr
       file = -1
       ! checked when the run started, and again here: a file put there since is not written over
-      why = foreign_checkpoint(temporary_path(path), temporary=.true.)
+      why = foreign_checkpoint(temporary_path(path), '', temporary=.true.)
       if (len(why) > 0) then
          call fatal_error(error, path//': cannot create the checkpoint: '//temporary_path(path)//', where it is '// &
             & 'written before it is moved into place, '//why//'; refusing to write it (move it away)')
