@@ -600,7 +600,7 @@ contains
          character(len=*), intent(in) :: msg
          character(len=:), allocatable :: body, key, value
          integer, allocatable :: starts(:)
-         integer :: i, one_stat, last, capacity, count
+         integer :: i, one_stat, last, slot, capacity, count
          character(len=512) :: one_msg
          body = group_body(cleaned, trim(group_names(g)))
          starts = assignment_starts(body)
@@ -611,13 +611,7 @@ contains
             value = body(starts(i):last)
             value = value(index(value, '=') + 1:)
             ! More values than a list key holds: out of range, not malformed.
-            capacity = 0
-            select case (trim(group_names(g)))
-            case ('stops')
-               if (key == 'lower' .or. key == 'upper' .or. key == 'nodes' .or. key == 'x') capacity = max_stops
-            case ('damping')
-               if (key == 'ratio' .or. key == 'modes') capacity = 2
-            end select
+            call list_key(trim(group_names(g)), key, slot, capacity)
             if (capacity > 0) then
                count = value_count(value)
                if (count > capacity) then
