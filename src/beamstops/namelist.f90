@@ -515,6 +515,15 @@ contains
             if (len(subscript) > 0) call section_of(subscript, capacity, first, final, step, ok)
             if (.not. ok) cycle
             values = value_count(body(j + 1:last))
+            ! an element outside the list (`nodes(1001) =`, `ratio(0) =`, `nodes(999) = 1, 2, 3`):
+            ! gfortran's read fails on it, which would be told as malformed
+            if (len(subscript) > 0 .and. outside_list(first, final, step, values, capacity, &
+               & index(subscript, ':') > 0)) then
+               call fatal_error(error, source//': &'//trim(group_names(g))//' '// &
+                  & assignment_text(body(starts(i):min(last, starts(i) + 120)))//' is out of range; allowed: '// &
+                  & 'elements '//key//'(1) to '//key//'('//itoa(capacity)//')')
+               return
+            end if
             k = first
             n = 0
             do while (n < values .and. k >= 1 .and. k <= capacity)

@@ -9,7 +9,7 @@ module beamstops_namelist_text
    private
    public :: group_names, group_keys, text_len, word_len
    public :: next_item, whole_numbers_text, clamped_list, beyond_integer, whole_number_text, without_bom
-   public :: assignment_text, value_count, list_key, section_of, has_null, logical_text, key_at, all_groups
+   public :: assignment_text, value_count, list_key, section_of, outside_list, has_null, logical_text, key_at, all_groups
    public :: known_key, text_capacity, text_length, value_kind, group_body, assignment_starts
 
    !> Groups a scene file may hold, each at most once.
@@ -229,6 +229,27 @@ contains
          part = stat == 0
       end function part
    end subroutine section_of
+
+   !> Whether a subscript's elements fall outside a list of `capacity` values: `(i)`, whose
+   !> `values` values run from element i, past either end; a section `(i:j:s)` that selects an
+   !> element outside 1 .. capacity (an empty section selects none).
+   pure logical function outside_list(first, final, step, values, capacity, section)
+      !> The subscript's first element, its bound and step (section_of).
+      integer, intent(in) :: first, final, step
+      !> Values the assignment gives, and values the list holds.
+      integer, intent(in) :: values, capacity
+      !> Whether the subscript is a section (has a colon).
+      logical, intent(in) :: section
+      integer :: reached
+      if (.not. section) then
+         outside_list = first < 1 .or. first > capacity .or. first - 1 > capacity - max(values, 1)
+         return
+      end if
+      outside_list = .false.
+      if ((step > 0 .and. first > final) .or. (step < 0 .and. first < final)) return
+      reached = first + ((final - first)/step)*step
+      outside_list = min(first, reached) < 1 .or. max(first, reached) > capacity
+   end function outside_list
 
    !> Whether the value text of an assignment holds a null value, one Fortran's namelist leaves
    !> as it was: an `r*` with nothing after the star, nothing (or blanks) between two commas, or

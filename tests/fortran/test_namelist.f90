@@ -67,6 +67,7 @@ contains
          & test_null_values), &
          & new_unittest('an element of a list given twice is refused; distinct elements are read', test_elements_twice), &
          & new_unittest('a subscript or a substring on a key of one value is malformed', test_scalar_subscript), &
+         & new_unittest('an element outside a list is out of range, with the list''s bounds', test_element_outside), &
          & new_unittest('&ensemble seed: the range a refused seed names is the range read', test_seed_range), &
          & new_unittest('lines ending in several carriage returns are read', test_carriage_returns) &
          & ]
@@ -921,6 +922,38 @@ contains
       if (allocated(error)) return
       call check(error, scene%damping_ratio(2), 0.02_wp, 'ratio(2)')
    end subroutine test_elements_twice
+
+   !> `nodes(1001) = 1001` or `ratio(0) = 0.1` failed gfortran's read and was told as malformed:
+   !> it is out of range, and the message gives the list's first and last elements. Elements
+   !> inside the list, and empty sections, are not refused for their subscript.
+   subroutine test_element_outside(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: bad(6) = [character(len=48) :: '&stops nodes(1001) = 1001 /', &
+         & '&stops nodes(0) = 3 /', '&stops lower(999) = -0.1, -0.1, -0.1 /', '&damping ratio(3) = 0.1 /', &
+         & '&damping ratio(1:3:2) = 0.1, 0.2 /', '&damping modes(2:0:-1) = 1, 2 /']
+      character(len=*), parameter :: shown(6) = [character(len=40) :: '&stops nodes(1001) = 1001', &
+         & '&stops nodes(0) = 3', '&stops lower(999) = -0.1, -0.1, -0.1', '&damping ratio(3) = 0.1', &
+         & '&damping ratio(1:3:2) = 0.1, 0.2', '&damping modes(2:0:-1) = 1, 2']
+      character(len=*), parameter :: bounds(6) = [character(len=40) :: 'nodes(1) to nodes(1000)', &
+         & 'nodes(1) to nodes(1000)', 'lower(1) to lower(1000)', 'ratio(1) to ratio(2)', 'ratio(1) to ratio(2)', &
+         & 'modes(1) to modes(2)']
+      character(len=64) :: needles(2)
+      type(scene_type) :: scene
+      integer :: i
+      do i = 1, size(bad)
+         needles(1) = trim(shown(i))//' is out of range'
+         needles(2) = 'allowed: elements '//trim(bounds(i))
+         call expect_text_error(trim(bad(i)), needles, error)
+         if (allocated(error)) return
+      end do
+      ! the last elements of a list, and a section backwards inside it, are read
+      call scene_from_text('&damping ratio(2:1:-1) = 0.02, 0.01, modes(2) = 3, modes(1) = 1 / &mesh elements = 4 /', &
+         & 'in.nml', scene, error)
+      if (allocated(error)) return
+      call check(error, scene%damping_ratio(1), 0.01_wp, 'ratio(1)')
+      if (allocated(error)) return
+      call check(error, scene%damping_ratio(2), 0.02_wp, 'ratio(2)')
+   end subroutine test_element_outside
 
    !> `load_rule(1:2) = 'pa'` was read as a substring of the default: load_rule = 'pantered'.
    !> A key of one value takes no subscript or substring.
