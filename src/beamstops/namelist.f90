@@ -517,6 +517,10 @@ contains
             values = value_count(body(j + 1:last))
             ! an element outside the list (`nodes(1001) =`, `ratio(0) =`, `nodes(999) = 1, 2, 3`):
             ! gfortran's read fails on it, which would be told as malformed
+            if (values > capacity) then
+               call fatal_error(error, too_many_values(g, key, values, capacity))
+               return
+            end if
             if (len(subscript) > 0 .and. outside_list(first, final, step, values, capacity, &
                & index(subscript, ':') > 0)) then
                call fatal_error(error, source//': &'//trim(group_names(g))//' '// &
@@ -601,6 +605,20 @@ contains
          if (second_read == unset) again = unset + spacing(unset)
       end function again
 
+      !> The message for a list key given more values than it holds.
+      function too_many_values(g, key, count, capacity) result(message)
+         integer, intent(in) :: g, count, capacity
+         character(len=*), intent(in) :: key
+         character(len=:), allocatable :: message
+         message = source//': &'//trim(group_names(g))//' '//key//' has '//itoa(count)//' values, out of range; '// &
+            & 'allowed: at most '
+         if (capacity == max_stops) then
+            message = message//itoa(max_stops)//' stops (one value per stop)'
+         else
+            message = message//'two values'
+         end if
+      end function too_many_values
+
       !> The message of a group gfortran could not read: each `key = value` of the group is read
       !> alone to find the first one that fails, and the message names it with the kind of value
       !> the key takes; gfortran's own words when no single assignment fails.
@@ -624,13 +642,7 @@ contains
             if (capacity > 0) then
                count = value_count(value)
                if (count > capacity) then
-                  if (capacity == max_stops) then
-                     call fatal_error(error, source//': &'//trim(group_names(g))//' '//key//' has '//itoa(count)// &
-                        & ' values, out of range; allowed: at most '//itoa(max_stops)//' stops (one value per stop)')
-                  else
-                     call fatal_error(error, source//': &'//trim(group_names(g))//' '//key//' has '//itoa(count)// &
-                        & ' values, out of range; allowed: at most two values')
-                  end if
+                  call fatal_error(error, too_many_values(g, key, count, capacity))
                   return
                end if
             end if

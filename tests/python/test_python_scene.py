@@ -6,6 +6,7 @@ import dataclasses
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import beamstops
@@ -227,6 +228,10 @@ def test_replace_and_keyword_checks() -> None:
         Scene(allow_unstable=1)
     with pytest.raises(TypeError, match="dt cannot hold"):
         Scene(dt={"a": 1})
+    # a numpy scalar or 0-d array is its one value, as a number is
+    assert Scene(dt=np.array(1e-6), elements=np.array(4), law=np.array("none")) == Scene(dt=1e-6, elements=4,
+                                                                                        law="none")
+    assert Scene(dt=np.float64(1e-6), allow_unstable=np.bool_(True)) == Scene(dt=1e-6, allow_unstable=True)
     with pytest.raises(ValueError, match="&stops law = 'glue'"):
         Scene(law="glue")
     with pytest.raises(ValueError, match="&beam density is missing"):

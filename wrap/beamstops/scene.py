@@ -271,7 +271,10 @@ class Scene:
 NAMELIST_HEADER = "! beamstops scene (written by beamstops.Scene.to_namelist)"
 
 def namelist_value(value: Any, key: str = "value") -> str:
-    """A Python value as a namelist value: reals that read back exactly, lists by commas, quoted texts."""
+    """A Python value as a namelist value: reals that read back exactly, lists by commas (nested lists
+    flattened, as they always were), quoted texts; a numpy scalar or 0-d array as its one value."""
+    if getattr(value, "ndim", None) == 0 and hasattr(value, "item"):
+        value = value.item()
     if isinstance(value, bool):
         return ".true." if value else ".false."
     if isinstance(value, str):
