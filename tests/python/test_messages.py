@@ -50,3 +50,19 @@ def test_run_refuses_a_shock_capacity_out_of_range(capacity: object) -> None:
 
     with pytest.raises(ValueError, match=r"shock_capacity = .* is out of range; allowed: a whole number"):
         beamstops.run(Scene(t_end=1e-3, dt=1e-4), shock_capacity=capacity)  # type: ignore[arg-type]
+
+
+def test_a_name_not_in_utf8_is_escaped_and_utf8_is_kept(program: str, tmp_path: Path) -> None:
+    """A file name in Latin-1 (bytes that are not UTF-8) reached the message raw, so the message
+    itself was not valid UTF-8; a C1 control (NEL, U+0085) breaks the line on some terminals.
+    Such bytes are escaped as \\xHH; a name in UTF-8 (é, 漢, 😀) is kept as it is."""
+    names = {b"caf\xe9.nml": "caf\\xe9.nml", "a\u0085b.nml".encode(): "a\\xc2\\x85b.nml",
+             b"x\xed\xa0\x80y.nml": "x\\xed\\xa0\\x80y.nml", "é漢😀.nml".encode(): "é漢😀.nml"}
+    for raw, shown in names.items():
+        path = bytes(tmp_path) + b"/" + raw
+        with open(path, "wb") as f:
+            f.write(b"&time dt = -1 /\n")
+        done = subprocess.run([program.encode(), b"run", raw], cwd=tmp_path, capture_output=True, timeout=60)
+        message = done.stderr.decode("utf-8")  # fails when the message is not valid UTF-8
+        assert done.returncode == 1 and message.count("\n") == 1, message
+        assert message.startswith(f"beamstops: error: {shown}: &time dt = -1 is out of range"), message
