@@ -770,7 +770,8 @@ contains
    end function summary_line
 
    !> The headline statistics after the transient, with their 95 % intervals: shocks per second,
-   !> power the stops take, impulse rate, RMS tip displacement (first stop).
+   !> power the stops take, impulse rate (each stop's, in the order of /stops, when there are
+   !> several), RMS tip displacement.
    function headline(summary) result(text)
       type(run_summary), intent(in) :: summary
       character(len=:), allocatable :: text
@@ -788,14 +789,18 @@ contains
       character(len=:), allocatable :: text
       character(len=*), parameter :: names(4) = [character(len=17) :: 'shocks_per_second', 'power', &
          & 'impulse_rate', 'tip_rms']
-      integer :: i, k
+      integer :: i, j, k
       text = ''
       do i = 1, size(names)
          k = table%find(trim(names(i)))
          if (k == 0) cycle
          associate (q => table%quantity(k))
-            text = text//' '//trim(names(i))//' '//fmt_real(q%value(1), 5)//' +- '//fmt_real(q%half_width(1), 3)// &
-               & ' '//q%unit//';'
+            text = text//' '//trim(names(i))
+            if (size(q%value) > 1) text = text//' of stops 1..'//fmt_int(int(size(q%value), ik))
+            do j = 1, size(q%value)
+               text = text//trim(merge(' ', ',', j == 1))//' '//fmt_real(q%value(j), 5)//' +- '//fmt_real(q%half_width(j), 3)
+            end do
+            text = text//' '//q%unit//';'
          end associate
       end do
    end function headline_values

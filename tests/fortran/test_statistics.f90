@@ -4,7 +4,7 @@
 !> of the per-step updates (printed, never asserted).
 module test_statistics
    use, intrinsic :: iso_fortran_env, only: int64
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_value, ieee_quiet_nan, ieee_positive_inf
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_value, ieee_quiet_nan, ieee_positive_inf, ieee_next_after
    use testing
    use beamstops, only: ik
    use beamstops_observe_shocks, only: shock_log, shock_row, new_shock_log, shock_row_values
@@ -33,6 +33,8 @@ contains
          & new_unittest('i.i.d. sequences: the 95 % intervals cover the true means at about 95 %', test_coverage), &
          & new_unittest('disjoint halves of a stationary series agree within their intervals', test_halves), &
          & new_unittest('no contact: no shocks, zero power, zero forces', test_no_contact), &
+         & new_unittest('histogram: a sample is in bin i exactly when edge i <= u < edge i+1 (stored edges)', &
+         & test_histogram_edges), &
          & new_unittest('samples and shocks before the transient are left out', test_transient), &
          & new_unittest('step_tip and step give the same table', test_step_tip), &
          & new_unittest('ensemble: mean and t s/sqrt(K) across members; bad members', test_ensemble), &
@@ -480,6 +482,69 @@ contains
       if (allocated(error)) return
       call check(error, value_of(table, 'window'), (n - 500)*dt, 'window', rel=.true., thr=1.0e-12_wp)
    end subroutine test_no_contact
+
+   !> A tip resting on the stop at 0.1 was counted in the bin [0.1, 0.2) of a histogram over
+   !> [-0.2, 0.2] whose stored lower edge was 0.10000000000000003: the edges did not give the bins.
+   !> For ranges and bin counts where the nominal edges round both ways, samples at each stored
+   !> edge, one ulp below it and at the nominal edge are binned by the engine as by the edges.
+   subroutine test_histogram_edges(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: cases = 6
+      real(wp), parameter :: lowers(cases) = [-0.2_wp, -0.1_wp, 0.1_wp, -1.0e9_wp, -3.0e-3_wp, -0.7_wp]
+      real(wp), parameter :: uppers(cases) = [0.2_wp, 0.1_wp, 0.7_wp, 1.0e9_wp, 7.0e-2_wp, 0.3_wp]
+      integer, parameter :: bin_counts(cases) = [4, 10, 7, 3, 13, 1000]
+      real(wp), allocatable :: u(:), r(:), e(:), edges(:), by_edges(:)
+      type(statistics_table) :: table
+      type(shock_row), allocatable :: rows(:)
+      real(wp) :: nominal, h
+      integer :: c, bins, i, k, q
+      do c = 1, cases
+         bins = bin_counts(c)
+         ! three samples a bin edge: the nominal edge, and (once the edges are known) the stored one
+         ! and the double below it
+         allocate (u(3*(bins - 1)))
+         do i = 1, bins - 1
+            nominal = lowers(c) + i*((uppers(c) - lowers(c))/bins)
+            u(3*i - 2:3*i) = nominal
+         end do
+         allocate (r(size(u)), e(size(u)))
+         r = 0
+         e = 0
+         call run_both(u, r, e, 0.0_wp, 0.0_wp, size(u)*dt, 2, bins, lowers(c), uppers(c), table, rows, error)
+         if (allocated(error)) return
+         q = table%find('tip_histogram_edges')
+         edges = table%quantity(q)%value
+         call check(error, size(edges), bins + 1, 'edges'); if (allocated(error)) return
+         call check(error, edges(1) == lowers(c) .and. edges(bins + 1) == uppers(c), 'first and last edges')
+         if (allocated(error)) return
+         do i = 1, bins - 1
+            call check(error, abs(edges(i + 1) - u(3*i)) <= 4*spacing(max(abs(lowers(c)), abs(uppers(c)))), &
+               & 'edge '//int_text(i)//' beside its nominal value')
+            if (allocated(error)) return
+            u(3*i - 1) = edges(i + 1)
+            u(3*i) = ieee_next_after(edges(i + 1), -huge(1.0_wp))
+         end do
+         call run_both(u, r, e, 0.0_wp, 0.0_wp, size(u)*dt, 2, bins, lowers(c), uppers(c), table, rows, error)
+         if (allocated(error)) return
+         allocate (by_edges(bins))
+         by_edges = 0
+         do k = 1, size(u)
+            ! edge i <= u < edge i+1 (u within [lower, upper) here)
+            i = count(edges(2:bins) <= u(k)) + 1
+            by_edges(i) = by_edges(i) + 1
+         end do
+         do i = 1, bins
+            call get(table, 'tip_histogram', nominal, h, i)
+            call check(error, nint(nominal*size(u)), nint(by_edges(i)), 'samples in bin '//int_text(i)//' of '// &
+               & int_text(bins)//' over ['//real_text(lowers(c))//', '//real_text(uppers(c))//']')
+            if (allocated(error)) return
+         end do
+         call note(int_text(bins)//' bins over ['//real_text(lowers(c))//', '//real_text(uppers(c))//']: '// &
+            & int_text(count(edges(2:bins) /= [(lowers(c) + i*((uppers(c) - lowers(c))/bins), i = 1, bins - 1)]))// &
+            & ' stored edges differ from their nominal value')
+         deallocate (u, r, e, by_edges)
+      end do
+   end subroutine test_histogram_edges
 
    subroutine test_transient(error)
       type(error_type), allocatable, intent(out) :: error

@@ -229,3 +229,35 @@ def test_massless_tip_reaction_only_on_the_stops() -> None:
     assert acting.sum() == run.impacts["contact_steps"].sum()
     assert run.impacts["energy_taken"].sum() == pytest.approx(run.dissipated[-2], rel=1e-9)
     assert run.impacts["impulse"].sum() == pytest.approx(run.reaction.sum() * DT, rel=1e-12)
+
+
+def test_histogram_counts_are_those_of_its_stored_edges() -> None:
+    """np.histogram of the window's tip samples on /statistics/tip_histogram_edges gives the
+    engine's histogram: the tip resting on the stop at 0.1 (Signorini) lies on an edge of a
+    histogram over [-0.2, 0.2] in 4 bins, where the nominal edge -0.2 + 3 * 0.1 is an ulp above it
+    (the bin the engine counts it in)."""
+    run = beamstops.run(Scene(dt=1e-5, t_end=2.0, bins=4, histogram_lower=-0.2, histogram_upper=0.2))
+    kept = run.t > 0
+    u = run.tip_u[kept]
+    assert np.count_nonzero(u == 0.1) > 100, "the tip rests on the upper stop"
+    edges = run.statistics["tip_histogram_edges"].value
+    assert edges[3] != -0.2 + 3 * (0.4 / 4), "the nominal edge is not the bins' edge here"
+    counts, _ = np.histogram(u, edges)
+    assert np.array_equal(counts, np.rint(run.statistics["tip_histogram"].value * u.size))
+
+
+def test_summary_line_gives_each_stops_headline_statistics(tmp_path: Path, program: str) -> None:
+    """With stops along the span the summary line printed stop 1's shocks per second, power and
+    impulse rate alone; it gives each stop's, in the order of /stops."""
+    scene = Scene(dt=1e-5, t_end=1.0, beta=0.25, nodes=(7, 13, 19), lower=(-0.03, -0.06, -0.1),
+                  upper=(0.03, 0.06, 0.1), file="out.h5")
+    scene.to_namelist(tmp_path / "s.nml")
+    done = subprocess.run([program, "run", "s.nml"], cwd=tmp_path, check=True, capture_output=True, text=True)
+    line = done.stdout.splitlines()[-1]
+    power = beamstops.load(tmp_path / "out.h5").statistics["power"]
+    assert power.value.size == 3
+    shown = line.split("power of stops 1..3 ")[1].split(" W;")[0].split(", ")
+    assert len(shown) == 3
+    for text, value, half in zip(shown, power.value, power.half_width):
+        v, h = (float(x) for x in text.split(" +- "))
+        assert v == pytest.approx(value, rel=1e-4) and h == pytest.approx(half, rel=1e-2)

@@ -22,7 +22,9 @@
 !> tip_histogram = fraction of the samples in each of `bins` equal bins over [lower, upper]:
 !> u_k counts in bin 1 + min(max(floor((u_k - lower) * (bins/(upper - lower))), 0), bins - 1)
 !> (u below lower in the first bin, u >= upper in the last), and tip_histogram_edges, the
-!> bins + 1 edges lower + i ((upper - lower)/bins), i = 0..bins (the last one = upper);
+!> bins + 1 edges of those bins: lower, for i = 1..bins-1 the least double u with
+!> (u - lower) (bins/(upper - lower)) >= i as rounded (lower + i ((upper - lower)/bins) or an ulp
+!> or so beside it), and upper: u in [lower, upper] is in bin i exactly when edge i <= u < edge i+1;
 !> window = T (s), the time the samples after the transient cover.
 !> The value of a quantity is its window estimate; its half-width is the batch-means interval
 !> t_{0.975, B'-1} s / sqrt(B'), s the sample standard deviation (divisor B'-1) of the B'
@@ -35,6 +37,7 @@
 !> scalars: about half the cost), add_shock for each row drained from the shock log, finish at
 !> the end, results for the table. The step allocates nothing and writes nothing.
 module beamstops_observe_statistics
+   use, intrinsic :: iso_fortran_env, only: int64
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite, ieee_is_nan
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
@@ -377,6 +380,62 @@ contains
       edge = start + product
    end function rounded_sum
 
+   !> The lower edge of histogram bin k (from 0) as the samples are binned (tip_sample: bin k when
+   !> (u - lower) scale, rounded, is at least k and below k + 1): the least double u with
+   !> (u - lower) scale >= k, so that a sample is in bin k exactly when edge(k) <= u < edge(k + 1)
+   !> (numpy's histogram or searchsorted on the stored edges reproduces the bins). The nominal edge
+   !> lower + k ((upper - lower)/bins) can be an ulp off it: a tip resting on a stop at 0.1 was
+   !> counted in the bin whose nominal edge was 0.10000000000000003. Found by bisection over the
+   !> doubles in their order (at most 64 halvings), from the nominal edge.
+   pure function bin_edge(lower, scale, k, nominal) result(edge)
+      real(wp), intent(in) :: lower, scale, nominal
+      integer, intent(in) :: k
+      real(wp) :: edge
+      integer(int64) :: below, above, middle
+      ! below: a key whose double is under the edge; above: one at or over it
+      below = order_key(lower)
+      above = order_key(lower + (k + 1)/scale)
+      if (in_bin_or_above(nominal)) then
+         above = order_key(nominal)
+      else
+         below = order_key(nominal)
+      end if
+      do
+         ! floor((below + above)/2) without forming the sum (past huge when both are large):
+         ! below when they are neighbours, else strictly between them
+         middle = iand(below, above) + shifta(ieor(below, above), 1)
+         if (middle == below) exit
+         if (in_bin_or_above(key_value(middle))) then
+            above = middle
+         else
+            below = middle
+         end if
+      end do
+      edge = key_value(above)
+   contains
+      pure logical function in_bin_or_above(u)
+         real(wp), intent(in) :: u
+         in_bin_or_above = (u - lower)*scale >= k
+      end function in_bin_or_above
+   end function bin_edge
+
+   !> A finite double as an integer in the doubles' order (-0 and +0 both 0).
+   pure integer(int64) function order_key(x) result(key)
+      real(wp), intent(in) :: x
+      key = transfer(x, key)
+      if (key < 0) key = -iand(key, huge(key))
+   end function order_key
+
+   !> The double of an order_key.
+   pure real(wp) function key_value(key) result(x)
+      integer(int64), intent(in) :: key
+      if (key >= 0) then
+         x = transfer(key, x)
+      else
+         x = transfer(ior(-key, ishft(1_int64, 63)), x)
+      end if
+   end function key_value
+
    !> What a quiet tip sample reads and changes (quiet_tip_stats).
    pure function quiet_tip(self) result(q)
       !> Statistics of the tip.
@@ -640,8 +699,9 @@ contains
       call put('tip_histogram', '1', 'bin', v, h)
       deallocate (v)
       allocate (v(s%bins + 1))
-      do k = 0, s%bins
-         v(k + 1) = rounded_sum(s%lower, k, (s%upper - s%lower)/s%bins)
+      v(1) = s%lower
+      do k = 1, s%bins - 1
+         v(k + 1) = bin_edge(s%lower, s%scale, k, rounded_sum(s%lower, k, (s%upper - s%lower)/s%bins))
       end do
       v(s%bins + 1) = s%upper
       call put('tip_histogram_edges', 'm', 'edge', v, spread(0.0_wp, 1, s%bins + 1))
