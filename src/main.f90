@@ -22,6 +22,7 @@ program beamstops_main
    use beamstops_reduced, only: reduced_model_type, reduce_model
    use beamstops_reduced_scheme, only: reduced_state_type, start_reduced
    use beamstops_reduced_checkpoint, only: read_reduced_checkpoint
+   use beamstops_restart_partial, only: check_partial_scene
    use beamstops_lapack, only: openblas_one_thread
    use beamstops_strings, only: fmt_real, fmt_int
    use beamstops_observe_statistics, only: statistics_table
@@ -429,6 +430,8 @@ contains
             call read_checkpoint(checkpoint, scene, model, state, records, snapshots, error)
          end if
          if (reported(error, exit_input, status)) return
+         call check_partial_scene(partial, scene, error)
+         if (reported(error, exit_input, status)) return
          call recorder%reopen(output, scene, model, records, snapshots, error)
          if (reported(error, exit_output, status)) return
       else
@@ -457,6 +460,28 @@ contains
       call recorder%finish(summary, finish_error)
       status = run_outcome(scene, input, summary, error, write_error, finish_error)
    end function run_to_file
+
+   !> An error when `beamstops run --restart` could not resume a scene from its checkpoint and
+   !> partial file (read_checkpoint's or read_reduced_checkpoint's, check_partial_scene's), so that
+   !> `run A.nml B.nml ... --restart` refuses them all before any runs.
+   subroutine check_resume(scene, model, input, error)
+      type(scene_type), intent(in) :: scene
+      type(model_type), intent(in) :: model
+      character(len=*), intent(in) :: input
+      type(error_type), allocatable, intent(out) :: error
+      type(state_type) :: state
+      type(reduced_model_type) :: reduced
+      type(reduced_state_type) :: reduced_state
+      integer(ik) :: records, snapshots
+      if (scene%modes > 0) then
+         call reduce_model(scene, model, input, reduced, error)
+         if (.not. allocated(error)) call read_reduced_checkpoint(checkpoint_path(scene%output_file), scene, reduced, &
+            & reduced_state, records, snapshots, error)
+      else
+         call read_checkpoint(checkpoint_path(scene%output_file), scene, model, state, records, snapshots, error)
+      end if
+      if (.not. allocated(error)) call check_partial_scene(partial_path(scene%output_file), scene, error)
+   end subroutine check_resume
 
    !> Refuse, before anything is written, the output of a scene that the run cannot write or that
    !> would destroy data (check_output_path), what the run may not write at its checkpoint or the
@@ -605,6 +630,9 @@ contains
          end do
          call refuse_all(error, exit_output, n)
          alone(i) = restart .and. file_exists(checkpoint_path(output)) .and. file_exists(partial_path(output))
+         ! the files a scene resumes from are checked before any scene runs, too
+         if (alone(i)) call check_resume(scenes(i), models(i), paths(i)%text, error)
+         call refuse_all(error, exit_input, n)
       end do
       call lockstep_groups(scenes, models, group, alone)
       block

@@ -5,11 +5,11 @@ module beamstops_checkpoint
    use hdf5
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type, fatal_error
-   use beamstops_scene, only: scene_type, scene_table, stop_count
+   use beamstops_scene, only: scene_type, scene_table, stop_count, steps_of
    use beamstops_attributes, only: attribute_list, kind_real, kind_text, namelist_text
    use beamstops_model, only: model_type
    use beamstops_state, only: state_type
-   use beamstops_loop_scalars, only: n_loop_scalars, loop_scalars_vector, restore_loop_scalars
+   use beamstops_loop_scalars, only: n_loop_scalars, loop_scalars_vector, restore_loop_scalars, implausible_scalars
    use beamstops_observe_observer, only: observer_type
    use beamstops_files, only: rename_file, remove_file, file_exists, not_writable_here
    use beamstops_recorder_hdf5_vector, only: write_vector, read_vector
@@ -19,7 +19,7 @@ module beamstops_checkpoint
    public :: foreign_checkpoint
    ! (the reduced model's checkpoints, beamstops_reduced_checkpoint, share the file's frame)
    public :: create_checkpoint, commit_checkpoint, open_checkpoint, close_checkpoint, write_observer, read_observer
-   public :: write_scene_text
+   public :: write_scene_text, check_scalars, signature_text, key_changes
 
    !> What checkpoint_state finds: not HDF5 (or HDF5 without a signature), HDF5 that cannot be
    !> opened, a checkpoint.
@@ -103,12 +103,11 @@ contains
       integer(hid_t), intent(in) :: file
       type(scene_type), intent(in) :: scene
       character(len=:), allocatable :: changed
-      character(len=:), allocatable :: old, new
-      character(len=:), allocatable :: old_keys(:), old_values(:), new_keys(:), new_values(:)
+      character(len=:), allocatable :: old
       real(wp) :: length(1)
       real(wp), allocatable :: codes(:)
       logical :: ok
-      integer :: i, j
+      integer :: i
       changed = ''
       call read_vector(file, 'scene_text_length', length, ok)
       if (.not. ok) return
@@ -121,22 +120,33 @@ contains
       do i = 1, size(codes)
          old(i:i) = achar(nint(codes(i)))
       end do
-      new = signature_text(scene)
+      changed = key_changes(old, signature_text(scene), 'the checkpoint')
+   end function changed_keys
+
+   !> The keys whose values differ between two signature texts (signature_text), as `&group key =
+   !> old in WHERE, new here; ...` ('' when the texts are the same), `where` naming the old one.
+   function key_changes(old, new, where) result(changed)
+      !> The old text, the new one, and where the old one comes from.
+      character(len=*), intent(in) :: old, new, where
+      character(len=:), allocatable :: changed
+      character(len=:), allocatable :: old_keys(:), old_values(:), new_keys(:), new_values(:)
+      integer :: i, j
+      changed = ''
       if (old == new) return
       call key_lines(old, old_keys, old_values)
       call key_lines(new, new_keys, new_values)
       do i = 1, size(new_keys)
          j = position(old_keys, new_keys(i))
          if (j == 0) then
-            call add(trim(new_keys(i))//' = '//trim(new_values(i))//' here, not in the checkpoint')
+            call add(trim(new_keys(i))//' = '//trim(new_values(i))//' here, not in '//where)
          else if (old_values(j) /= new_values(i)) then
-            call add(trim(new_keys(i))//' = '//trim(old_values(j))//' in the checkpoint, '//trim(new_values(i))// &
+            call add(trim(new_keys(i))//' = '//trim(old_values(j))//' in '//where//', '//trim(new_values(i))// &
                & ' here')
          end if
       end do
       do j = 1, size(old_keys)
          if (position(new_keys, old_keys(j)) == 0) &
-            & call add(trim(old_keys(j))//' = '//trim(old_values(j))//' in the checkpoint, not here')
+            & call add(trim(old_keys(j))//' = '//trim(old_values(j))//' in '//where//', not here')
       end do
 
    contains
@@ -146,7 +156,7 @@ contains
          if (len(changed) > 0) changed = changed//'; '
          changed = changed//piece
       end subroutine add
-   end function changed_keys
+   end function key_changes
 
    !> The `&group key` and value of each `key = value` line of a namelist_text.
    subroutine key_lines(text, keys, values)
@@ -459,6 +469,25 @@ contains
       if (ok(6) .and. scene%statistics) call read_observer(file, state%observer, ok(6))
       call close_checkpoint(path, file, all(ok), signature, scene, error)
       if (allocated(error)) return
+      call check_scalars(path, scene, scalars, [state%u, state%d, state%su, state%damped], error)
+      if (allocated(error)) return
       call restore_loop_scalars(scalars, state%loop_scalars_type, records, snapshots)
    end subroutine read_checkpoint
+
+   !> An error when the loop scalars read from a checkpoint (and the state's `values`) cannot be a
+   !> checkpoint of a run of the scene (beamstops_loop_scalars' implausible_scalars).
+   subroutine check_scalars(path, scene, scalars, values, error)
+      !> Checkpoint file.
+      character(len=*), intent(in) :: path
+      !> Scene of the run to resume.
+      type(scene_type), intent(in) :: scene
+      !> The checkpoint's loop scalars and the state's other values.
+      real(wp), intent(in) :: scalars(n_loop_scalars), values(:)
+      !> Set when they cannot be.
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: why
+      why = implausible_scalars(scalars, values, steps_of(scene), scene%record_every, scene%snapshot_every)
+      if (len(why) > 0) call fatal_error(error, path//': the checkpoint is damaged: '//why// &
+         & '; run without --restart to start over')
+   end subroutine check_scalars
 end module beamstops_checkpoint

@@ -1,10 +1,12 @@
 !> The scalars that every time loop (the full model's and the reduced model's) carries from
 !> step n to step n+1, as one parent type of their states, and their place in a checkpoint.
 module beamstops_loop_scalars
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use beamstops_kinds, only: wp, ik
+   use beamstops_strings, only: fmt_int, fmt_real
    implicit none
    private
-   public :: loop_scalars_type, n_loop_scalars, loop_scalars_vector, restore_loop_scalars
+   public :: loop_scalars_type, n_loop_scalars, loop_scalars_vector, restore_loop_scalars, implausible_scalars
 
    !> Length of loop_scalars_vector: the 14 scalars a checkpoint keeps, then the records and snapshots.
    integer, parameter :: n_loop_scalars = 16
@@ -55,6 +57,54 @@ contains
          & merge(1.0_wp, 0.0_wp, scalars%in_contact), real(scalars%impacts, wp), scalars%cpu_seconds, &
          & scalars%max_violation, real(records, wp), real(snapshots, wp)]
    end function loop_scalars_vector
+
+   !> Why a vector of loop_scalars_vector (read from a checkpoint) cannot be a checkpoint of a run
+   !> of `steps` steps recording every `record_every` steps and a snapshot every `snapshot_every`
+   !> (0: none), or '' when it can: a value that is not finite (of the vector or of the state
+   !> `values` saved beside it), a step outside 1 .. steps + 1 or not whole, counts of records and
+   !> snapshots other than those the loop has written before that step (the first at step 0, then
+   !> one every record_every: (step - 1)/record_every + 1), a contact flag other than 0 or 1, or a
+   !> negative count, CPU time or violation. An edited or damaged checkpoint was trusted: a step of
+   !> 1e9 ran to t = 50,000 s of a 400 s scene and wrote a file marked complete; records = -3 made
+   !> HDF5 spin while extending the series.
+   function implausible_scalars(v, values, steps, record_every, snapshot_every) result(why)
+      !> The vector.
+      real(wp), intent(in) :: v(n_loop_scalars)
+      !> The state's other values (displacements, increments, ...).
+      real(wp), intent(in) :: values(:)
+      !> Steps of the run, and its record and snapshot periods (steps; snapshot_every 0: none).
+      integer(ik), intent(in) :: steps
+      integer, intent(in) :: record_every, snapshot_every
+      character(len=:), allocatable :: why
+      integer(ik) :: step, expected
+      why = ''
+      if (.not. (all(ieee_is_finite(v)) .and. all(ieee_is_finite(values)))) then
+         why = 'a value is not finite'
+         return
+      end if
+      if (.not. (v(1) >= 1 .and. v(1) <= real(steps, wp) + 1 .and. v(1) == aint(v(1)))) then
+         why = 'its step '//fmt_real(v(1))//' is not a step of the run (1 to '//fmt_int(steps + 1)//')'
+         return
+      end if
+      step = nint(v(1), ik)
+      expected = (step - 1)/record_every + 1
+      if (v(15) /= real(expected, wp)) then
+         why = 'it counts '//fmt_real(v(15))//' records where the run has written '//fmt_int(expected)// &
+            & ' before step '//fmt_int(step)
+         return
+      end if
+      expected = 0
+      if (snapshot_every > 0) expected = (step - 1)/snapshot_every + 1
+      if (v(16) /= real(expected, wp)) then
+         why = 'it counts '//fmt_real(v(16))//' snapshots where the run has written '//fmt_int(expected)// &
+            & ' before step '//fmt_int(step)
+         return
+      end if
+      if (v(11) /= 0 .and. v(11) /= 1) why = 'its contact flag is '//fmt_real(v(11))//' (0 or 1)'
+      if (.not. (v(12) >= 0 .and. v(12) <= real(step, wp) .and. v(12) == aint(v(12)))) &
+         & why = 'its impacts '//fmt_real(v(12))//' are not a count of the steps so far'
+      if (v(13) < 0 .or. v(14) < 0) why = 'a negative CPU time or violation'
+   end function implausible_scalars
 
    !> The inverse of loop_scalars_vector (`damped` and `dcd_prev` are left as they are).
    pure subroutine restore_loop_scalars(v, scalars, records, snapshots)

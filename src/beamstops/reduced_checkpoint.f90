@@ -9,7 +9,7 @@ module beamstops_reduced_checkpoint
    use beamstops_kinds, only: wp, ik
    use beamstops_error, only: error_type
    use beamstops_scene, only: scene_type, stop_count
-   use beamstops_checkpoint, only: scene_signature, create_checkpoint, commit_checkpoint, open_checkpoint, &
+   use beamstops_checkpoint, only: scene_signature, create_checkpoint, commit_checkpoint, open_checkpoint, check_scalars, &
       & close_checkpoint, write_observer, read_observer, write_scene_text
    use beamstops_loop_scalars, only: n_loop_scalars, loop_scalars_vector, restore_loop_scalars
    use beamstops_recorder_hdf5_vector, only: write_vector, read_vector
@@ -86,6 +86,8 @@ contains
       if (allocated(state%stop_reaction)) call read_vector(file, 'stop_reaction', state%stop_reaction, ok(5))
       if (ok(5) .and. scene%statistics) call read_observer(file, state%observer, ok(5))
       call close_checkpoint(path, file, all(ok), signature, scene, error)
+      if (allocated(error)) return
+      call check_scalars(path, scene, scalars(:n_loop_scalars), [state%q, state%d, scalars(n_loop_scalars + 1:)], error)
       if (allocated(error)) return
       call restore_loop_scalars(scalars(:n_loop_scalars), state%loop_scalars_type, records, snapshots)
       state%damped = scalars(n_scalars)

@@ -331,3 +331,64 @@ def test_a_partial_output_older_than_its_checkpoint_is_refused(tmp_path: Path) -
     assert f"holds {early_records} rows of /tip/t, fewer than the " in done.stderr
     assert "run without --restart to start over" in done.stderr
     assert partial.read_bytes() == before and not (tmp_path / "old.h5").exists()
+
+
+@pytest.mark.parametrize("index, value, needle", [
+    (0, 1e9, "its step 1e+09 is not a step of the run"),
+    (0, -5.0, "its step -5 is not a step of the run"),
+    (0, float("nan"), "a value is not finite"),
+    (14, 0.0, "it counts 0 records where the run has written"),
+    (14, -3.0, "it counts -3 records where the run has written"),
+    (15, 7.0, "it counts 7 snapshots where the run has written"),
+])
+def test_a_damaged_checkpoint_is_refused(tmp_path: Path, index: int, value: float, needle: str) -> None:
+    """The checkpoint's loop values were trusted: a step of 1e9 ran far past t_end into a file
+    marked complete, a step of NaN ran until killed, records = -3 made HDF5 spin in the writer
+    (SIGTERM ignored). Each is refused (exit 1, one line), both files untouched."""
+    scene = write_scene(tmp_path, "d", t_end=4.0)
+    partial, checkpoint = tmp_path / "d.h5.partial", tmp_path / "d.h5.checkpoint"
+    kill_after_first_checkpoint(scene, checkpoint)
+    with h5py.File(checkpoint, "r+") as f:
+        scalars = f["scalars"][()]
+        scalars[index] = value
+        f["scalars"][...] = scalars
+    before = partial.read_bytes(), checkpoint.read_bytes()
+    done = run("run", scene, "--restart", cwd=tmp_path)
+    assert done.returncode == 1 and done.stdout == "" and done.stderr.count("\n") == 1, done.stderr
+    assert "d.h5.checkpoint: the checkpoint is damaged: " + needle in done.stderr
+    assert (partial.read_bytes(), checkpoint.read_bytes()) == before and not (tmp_path / "d.h5").exists()
+
+
+def test_a_partial_file_of_another_scene_is_refused(tmp_path: Path) -> None:
+    """The complete output of another scene copied to OUT.h5.partial, beside this scene's
+    checkpoint, was extended and marked complete: its first rows and attributes the other
+    scene's. It is refused, naming the keys that differ; both files untouched."""
+    scene = write_scene(tmp_path, "p", t_end=4.0)
+    partial, checkpoint = tmp_path / "p.h5.partial", tmp_path / "p.h5.checkpoint"
+    kill_after_first_checkpoint(scene, checkpoint)
+    other = tmp_path / "other.nml"
+    other.write_text("&support omega = 12 /\n&time dt=1e-6, t_end=0.2 /\n&output file='other.h5', "
+                     "record_every=1, snapshot_every=997, checkpoint_every=40000 /\n")
+    assert run("run", other, cwd=tmp_path).returncode == 0
+    shutil.copy2(tmp_path / "other.h5", partial)
+    before = partial.read_bytes(), checkpoint.read_bytes()
+    done = run("run", scene, "--restart", cwd=tmp_path)
+    assert done.returncode == 1 and done.stderr.count("\n") == 1, done.stderr
+    assert "p.h5.partial, the output of the interrupted run, belongs to another scene: " in done.stderr
+    assert "&support omega = 12.0 in the partial file, 10.0 here" in done.stderr
+    assert (partial.read_bytes(), checkpoint.read_bytes()) == before and not (tmp_path / "p.h5").exists()
+
+
+def test_several_files_with_restart_are_all_checked_before_any_runs(tmp_path: Path) -> None:
+    """`run A B C --restart` ran A and the scenes after a refused checkpoint of B: every scene's
+    checkpoint and partial file are now checked first, and none runs (README)."""
+    scene = write_scene(tmp_path, "b", t_end=4.0)
+    kill_after_first_checkpoint(scene, tmp_path / "b.h5.checkpoint")
+    scene.write_text(SCENE.format(t_end=3.0, file="b.h5"))  # another t_end: not this checkpoint's scene
+    for name in ("a", "c"):
+        write_scene(tmp_path, name, t_end=0.01)
+    done = run("run", "a.nml", "b.nml", "c.nml", "--restart", cwd=tmp_path)
+    assert done.returncode == 1, done.stderr
+    assert "b.h5.checkpoint: the checkpoint belongs to another scene" in done.stderr
+    assert "none of the 3 scenes was run" in done.stderr
+    assert not (tmp_path / "a.h5").exists() and not (tmp_path / "c.h5").exists()
