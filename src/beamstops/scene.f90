@@ -9,6 +9,7 @@ module beamstops_scene
    implicit none
    private
    public :: scene_type, validate_scene, steps_of, record_count, snapshot_count, output_bytes
+   public :: shock_log_rows, shock_row_bytes
    public :: tube_section, tube_beam, fmt_real, fmt_int
    public :: law_none, law_signorini, law_compliance, law_name, law_code
    public :: max_elements, max_stops, max_members, stop_count, scene_table, canonical_text
@@ -23,9 +24,13 @@ module beamstops_scene
    !> Most members of an ensemble (&ensemble members).
    integer, parameter :: max_members = 10000
    !> Most memory an ensemble's members may take together (GB): each keeps its statistics (bins
-   !> x batches values of its histograms) and its state (about 16 values an unknown in lockstep).
-   !> Beyond it the allocations failed with a backtrace, or succeeded and filled the machine.
+   !> x batches values of its histograms), its state (about 16 values an unknown in lockstep) and
+   !> its shock log (shock_log_rows rows of shock_row_bytes). Beyond it the allocations failed with
+   !> a backtrace, or succeeded and filled the machine.
    real(wp), parameter :: max_ensemble_gb = 16
+   !> Bytes of a row of the shock log (beamstops_observe_shocks' shock_row; the shocks suite of
+   !> tests/fortran checks it against the type's storage_size).
+   integer, parameter :: shock_row_bytes = 96
    !> Range of the compliance spring per unit mass (1/s^2); &stops stiffness (N/m) is told in it
    !> times mass_per_length.
    real(wp), parameter :: min_stiffness_per_mass = 1.0e-12_wp, max_stiffness_per_mass = 1.0e20_wp
@@ -158,6 +163,14 @@ contains
       integer(ik) :: n
       n = steps_of(scene)/scene%record_every + 1
    end function record_count
+
+   !> Rows of the shock log of a scene with m stops (the tip alone: 1): drained every block of
+   !> 8192 steps, in which at most m (4096 + 1) shocks can close (beamstops_observe_observer).
+   pure integer function shock_log_rows(m)
+      !> Stops.
+      integer, intent(in) :: m
+      shock_log_rows = m*4097 + 16
+   end function shock_log_rows
 
    !> Snapshots a complete run writes (t = 0 included; 0 when snapshot_every = 0).
    pure function snapshot_count(scene) result(n)
@@ -411,13 +424,16 @@ contains
       subroutine ensemble_fits()
          real(wp) :: member_bytes
          if (scene%members < 2 .or. scene%members > max_members) return
-         member_bytes = 8*(real(scene%bins, wp)*real(scene%batches, wp) + 16*2*real(scene%elements, wp))
+         member_bytes = 8*(real(scene%bins, wp)*real(scene%batches, wp) + 16*2*real(scene%elements, wp)) + &
+            & real(shock_row_bytes, wp)*shock_log_rows(max(1, stop_count(scene)))
          if (member_bytes*scene%members <= max_ensemble_gb*1.0e9_wp) return
          call say('ensemble', 'members', fmt_int(int(scene%members, ik)), 'members <= '// &
             & fmt_int(int(max_ensemble_gb*1.0e9_wp/member_bytes, ik))//' for this scene: the members take '// &
-            & fmt_real(member_bytes*scene%members/1.0e9_wp, 5)//' GB of memory together, 8 bytes x members x '// &
-            & '(bins x batches + 16 x 2 elements) with bins = '//fmt_int(int(scene%bins, ik))//', batches = '// &
-            & fmt_int(int(scene%batches, ik))//', elements = '//fmt_int(int(scene%elements, ik))//'; at most '// &
+            & fmt_real(member_bytes*scene%members/1.0e9_wp, 5)//' GB of memory together, members x (8 bytes x '// &
+            & '(bins x batches + 16 x 2 elements) + '//fmt_int(int(shock_row_bytes, ik))//' bytes x (4097 stops + 16) '// &
+            & 'for the shock log) with bins = '//fmt_int(int(scene%bins, ik))//', batches = '// &
+            & fmt_int(int(scene%batches, ik))//', elements = '//fmt_int(int(scene%elements, ik))//', stops = '// &
+            & fmt_int(int(max(1, stop_count(scene)), ik))//'; at most '// &
             & fmt_real(max_ensemble_gb)//' GB')
       end subroutine ensemble_fits
 

@@ -4,6 +4,7 @@ module test_shocks
    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_value, ieee_quiet_nan
    use testing
    use beamstops, only: ik
+   use beamstops_scene, only: shock_row_bytes
    use beamstops_observe_shocks, only: shock_log, shock_row, new_shock_log, shock_row_values, n_shock_columns, &
       & shock_column_names, side_lower, side_upper
    implicit none
@@ -15,12 +16,22 @@ module test_shocks
 
 contains
 
+   !> scene.f90's shock_row_bytes (the ensemble's memory check, which cannot see the type) is
+   !> the size of a shock_row: the check said 11 kB a member of the paper's scene where a member
+   !> took 0.4 MB, most of it its shock log.
+   subroutine test_row_bytes(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(shock_row) :: row
+      call check(error, shock_row_bytes, int(storage_size(row)/8), 'bytes of a shock row')
+   end subroutine test_row_bytes
+
    !> Tests of the suite.
    subroutine collect_shocks(tests)
       !> The suite's tests.
       type(unittest_type), allocatable, intent(out) :: tests(:)
       tests = [ &
          & new_unittest('one isolated contact: one shock, its times, impulse, velocities', test_isolated), &
+         & new_unittest('the ensemble memory check counts a shock row at its size', test_row_bytes), &
          & new_unittest('chatter within rest_time: one shock with its rebounds', test_chatter_merged), &
          & new_unittest('phases further apart than rest_time: separate shocks', test_separate), &
          & new_unittest('rest_time = 0: every phase a shock', test_rest_zero), &

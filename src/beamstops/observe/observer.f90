@@ -8,7 +8,7 @@ module beamstops_observe_observer
    use beamstops_error, only: error_type, fatal_error
    use beamstops_observe_shocks, only: shock_log, shock_row, new_shock_log, shock_row_values, n_shock_columns
    use beamstops_observe_statistics, only: statistics_type, statistics_table, new_statistics
-   use beamstops_scene, only: scene_type, steps_of
+   use beamstops_scene, only: scene_type, steps_of, shock_log_rows
    implicit none
    private
    public :: observer_type, new_observer, observe_scene
@@ -89,7 +89,7 @@ contains
       self%dissipated_seen = dissipated0
       allocate (self%u(m), self%r(m), self%e(m))
       ! Drained every block of 8192 steps: a capacity of m (4096 + 1) rows never drops one.
-      call new_shock_log(self%shocks, m, rest_time, u0, error, capacity=m*4097 + 16)
+      call new_shock_log(self%shocks, m, rest_time, u0, error, capacity=shock_log_rows(m))
       if (allocated(error)) return
       call new_statistics(self%stats, m, transient, t_end, batches, bins, lower, upper, error)
       if (allocated(error)) return
