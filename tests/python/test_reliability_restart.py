@@ -392,3 +392,28 @@ def test_several_files_with_restart_are_all_checked_before_any_runs(tmp_path: Pa
     assert "b.h5.checkpoint: the checkpoint belongs to another scene" in done.stderr
     assert "none of the 3 scenes was run" in done.stderr
     assert not (tmp_path / "a.h5").exists() and not (tmp_path / "c.h5").exists()
+
+
+def test_an_interrupted_run_counts_its_shocks_not_its_contact_phases(tmp_path: Path) -> None:
+    """A run stopped by SIGTERM wrote its contact phases as `impacts` (the README: `impacts`
+    counts shocks): the partial file's `impacts` is now the shocks closed so far, those of the
+    resumed run's shock log that had ended by then (closed a rest time and two steps later)."""
+    scene = tmp_path / "s.nml"
+    scene.write_text("&time dt=5e-5, t_end=400 /\n&output file='s.h5', record_every=100 /\n")
+    process = subprocess.Popen([PROGRAM, "run", str(scene)], cwd=tmp_path, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+    partial = tmp_path / "s.h5.partial"
+    while process.poll() is None and not partial.exists():
+        time.sleep(0.01)
+    time.sleep(0.4)
+    process.send_signal(signal.SIGTERM)
+    assert process.wait() != 0
+    with h5py.File(partial) as f:
+        impacts, phases, stopped = int(f.attrs["impacts"]), int(f.attrs["contact_phases"]), float(f.attrs["t_final"])
+    assert 0 < impacts < phases
+    done = run("run", scene, "--restart", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    final = beamstops.load(tmp_path / "s.h5")
+    t_start, t_end = final.impacts["t_start"], final.impacts["t_end"]
+    rest = final.scene().rest_time
+    assert np.count_nonzero(t_end + rest + 3 * 5e-5 < stopped) <= impacts <= np.count_nonzero(t_start < stopped)
