@@ -601,3 +601,31 @@ def test_a_point_the_engine_refuses_refuses_the_specification_before_anything_is
     limits = beamstops.stability(spec.points[0].scene)
     assert limits.runnable and limits.run_model == "reduced model of 4 modes"
     assert limits.dt_limit_run == pytest.approx(1.296673e-3, rel=1e-6) and limits.dt_limit_newmark < 2e-5
+
+
+@pytest.mark.parametrize("how", ["option", "spec"])
+def test_a_time_limit_of_any_length_works(how: str, tmp_path: Path, write_spec: Callable[..., Path]) -> None:
+    """A limit beyond what one wait takes (2**31 ms over the points of a batch; 1e300 s beyond
+    Python's clock) made every point fail with `OverflowError: timeout is too large`: a 30-day
+    limit, or 1e300 s, is waited in pieces and the points complete."""
+    if how == "option":
+        done = sweep_command(write_spec(STABLE), "-o", tmp_path / "out", "-j", "1", "--timeout", str(30 * 86400),
+                             cwd=tmp_path)
+    else:
+        done = sweep_command(write_spec("[sweep]\ntimeout = 1e300\n" + STABLE), "-o", tmp_path / "out", "-j", "1",
+                             cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert [r["status"] for r in read_summary(tmp_path / "out")] == ["complete", "complete"]
+
+
+def test_a_long_time_limit_is_waited_in_pieces(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The wait for a point's program is cut into pieces no longer than one wait can take; the
+    limit still stops a program that runs beyond it."""
+    from beamstops.sweep import worker
+
+    monkeypatch.setattr(worker, "_WAIT_PIECE", 0.05)
+    sleeper = [sys.executable, "-c", "import time; time.sleep(0.4); print('done')"]
+    done = worker._run(sleeper, timeout=1e300)
+    assert done.returncode == 0 and done.stdout == "done\n"
+    with pytest.raises(subprocess.TimeoutExpired):
+        worker._run([sys.executable, "-c", "import time; time.sleep(60)"], timeout=0.2)

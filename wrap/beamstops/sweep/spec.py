@@ -7,7 +7,7 @@ A specification (``input/sweeps/*.toml``)::
     mode = "product"              # "product" (default: every combination) or "zip" (axes side by side)
     zip = [["omega", "amplitude"]]  # product mode only: groups of axes that vary together
     max_points = 10000            # refuse larger sweeps (default 10000)
-    timeout = 600                 # wall-time limit of one point (s; default none)
+    timeout = 600                 # wall-time limit of one point (s > 0, any length; default none)
     lockstep = 8                  # points per `beamstops run` process (default 8; 1: one process per point)
     description = "free text"
 
