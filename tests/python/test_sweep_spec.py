@@ -151,6 +151,16 @@ BAD: list[tuple[str, str, str]] = [
     ("reduction key", "[axes]\nomega = [1]\n[reductions.x]\nkind = 'max'\nwhen = 3", "unknown key 'when'"),
     ("reduction quantity", "[axes]\nomega = [1]\n[reductions.x]\nkind = 'max'\nquantity = 'u'", "quantity = 'u'"),
     ("reduction name", "[axes]\nomega = [1]\n[reductions.status]\nkind = 'max'", "taken by a column"),
+    # a strobe's derived columns (NAME_offset, NAME_period) were a second column of that name in
+    # summary.csv, and one result was lost in summary.json
+    ("strobe's column", "[axes]\nomega = [1]\n[reductions.x]\nkind = 'strobe'\n[reductions.x_period]\nkind = 'max'",
+     "reduction name 'x_period' is taken by a column of [reductions.x] (a strobe fills the columns x, x_offset, "
+     "x_period); choose another name"),
+    ("strobe after", "[axes]\nomega = [1]\n[reductions.x_offset]\nkind = 'final'\n[reductions.x]\nkind = 'strobe'",
+     "[reductions.x]: a strobe fills the columns x, x_offset, x_period, and x_offset is [reductions.x_offset]; "
+     "choose another name"),
+    ("two strobes", "[axes]\nomega = [1]\n[reductions.a]\nkind = 'strobe'\n[reductions.a_offset]\nkind = 'strobe'",
+     "reduction name 'a_offset' is taken by a column of [reductions.a]"),
     ("strobe omega 0", "[scene]\nomega = 0.0\n[axes]\namplitude = [1.0]\n[reductions.s]\nkind = 'strobe'",
      "needs omega > 0"),
     ("material incomplete", "[axes]\nyoungs_modulus = [2e11]", "density is missing"),

@@ -34,6 +34,8 @@ A specification (``input/sweeps/*.toml``)::
     kind = "max"                  # max, min, mean, rms, peak_to_peak, final
     quantity = "tip_u"            # tip_u, tip_v, reaction, energy, work, dissipated, damped
     after_periods = 50            # or after = 1.5 (s): only the records from then on
+    # a reduction's columns (a strobe's NAME, NAME_offset, NAME_period) are its own: a name that is
+    # a column of the summary or of another reduction is refused
 
 Axis and scene keys are the namelist keys of :class:`beamstops.Scene` (fields and the
 routes ``stiffness`` and the four material keys); ``file`` is the sweep's to set.
@@ -551,7 +553,10 @@ def _periods(table: Any, fixed: dict[str, Any], axes: dict[str, list[Any]], fail
 
 
 def _reductions(table: Any, axes: list[str], fail: Any) -> dict[str, dict[str, Any]]:
+    from .reductions import columns
+
     out: dict[str, dict[str, Any]] = {}
+    owner: dict[str, str] = {}  # every reduction's columns (a strobe's NAME_offset, NAME_period): whose
     for name, body in table.items():
         if not _NAME.match(name):
             raise fail(f"reduction name {name!r}: use letters, digits and _")
@@ -584,6 +589,21 @@ def _reductions(table: Any, axes: list[str], fail: Any) -> dict[str, dict[str, A
             raise fail(f"[reductions.{name}] phase = {spec['phase']!r}; allowed: 0 <= phase < 1 (a fraction of T)")
         if spec.get("after") is not None and spec.get("after_periods") is not None:
             raise fail(f"[reductions.{name}]: give after (s) or after_periods, not both")
+        filled = columns(name, spec)
+        fills = f"a {kind} fills the columns {', '.join(filled)}" if len(filled) > 1 else ""
+        for column in filled:
+            if column != name and (column in BUILTIN_COLUMNS or column in axes or column in SCENE_KEYS):
+                raise fail(f"[reductions.{name}]: {fills}, and {column} is taken by a column of the summary; "
+                           "choose another name")
+            if column in owner:
+                other = owner[column]
+                theirs = columns(other, out[other])
+                if column == name:  # this name is a column another reduction fills
+                    raise fail(f"reduction name {name!r} is taken by a column of [reductions.{other}] (a "
+                               f"{out[other]['kind']} fills the columns {', '.join(theirs)}); choose another name")
+                raise fail(f"[reductions.{name}]: {fills}, and {column} is [reductions.{other}]; choose another "
+                           "name")
+        owner.update((column, name) for column in filled)
         out[name] = spec
     return out
 
