@@ -629,3 +629,40 @@ def test_a_long_time_limit_is_waited_in_pieces(monkeypatch: pytest.MonkeyPatch) 
     assert done.returncode == 0 and done.stdout == "done\n"
     with pytest.raises(subprocess.TimeoutExpired):
         worker._run([sys.executable, "-c", "import time; time.sleep(60)"], timeout=0.2)
+
+
+@pytest.mark.parametrize("content", [
+    '{"format": 1, "spec_hash": 5}', "[1, 2]", '"text"', "{}", "[" * 100000, "\xff\xfe",
+    "SPEC_HASH_BUT_OVERRIDES_OF_NUMBERS", "SPEC_HASH_OF_ANOTHER_FORMAT"])
+def test_a_tampered_manifest_is_unreadable_in_one_line(content: str, tmp_path: Path, write_spec: Callable[..., Path],
+                                                       program: str) -> None:
+    """A sweep.json of another structure (`"spec_hash": 5` ended in a traceback, `TypeError: 'int'
+    object is not subscriptable`): the folder's one line, exit status 1, the points left alone."""
+    spec_path = write_spec(STABLE)
+    out = tmp_path / "out"
+    prepare_folder(load_spec(spec_path), out, program)
+    good = json.loads((out / "sweep.json").read_text())
+    if content == "SPEC_HASH_BUT_OVERRIDES_OF_NUMBERS":
+        content = json.dumps({**good, "overrides": [5]})
+    elif content == "SPEC_HASH_OF_ANOTHER_FORMAT":
+        content = json.dumps({**good, "format": 99})
+    (out / "sweep.json").write_bytes(content.encode("latin-1") if content == "\xff\xfe" else content.encode())
+    (out / "points" / "mine.txt").write_text("kept")
+    done = sweep_command(spec_path, "-o", out, cwd=tmp_path)
+    assert done.returncode == 1
+    assert done.stderr == f"beamstops: error: {out}: sweep.json is unreadable; this is not a sweep folder to resume\n"
+    assert (out / "points" / "mine.txt").read_text() == "kept" and not (out / "points" / "00000.h5").exists()
+
+
+def test_a_tampered_point_record_is_made_again(tmp_path: Path, write_spec: Callable[..., Path]) -> None:
+    """A point's record of another structure (reductions that are not an object, a text for a
+    number) is not taken for the point's: the finished output is reduced again, no traceback."""
+    spec = load_spec(write_spec(STABLE + "[reductions.u]\nkind = 'max'\n"))
+    run_sweep(spec, tmp_path / "out", jobs=1, stream=None)
+    record = tmp_path / "out" / "points" / "00000.json"
+    first = json.loads(record.read_text())
+    record.write_text(json.dumps({**first, "reductions": 5, "cpu_seconds": "fast"}))
+    again = run_sweep(spec, tmp_path / "out", jobs=1, stream=None)
+    assert (again.ran, again.skipped, again.complete) == (1, 1, 2)
+    row = read_summary(tmp_path / "out")[0]
+    assert row["u"] == first["reductions"]["u"] and row["cpu_seconds"] == first["cpu_seconds"]
