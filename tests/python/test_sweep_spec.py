@@ -323,3 +323,29 @@ def test_the_allowed_scene_keys_are_listed_once_each(write_spec: Callable[..., P
     points = load_spec(write_spec("[axes]\nmodes = [0, 4]\n", "modes.toml")).points
     assert [p.scene.modes for p in points] == [0, 4]
     assert {p.scene.damping_modes for p in points} == {Scene().damping_modes}
+
+
+@pytest.mark.parametrize("axes, count, shape", [
+    ("omega = { start = 1, stop = 2, step = 1e-300 }", "about 1e+300", "about 1e+300"),
+    ("omega = { start = 1, stop = 2, step = 1e-300 }\namplitude = { start = 0, stop = 0.1, step = 1e-300 }\n"
+     "dt = { start = 1e-5, stop = 2e-5, step = 1e-307 }", "about 1e+901", "about 1e+300 × about 1e+299 × about 1e+302"),
+    ("omega = { start = 1, stop = 2, step = 1e-12 }", "about 1e+12", "about 1e+12"),
+    ("omega = { start = 1, stop = 2, num = 100000 }\namplitude = [0.1, 0.2]", "200000", "100000 × 2"),
+])
+def test_a_huge_number_of_points_is_written_compactly(axes: str, count: str, shape: str,
+                                                      write_spec: Callable[..., Path]) -> None:
+    """A step of 1e-300 printed a count of 301 digits, twice (a line of 721 characters)."""
+    path = write_spec(f"[axes]\n{axes}\n")
+    with pytest.raises(SpecError) as info:
+        load_spec(path)
+    assert str(info.value) == (f"{path}: the axes make {count} points ({shape}), more than max_points = 10000; "
+                               "set [sweep] max_points if you mean it")
+
+
+def test_zip_axes_of_huge_lengths_are_written_compactly(write_spec: Callable[..., Path]) -> None:
+    path = write_spec("[sweep]\nmode = 'zip'\n[axes]\nomega = { start = 1, stop = 2, step = 1e-300 }\n"
+                      "amplitude = [0.1, 0.2]\n")
+    with pytest.raises(SpecError) as info:
+        load_spec(path)
+    assert str(info.value) == (f"{path}: zip axes of different lengths: omega has about 1e+300 values, amplitude has "
+                               "2 values")

@@ -287,12 +287,12 @@ def _parse(data: Mapping[str, Any], path: str, base_dir: Path, text: str, overri
         lengths = {key: sizes[key] for key in group}
         if len(set(lengths.values())) > 1:
             raise fail("zip axes of different lengths: "
-                       + ", ".join(f"{key} has {n} value{'s' if n != 1 else ''}" for key, n in lengths.items()))
+                       + ", ".join(f"{key} has {_many(n)} value{'s' if n != 1 else ''}" for key, n in lengths.items()))
         total *= lengths[group[0]]
         if total > max_points:
             break
     if total > max_points:
-        shape = " × ".join(str(sizes[g[0]]) for g in groups)
+        shape = " × ".join(_many(sizes[g[0]]) for g in groups)
         raise fail(f"the axes make {_count(groups, sizes)} points ({shape}), more than max_points = {max_points}; "
                    "set [sweep] max_points if you mean it")
     axes = {key: _axis_values(key, value, fail) for key, value in raw_axes.items()}
@@ -504,11 +504,34 @@ def _groups(zips: Any, mode: str, names: list[str], fail: Any) -> list[list[str]
     return out
 
 
-def _count(groups: list[list[str]], sizes: dict[str, int]) -> int:
+#: Counts up to this many digits are written out; larger ones as ``about 1e+300``.
+_DIGITS = 12
+
+
+def _many(count: int) -> str:
+    """A number of points or values as written, or compactly when it is huge (a step of 1e-300 gave
+    a count of 301 digits)."""
+    return str(count) if count < 10**_DIGITS else _about(math.log10(count))
+
+
+def _about(log10: float) -> str:
+    exponent = math.floor(log10)
+    mantissa = round(10 ** (log10 - exponent), 1)
+    if mantissa >= 10:
+        mantissa, exponent = mantissa / 10, exponent + 1
+    return f"about {mantissa:g}e+{exponent}"
+
+
+def _count(groups: list[list[str]], sizes: dict[str, int]) -> str:
+    """The number of points of the axes, as :func:`_many` writes it (from the sum of the logarithms
+    when it is huge: the product of a few such axes has thousands of digits)."""
+    log10 = sum(math.log10(sizes[group[0]]) for group in groups)
+    if log10 >= _DIGITS:
+        return _about(log10)
     total = 1
     for group in groups:
         total *= sizes[group[0]]
-    return total
+    return _many(total)
 
 
 def _combinations(axes: dict[str, list[Any]], groups: list[list[str]]) -> list[dict[str, Any]]:
