@@ -349,3 +349,27 @@ def test_zip_axes_of_huge_lengths_are_written_compactly(write_spec: Callable[...
         load_spec(path)
     assert str(info.value) == (f"{path}: zip axes of different lengths: omega has about 1e+300 values, amplitude has "
                                "2 values")
+
+
+def test_max_points_is_at_most_what_the_engine_checks_in_reasonable_time(write_spec: Callable[..., Path]) -> None:
+    """max_points up to 10,000,000 was accepted, but every point's scene is read and checked by the
+    engine before anything runs (a --dry-run of 10M points ran for minutes and 4.4 GB and had not
+    ended): the largest sweep accepted is 100,000 points."""
+    path = write_spec("[sweep]\nmax_points = 100001\n[axes]\nomega = [1.0]\n")
+    with pytest.raises(SpecError) as info:
+        load_spec(path)
+    assert str(info.value) == f"{path}: [sweep] max_points = 100001; allowed: an integer 1 ... 100000"
+    assert len(load_spec(write_spec("[sweep]\nmax_points = 100000\n[axes]\nomega = [1.0]\n")).points) == 1
+
+
+def test_the_hash_is_the_resolved_specification_s_text_written_point_by_point(write_spec: Callable[..., Path]) -> None:
+    """The hash is computed point by point (the text of 100,000 points is some 200 MB), and is the one
+    of the whole text, so that folders written before resume."""
+    import hashlib
+    import json
+
+    spec = load_spec(write_spec(GOOD))
+    text = json.dumps(spec.resolved(), sort_keys=True, allow_nan=False)
+    assert spec.hash == hashlib.sha256(text.encode()).hexdigest()
+    scene = spec.points[0].scene
+    assert scene.to_dict() == __import__("dataclasses").asdict(scene)

@@ -243,8 +243,9 @@ class Scene:
         Path(path).write_text(NAMELIST_HEADER + "\n" + self.to_text(), encoding="utf-8")
 
     def to_dict(self) -> dict[str, Any]:
-        """The fields as a flat dictionary."""
-        return dataclasses.asdict(self)
+        """The fields as a flat dictionary (their values are immutable: numbers, texts, tuples; a
+        shallow copy, where dataclasses.asdict's deep one cost a sweep of 100,000 points 30 s)."""
+        return {name: getattr(self, name) for name in _FIELD_NAMES}
 
     # ------------------------------------------------------------------ engine
 
@@ -264,6 +265,10 @@ class Scene:
             if not same:
                 out.append(f"{field.name}: {a!r} != {b!r}")
         return "; ".join(out)
+
+
+#: The fields of a Scene, in order (to_dict).
+_FIELD_NAMES: tuple[str, ...] = tuple(field.name for field in dataclasses.fields(Scene))
 
 
 # ---------------------------------------------------------------------- text
