@@ -238,3 +238,17 @@ def test_submodules_are_reachable_from_the_package_after_a_plain_import() -> Non
         "    print(exc)",
     ])
     assert out.strip() == "module 'beamstops' has no attribute 'nothing'"
+
+
+@pytest.mark.parametrize("value", ["no", "False", 0, 1, None, np.array([True]), 0.0])
+def test_allow_incomplete_is_true_or_false(value: object, tmp_path: Path) -> None:
+    """run(scene, allow_incomplete='no') was taken as true (any object is a condition); a bool (or
+    a numpy bool) is required, anything else a TypeError naming the keyword."""
+    scene = Scene(beta=0.0, dt=2e-5, t_end=0.5, allow_unstable=True, record_every=100)
+    with pytest.raises(TypeError, match=r"^run: allow_incomplete = .*; allowed: True or False$"):
+        beamstops.run(scene, allow_incomplete=value)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match=r"^load: allow_incomplete = .*; allowed: True or False$"):
+        beamstops.load(tmp_path / "nowhere.h5", allow_incomplete=value)  # type: ignore[arg-type]
+    assert beamstops.run(scene, allow_incomplete=np.bool_(True)).status == "diverged"
+    with pytest.raises(IncompleteRunError):
+        beamstops.run(scene, allow_incomplete=np.bool_(False))

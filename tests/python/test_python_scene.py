@@ -329,3 +329,43 @@ def test_the_engine_drops_a_carried_key_that_does_nothing_and_refuses_one_given_
     assert "modes" not in Scene.from_text(engine.canonical(modes, carried=["damping:modes"])).groups()["damping"]
     with pytest.raises(ValueError, match="only with law = 'compliance'"):
         Scene(law="compliance", stiffness_per_mass=1e8, beta=0.25, dt=5e-6).replace(law="signorini", stiffness=1e6)
+
+
+@pytest.mark.parametrize("value", [123, 1.5, True, b"out.h5", ["out.h5"], np.int64(7)])
+def test_the_output_file_is_a_str_or_a_path(value: object) -> None:
+    """Scene(file=123) was written `file = 123`, which the reader took for the name '123'; the file
+    is a str or an os.PathLike, and any other type a TypeError naming the key."""
+    with pytest.raises(TypeError, match=r"^scene key file = .*: allowed: a str or an os\.PathLike"):
+        Scene(file=value)
+    with pytest.raises(TypeError, match=r"^scene key file = .*: allowed: a str or an os\.PathLike"):
+        Scene().replace(file=value)
+    assert Scene(file=Path("out dir") / "a.h5").file == "out dir/a.h5" == Scene(file="out dir/a.h5").file
+    assert Scene(file="a.h5").replace(file=None).file is None
+
+
+@pytest.mark.parametrize("changes, message", [
+    ({"elements": 10**5000}, "&mesh elements = 1000000000"),     # beyond Python's int-to-str limit
+    ({"elements": -10**5000}, "&mesh elements = -1000000000"),
+    ({"nodes": [10**5000]}, "&stops nodes(1:1) = 1000000000"),
+    ({"dt": __import__("fractions").Fraction(10**400)}, "&time dt = Inf is out of range"),  # beyond the doubles
+    ({"dt": np.nan}, "&time dt = NaN is out of range"),
+    ({"seed": np.int64(2**40)}, "&ensemble seed = 1099511627776 is out of range"),
+])
+def test_huge_values_reach_the_engines_range_check(changes: dict, message: str) -> None:
+    """A whole number beyond Python's limit of 4300 digits ended in Python's own ValueError
+    ('Exceeds the limit (4300 digits) for integer string conversion'), a Fraction beyond the
+    doubles in an OverflowError: the engine's reader refuses them with the key's range."""
+    with pytest.raises(ValueError, match="^scene: " + re.escape(message)):
+        Scene(**changes)
+
+
+@pytest.mark.parametrize("call", ["from_text", "replace", "validate", "stability"])
+def test_a_source_that_is_not_text_is_a_type_error(call: str) -> None:
+    """The name messages start with went to os.fsencode: 'expected str, bytes or os.PathLike object'."""
+    scene = Scene(t_end=0.01)
+    calls = {"from_text": lambda: Scene.from_text("&time /", 5), "replace": lambda: scene.replace(_source=5, dt=1e-5),
+             "validate": lambda: scene.validate(5), "stability": lambda: beamstops.stability(scene, 5)}
+    with pytest.raises(TypeError, match=r"^source = 5: allowed: a str"):
+        calls[call]()
+    with pytest.raises(TypeError, match=r"^path = None: allowed: a str or an os\.PathLike"):
+        Scene.from_namelist(None)  # type: ignore[arg-type]

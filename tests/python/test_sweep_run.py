@@ -601,3 +601,68 @@ def test_a_point_the_engine_refuses_refuses_the_specification_before_anything_is
     limits = beamstops.stability(spec.points[0].scene)
     assert limits.runnable and limits.run_model == "reduced model of 4 modes"
     assert limits.dt_limit_run == pytest.approx(1.296673e-3, rel=1e-6) and limits.dt_limit_newmark < 2e-5
+
+
+@pytest.mark.parametrize("how", ["option", "spec"])
+def test_a_time_limit_of_any_length_works(how: str, tmp_path: Path, write_spec: Callable[..., Path]) -> None:
+    """A limit beyond what one wait takes (2**31 ms over the points of a batch; 1e300 s beyond
+    Python's clock) made every point fail with `OverflowError: timeout is too large`: a 30-day
+    limit, or 1e300 s, is waited in pieces and the points complete."""
+    if how == "option":
+        done = sweep_command(write_spec(STABLE), "-o", tmp_path / "out", "-j", "1", "--timeout", str(30 * 86400),
+                             cwd=tmp_path)
+    else:
+        done = sweep_command(write_spec("[sweep]\ntimeout = 1e300\n" + STABLE), "-o", tmp_path / "out", "-j", "1",
+                             cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert [r["status"] for r in read_summary(tmp_path / "out")] == ["complete", "complete"]
+
+
+def test_a_long_time_limit_is_waited_in_pieces(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The wait for a point's program is cut into pieces no longer than one wait can take; the
+    limit still stops a program that runs beyond it."""
+    from beamstops.sweep import worker
+
+    monkeypatch.setattr(worker, "_WAIT_PIECE", 0.05)
+    sleeper = [sys.executable, "-c", "import time; time.sleep(0.4); print('done')"]
+    done = worker._run(sleeper, timeout=1e300)
+    assert done.returncode == 0 and done.stdout == "done\n"
+    with pytest.raises(subprocess.TimeoutExpired):
+        worker._run([sys.executable, "-c", "import time; time.sleep(60)"], timeout=0.2)
+
+
+@pytest.mark.parametrize("content", [
+    '{"format": 1, "spec_hash": 5}', "[1, 2]", '"text"', "{}", "[" * 100000, "\xff\xfe",
+    "SPEC_HASH_BUT_OVERRIDES_OF_NUMBERS", "SPEC_HASH_OF_ANOTHER_FORMAT"])
+def test_a_tampered_manifest_is_unreadable_in_one_line(content: str, tmp_path: Path, write_spec: Callable[..., Path],
+                                                       program: str) -> None:
+    """A sweep.json of another structure (`"spec_hash": 5` ended in a traceback, `TypeError: 'int'
+    object is not subscriptable`): the folder's one line, exit status 1, the points left alone."""
+    spec_path = write_spec(STABLE)
+    out = tmp_path / "out"
+    prepare_folder(load_spec(spec_path), out, program)
+    good = json.loads((out / "sweep.json").read_text())
+    if content == "SPEC_HASH_BUT_OVERRIDES_OF_NUMBERS":
+        content = json.dumps({**good, "overrides": [5]})
+    elif content == "SPEC_HASH_OF_ANOTHER_FORMAT":
+        content = json.dumps({**good, "format": 99})
+    (out / "sweep.json").write_bytes(content.encode("latin-1") if content == "\xff\xfe" else content.encode())
+    (out / "points" / "mine.txt").write_text("kept")
+    done = sweep_command(spec_path, "-o", out, cwd=tmp_path)
+    assert done.returncode == 1
+    assert done.stderr == f"beamstops: error: {out}: sweep.json is unreadable; this is not a sweep folder to resume\n"
+    assert (out / "points" / "mine.txt").read_text() == "kept" and not (out / "points" / "00000.h5").exists()
+
+
+def test_a_tampered_point_record_is_made_again(tmp_path: Path, write_spec: Callable[..., Path]) -> None:
+    """A point's record of another structure (reductions that are not an object, a text for a
+    number) is not taken for the point's: the finished output is reduced again, no traceback."""
+    spec = load_spec(write_spec(STABLE + "[reductions.u]\nkind = 'max'\n"))
+    run_sweep(spec, tmp_path / "out", jobs=1, stream=None)
+    record = tmp_path / "out" / "points" / "00000.json"
+    first = json.loads(record.read_text())
+    record.write_text(json.dumps({**first, "reductions": 5, "cpu_seconds": "fast"}))
+    again = run_sweep(spec, tmp_path / "out", jobs=1, stream=None)
+    assert (again.ran, again.skipped, again.complete) == (1, 1, 2)
+    row = read_summary(tmp_path / "out")[0]
+    assert row["u"] == first["reductions"]["u"] and row["cpu_seconds"] == first["cpu_seconds"]

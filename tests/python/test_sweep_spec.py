@@ -151,6 +151,16 @@ BAD: list[tuple[str, str, str]] = [
     ("reduction key", "[axes]\nomega = [1]\n[reductions.x]\nkind = 'max'\nwhen = 3", "unknown key 'when'"),
     ("reduction quantity", "[axes]\nomega = [1]\n[reductions.x]\nkind = 'max'\nquantity = 'u'", "quantity = 'u'"),
     ("reduction name", "[axes]\nomega = [1]\n[reductions.status]\nkind = 'max'", "taken by a column"),
+    # a strobe's derived columns (NAME_offset, NAME_period) were a second column of that name in
+    # summary.csv, and one result was lost in summary.json
+    ("strobe's column", "[axes]\nomega = [1]\n[reductions.x]\nkind = 'strobe'\n[reductions.x_period]\nkind = 'max'",
+     "reduction name 'x_period' is taken by a column of [reductions.x] (a strobe fills the columns x, x_offset, "
+     "x_period); choose another name"),
+    ("strobe after", "[axes]\nomega = [1]\n[reductions.x_offset]\nkind = 'final'\n[reductions.x]\nkind = 'strobe'",
+     "[reductions.x]: a strobe fills the columns x, x_offset, x_period, and x_offset is [reductions.x_offset]; "
+     "choose another name"),
+    ("two strobes", "[axes]\nomega = [1]\n[reductions.a]\nkind = 'strobe'\n[reductions.a_offset]\nkind = 'strobe'",
+     "reduction name 'a_offset' is taken by a column of [reductions.a]"),
     ("strobe omega 0", "[scene]\nomega = 0.0\n[axes]\namplitude = [1.0]\n[reductions.s]\nkind = 'strobe'",
      "needs omega > 0"),
     ("material incomplete", "[axes]\nyoungs_modulus = [2e11]", "density is missing"),
@@ -313,3 +323,53 @@ def test_the_allowed_scene_keys_are_listed_once_each(write_spec: Callable[..., P
     points = load_spec(write_spec("[axes]\nmodes = [0, 4]\n", "modes.toml")).points
     assert [p.scene.modes for p in points] == [0, 4]
     assert {p.scene.damping_modes for p in points} == {Scene().damping_modes}
+
+
+@pytest.mark.parametrize("axes, count, shape", [
+    ("omega = { start = 1, stop = 2, step = 1e-300 }", "about 1e+300", "about 1e+300"),
+    ("omega = { start = 1, stop = 2, step = 1e-300 }\namplitude = { start = 0, stop = 0.1, step = 1e-300 }\n"
+     "dt = { start = 1e-5, stop = 2e-5, step = 1e-307 }", "about 1e+901", "about 1e+300 × about 1e+299 × about 1e+302"),
+    ("omega = { start = 1, stop = 2, step = 1e-12 }", "about 1e+12", "about 1e+12"),
+    ("omega = { start = 1, stop = 2, num = 100000 }\namplitude = [0.1, 0.2]", "200000", "100000 × 2"),
+])
+def test_a_huge_number_of_points_is_written_compactly(axes: str, count: str, shape: str,
+                                                      write_spec: Callable[..., Path]) -> None:
+    """A step of 1e-300 printed a count of 301 digits, twice (a line of 721 characters)."""
+    path = write_spec(f"[axes]\n{axes}\n")
+    with pytest.raises(SpecError) as info:
+        load_spec(path)
+    assert str(info.value) == (f"{path}: the axes make {count} points ({shape}), more than max_points = 10000; "
+                               "set [sweep] max_points if you mean it")
+
+
+def test_zip_axes_of_huge_lengths_are_written_compactly(write_spec: Callable[..., Path]) -> None:
+    path = write_spec("[sweep]\nmode = 'zip'\n[axes]\nomega = { start = 1, stop = 2, step = 1e-300 }\n"
+                      "amplitude = [0.1, 0.2]\n")
+    with pytest.raises(SpecError) as info:
+        load_spec(path)
+    assert str(info.value) == (f"{path}: zip axes of different lengths: omega has about 1e+300 values, amplitude has "
+                               "2 values")
+
+
+def test_max_points_is_at_most_what_the_engine_checks_in_reasonable_time(write_spec: Callable[..., Path]) -> None:
+    """max_points up to 10,000,000 was accepted, but every point's scene is read and checked by the
+    engine before anything runs (a --dry-run of 10M points ran for minutes and 4.4 GB and had not
+    ended): the largest sweep accepted is 100,000 points."""
+    path = write_spec("[sweep]\nmax_points = 100001\n[axes]\nomega = [1.0]\n")
+    with pytest.raises(SpecError) as info:
+        load_spec(path)
+    assert str(info.value) == f"{path}: [sweep] max_points = 100001; allowed: an integer 1 ... 100000"
+    assert len(load_spec(write_spec("[sweep]\nmax_points = 100000\n[axes]\nomega = [1.0]\n")).points) == 1
+
+
+def test_the_hash_is_the_resolved_specification_s_text_written_point_by_point(write_spec: Callable[..., Path]) -> None:
+    """The hash is computed point by point (the text of 100,000 points is some 200 MB), and is the one
+    of the whole text, so that folders written before resume."""
+    import hashlib
+    import json
+
+    spec = load_spec(write_spec(GOOD))
+    text = json.dumps(spec.resolved(), sort_keys=True, allow_nan=False)
+    assert spec.hash == hashlib.sha256(text.encode()).hexdigest()
+    scene = spec.points[0].scene
+    assert scene.to_dict() == __import__("dataclasses").asdict(scene)

@@ -36,6 +36,21 @@ def _text(value: Any) -> str:
     return str(value).rstrip(" \x00")
 
 
+def _source(source: Any) -> bytes:
+    """The name a message starts with, for the engine (a TypeError when it is not a str)."""
+    if not isinstance(source, str):
+        raise TypeError(f"source = {source!r}: allowed: a str, the name the messages start with (e.g. 'scene')")
+    return os.fsencode(source)
+
+
+def flag(name: str, value: Any, where: str = "run") -> bool:
+    """A keyword that is True or False (a numpy bool too); a TypeError naming it otherwise ('no',
+    1 or None were taken for what they are as a condition)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{where}: {name} = {value!r}; allowed: True or False")
+    return bool(value)
+
+
 def _check(status: int, message: Any) -> None:
     if status != 0:
         raise ValueError(_text(message))
@@ -87,8 +102,10 @@ def canonical(text: str, source: str = "scene", carried: Iterable[str] = ()) -> 
     words = " ".join(carried) or " "
     # f2py hands the engine a text up to its first NUL (what follows was dropped unsaid): a NUL
     # goes as another control character, which the engine refuses as binary as it refuses NUL
+    if not isinstance(text, str):
+        raise TypeError(f"canonical: text must be a str of namelist text, not {type(text).__name__}")
     result, status, message = engine_call(_engine.bs_scene, text.replace("\x00", "\x01").encode("utf-8"),
-                                          os.fsencode(source),
+                                          _source(source),
                                           words.encode("utf-8"))
     _check(status, message)
     return _text(result)
@@ -105,6 +122,8 @@ def validate(scene: Scene, source: str = "scene") -> None:
 
 def read_file(path: PathLike) -> str:
     """The canonical text of the scene of a namelist file, read as the program reads it."""
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise TypeError(f"path = {path!r}: allowed: a str or an os.PathLike naming a namelist file")
     result, status, message = engine_call(_engine.bs_read_file, os.fsencode(os.fspath(path)))
     if status != 0 and not os.path.exists(path):
         raise FileNotFoundError(_text(message))
@@ -168,7 +187,7 @@ def stability(scene: Scene, source: str = "scene") -> Stability:
     messages start with ``source``."""
     (kappa_h, kappa_bound, kappa_contact, dt_newmark, dt_paper, dt_paper_bound, method, kappa_run, dt_run,
      run_model, refused, refusal, status, message) = engine_call(_engine.bs_stability, _scene_text(scene),
-                                                                 os.fsencode(source))
+                                                                 _source(source))
     _check(status, message)
     return Stability(kappa_h=float(kappa_h), kappa_bound=float(kappa_bound), kappa_contact=float(kappa_contact),
                      kappa_method=_text(method), dt_limit_newmark=float(dt_newmark),
@@ -222,6 +241,7 @@ def run(scene: Scene, *, allow_incomplete: bool = False, shock_capacity: int = 4
     (a ValueError holding the partial result) unless ``allow_incomplete``. ``shock_capacity``: rows
     of the shock log to make room for (a run with more shocks runs again, with room for every one).
     """
+    allow_incomplete = flag("allow_incomplete", allow_incomplete)
     if (isinstance(shock_capacity, bool) or not isinstance(shock_capacity, (int, np.integer))
             or not 1 <= shock_capacity <= MAX_SHOCK_CAPACITY):
         raise ValueError(f"run: shock_capacity = {shock_capacity!r} is out of range; allowed: a whole number, "

@@ -214,6 +214,9 @@ def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result
     size, in place, and is read again (what ``h5clear --increment=0`` does; nothing else of the
     file changes). The series of a file that is not complete are cut to the records they all hold.
     """
+    from .engine import flag
+
+    allow_incomplete = flag("allow_incomplete", allow_incomplete, "load")
     path = os.fspath(path)
     if os.path.isdir(path):
         raise IsADirectoryError(f"{path}: is a folder, not the HDF5 output of `beamstops run`; name the file")

@@ -29,6 +29,10 @@ class StudyCommand:
     description: str
     prog: str
     script_description: str
+    check: Optional[Callable[[argparse.Namespace], Optional[str]]] = None
+    """After parsing: the message refusing an option (``argument --X: ...``), or None; a refusal is
+    argparse's one line, exit status 2, before anything runs (the engine's limits on the scenes the
+    study makes of the options, :mod:`beamstops.studies.options`)."""
 
     def arguments(self, parser: argparse.ArgumentParser) -> None:
         parser.add_argument("-o", "--output", type=Path, help=f"output folder (default out/{self.stem})")
@@ -40,17 +44,25 @@ class StudyCommand:
         print(self.run(out_dir(args.output, self.stem), args))
         return 0
 
+    def checked(self, parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
+        """:meth:`handler` once :attr:`check` accepts the options (else ``parser.error``: exit status 2)."""
+        if self.check is not None:
+            message = self.check(args)
+            if message is not None:
+                parser.error(message)
+        return self.handler(args)
+
     def register(self, subparsers: argparse._SubParsersAction) -> None:
         """Add the study's subcommand to ``python -m beamstops``."""
         parser = subparsers.add_parser(self.name, help=self.help, description=self.description)
         self.arguments(parser)
-        parser.set_defaults(handler=self.handler)
+        parser.set_defaults(handler=lambda args: self.checked(parser, args))
 
     def main(self, argv: Optional[Sequence[str]] = None) -> int:
         """The study's script: parse ``argv`` (default sys.argv[1:]), run, print the file."""
         parser = OneLineParser(prog=self.prog, description=self.script_description)
         self.arguments(parser)
-        return self.handler(parser.parse_args(argv))
+        return self.checked(parser, parser.parse_args(argv))
 
 
 def register_converge(subparsers: argparse._SubParsersAction) -> None:

@@ -228,6 +228,12 @@ def _options(parser: argparse.ArgumentParser) -> None:
     qoi_options(parser)
 
 
+def _check(args: argparse.Namespace) -> Optional[str]:
+    from .options import check_statistical
+
+    return check_statistical("converge", args)
+
+
 def _run(folder: Path, args: argparse.Namespace) -> Path:
     from . import qoi_convergence
     from .qoi import HalfWidth
@@ -250,6 +256,6 @@ def _run(folder: Path, args: argparse.Namespace) -> Path:
 COMMAND = StudyCommand("convergence", _options, _run, name="converge",
                        help="convergence tables in Δt and h (markdown and CSV)",
                        description="Convergence tables in Δt and h against finer reference runs.",
-                       prog="convergence", script_description="Convergence tables in Δt and h.")
+                       prog="convergence", script_description="Convergence tables in Δt and h.", check=_check)
 register = COMMAND.register
 main = COMMAND.main

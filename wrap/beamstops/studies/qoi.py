@@ -24,8 +24,8 @@ from ..observations import Statistic
 from ..result import IncompleteRunError, Result
 from ..scene import Scene
 
-__all__ = ["QOIS", "POINTWISE", "statistic_name", "Estimate", "Law", "Measured", "laws", "measure", "HalfWidth",
-           "window_for", "cost_for"]
+__all__ = ["QOIS", "POINTWISE", "statistic_name", "Estimate", "Law", "Measured", "laws", "measure", "configure",
+           "HalfWidth", "window_for", "cost_for"]
 
 #: Study names of the QoIs and the engine's statistics they read (engine names are accepted too).
 QOIS: dict[str, str] = {
@@ -142,6 +142,17 @@ def _scalars(table: Mapping[str, Statistic]) -> dict[str, Estimate]:
             for name, stat in table.items() if stat.value.size == 1}
 
 
+def configure(scene: Scene, transient: float, window: float, *, batches: int = 20, members: int = 1,
+              perturbation: float = 1e-6, record_grid: float = 0.01) -> Scene:
+    """The scene :func:`measure` runs (the engine's reader refuses what it would not run)."""
+    changes: dict[str, object] = dict(t_end=transient + window, transient=transient, batches=batches, enabled=True,
+                                      record_every=max(1, round(record_grid / scene.dt)), snapshot_every=0,
+                                      members=members)
+    if members > 1:
+        changes.update(perturbation=perturbation)
+    return scene.replace(**changes)
+
+
 def measure(scene: Scene, transient: float, window: float, *, batches: int = 20, members: int = 1,
             perturbation: float = 1e-6, record_grid: float = 0.01) -> Measured:
     """Run ``scene`` for transient + window seconds, statistics on [transient, end] in ``batches``
@@ -150,12 +161,8 @@ def measure(scene: Scene, transient: float, window: float, *, batches: int = 20,
     if scene.nodes:
         raise ValueError("the statistical studies chart the tip stops: a scene with stops along the span has one "
                          "statistic per stop")
-    changes: dict[str, object] = dict(t_end=transient + window, transient=transient, batches=batches, enabled=True,
-                                      record_every=max(1, round(record_grid / scene.dt)), snapshot_every=0,
-                                      members=members)
-    if members > 1:
-        changes.update(perturbation=perturbation)
-    configured = scene.replace(**changes)
+    configured = configure(scene, transient, window, batches=batches, members=members, perturbation=perturbation,
+                           record_grid=record_grid)
     try:
         result: Result = run(configured, allow_incomplete=True)
     except IncompleteRunError as exc:  # pragma: no cover - allow_incomplete returns instead

@@ -43,6 +43,10 @@ class Method:
     dts: tuple[float, ...]
 
 
+#: The record grid of the runs of :func:`study` (s).
+GRID = 4e-5
+
+
 def methods(quick: bool = False) -> list[Method]:
     """The methods of the chart, each with Δt = grid/2^k (β = 0 below its stability limit)."""
     k = 3 if quick else 7
@@ -165,10 +169,20 @@ def split_qois(names: Sequence[str]) -> tuple[bool, list[str]]:
 
 
 def _options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--window", type=number("a time in s"), nargs="+", default=[0.08, 0.2],
+    parser.add_argument("--window", type=number("a time in s"), nargs="+", metavar="W",
                         help="compare on [0, W] s for each W (default 0.08 0.2: before the first impact, "
-                             "the first contact period)")
+                             "the first contact period; --quick: one W <= 0.05, default 0.05)")
     qoi_options(parser)
+
+
+#: The windows of ``--window`` when it is not given.
+WINDOWS = (0.08, 0.2)
+
+
+def _check(args: argparse.Namespace) -> Optional[str]:
+    from .options import check_statistical, check_windows
+
+    return check_windows(args) or check_statistical("work-precision", args)
 
 
 def _run(folder: Path, args: argparse.Namespace) -> Path:
@@ -183,7 +197,7 @@ def _run(folder: Path, args: argparse.Namespace) -> Path:
                                 reference_window=args.reference_window, members=args.members, quiet=args.quiet)
         printed = folder / "work_precision_statistics.md"
     if pointwise:
-        study(folder, quick=args.quick, windows=tuple(args.window), quiet=args.quiet)
+        study(folder, quick=args.quick, windows=tuple(args.window or WINDOWS), quiet=args.quiet)
         printed = folder / "work_precision.png"
     return printed
 
@@ -192,6 +206,6 @@ def _run(folder: Path, args: argparse.Namespace) -> Path:
 COMMAND = StudyCommand("work_precision", _options, _run, name="work-precision",
                        help="error against CPU time for every method (PNG, md, CSV)",
                        description="Work-precision chart: tip error against the engine's CPU time.",
-                       prog="study_workprecision", script_description=__doc__.splitlines()[0])
+                       prog="study_workprecision", script_description=__doc__.splitlines()[0], check=_check)
 register = COMMAND.register
 main = COMMAND.main

@@ -86,7 +86,7 @@ def register_sweep(subparsers: argparse._SubParsersAction) -> None:
                         help="change the specification, e.g. --set axes.omega.num=20 (a TOML value; repeatable; "
                              "changes the hash, so use another folder)")
     parser.add_argument("--timeout", type=number("a number of seconds"),
-                        help="wall-time limit of one point, s > 0 (default: [sweep] timeout)")
+                        help="wall-time limit of one point, s > 0, any length (default: [sweep] timeout)")
     parser.add_argument("--program", help="the beamstops program to run (default: the one installed with "
                                           "this package)")
     parser.add_argument("--dry-run", action="store_true", help="check the specification, list points, run nothing")

@@ -32,6 +32,7 @@ import io
 import json
 import math
 import os
+import re
 import shutil
 import signal
 import socket
@@ -328,11 +329,10 @@ def prepare_folder(spec: Spec, out: Path, program: str) -> tuple[Path, Optional[
     manifest = out / MANIFEST
     note = None
     if manifest.is_file():
-        try:
-            old = json.loads(manifest.read_text(encoding="utf-8"))
-            old_hash = old["spec_hash"]
-        except (OSError, ValueError, KeyError, TypeError):
-            raise ValueError(f"{out}: {MANIFEST} is unreadable; this is not a sweep folder to resume") from None
+        old = _read_manifest(manifest)
+        if old is None:
+            raise ValueError(f"{out}: {MANIFEST} is unreadable; this is not a sweep folder to resume")
+        old_hash = old["spec_hash"]
         if old_hash != spec.hash:
             raise ValueError(f"{out}: holds the results of another specification ({old.get('spec_file')}"
                              f"{_with_sets(old.get('overrides'))}, hash {old_hash[:12]}); {spec.path}"
@@ -353,6 +353,31 @@ def prepare_folder(spec: Spec, out: Path, program: str) -> tuple[Path, Optional[
         os.replace(tmp, manifest)
     (out / "points").mkdir(exist_ok=True)
     return out, note
+
+
+#: The manifest's entries a resume reads, and their types (sweep.json as _manifest writes it).
+_MANIFEST_TYPES: dict[str, type] = {"format": int, "spec_hash": str, "spec_file": str, "program": str,
+                                    "program_sha256": str, "overrides": list, "engine_version": str}
+_HASH = re.compile(r"^[0-9a-f]{64}$")
+
+
+def _read_manifest(path: Path) -> Optional[dict[str, Any]]:
+    """A folder's sweep.json, or None when it is not one _manifest wrote: not JSON, not an object,
+    an entry a resume reads missing or of another type (``"spec_hash": 5``), another format."""
+    try:
+        old = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):
+        return None
+    if not isinstance(old, dict):
+        return None
+    for key, kind in _MANIFEST_TYPES.items():
+        if not isinstance(old.get(key), kind) or isinstance(old.get(key), bool):
+            return None
+    if old["format"] != _MANIFEST_FORMAT or not _HASH.match(old["spec_hash"]):
+        return None
+    if not all(isinstance(item, str) for item in old["overrides"]):
+        return None
+    return old
 
 
 def _with_sets(overrides: Any) -> str:
@@ -402,12 +427,28 @@ def batches(tasks: list[dict[str, Any]], lockstep: int, workers: int) -> list[li
     return out
 
 
+#: The figures of a point's record (numbers, or null for none).
+_RECORD_NUMBERS = ("cpu_seconds", "wall_seconds", "steps", "impacts", "max_violation", "dissipated", "dt", "t_end",
+                   "record_every")
+
+
 def _read_record(path: Path) -> Optional[dict[str, Any]]:
+    """A point's record (NNNNN.json), or None when it is not one the worker wrote (then the point's
+    finished output is reduced again): its figures numbers or null, its message a text, its
+    reductions an object."""
     try:
         record = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):
         return None
-    return record if isinstance(record, dict) else None
+    if not isinstance(record, dict):
+        return None
+    for key in _RECORD_NUMBERS:
+        value = record.get(key)
+        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))):
+            return None
+    if not isinstance(record.get("message", ""), str) or not isinstance(record.get("reductions", {}), dict):
+        return None
+    return record
 
 
 # ---------------------------------------------------------------------- progress

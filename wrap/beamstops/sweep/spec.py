@@ -6,8 +6,8 @@ A specification (``input/sweeps/*.toml``)::
     base = "../quickstart.nml"    # base scene: a namelist, relative to this file (default: the paper's scene)
     mode = "product"              # "product" (default: every combination) or "zip" (axes side by side)
     zip = [["omega", "amplitude"]]  # product mode only: groups of axes that vary together
-    max_points = 10000            # refuse larger sweeps (default 10000)
-    timeout = 600                 # wall-time limit of one point (s; default none)
+    max_points = 10000            # refuse larger sweeps (default 10000, at most 100000)
+    timeout = 600                 # wall-time limit of one point (s > 0, any length; default none)
     lockstep = 8                  # points per `beamstops run` process (default 8; 1: one process per point)
     description = "free text"
 
@@ -34,6 +34,8 @@ A specification (``input/sweeps/*.toml``)::
     kind = "max"                  # max, min, mean, rms, peak_to_peak, final
     quantity = "tip_u"            # tip_u, tip_v, reaction, energy, work, dissipated, damped
     after_periods = 50            # or after = 1.5 (s): only the records from then on
+    # a reduction's columns (a strobe's NAME, NAME_offset, NAME_period) are its own: a name that is
+    # a column of the summary or of another reduction is refused
 
 Axis and scene keys are the namelist keys of :class:`beamstops.Scene` (fields and the
 routes ``stiffness`` and the four material keys); ``file`` is the sweep's to set.
@@ -91,8 +93,11 @@ __all__ = ["Spec", "Point", "SpecError", "load_spec", "parse_spec", "QUANTITIES"
 FORMAT = 1
 #: Largest sweep accepted unless [sweep] max_points says otherwise.
 DEFAULT_MAX_POINTS = 10_000
-#: [sweep] max_points cannot go beyond this.
-HARD_MAX_POINTS = 10_000_000
+#: [sweep] max_points cannot go beyond this: every point's scene is read and checked by the engine
+#: before anything runs (about 0.8 ms a point, and some 4.5 KB of memory: a --dry-run of 100,000
+#: points took 80 s of CPU and 0.45 GB; 10,000,000, accepted before, took over 2 min and 4.4 GB for
+#: a tenth of its points).
+HARD_MAX_POINTS = 100_000
 #: Keys a sweep may set: every namelist key but the output file, which the sweep names, and the
 #: positions of stops along the span (lists). ``modes`` is a key of &damping and of &mesh: a sweep's
 #: ``modes`` is the Scene field, &mesh's (the damping modes, a pair, go in the base namelist), so
@@ -285,12 +290,12 @@ def _parse(data: Mapping[str, Any], path: str, base_dir: Path, text: str, overri
         lengths = {key: sizes[key] for key in group}
         if len(set(lengths.values())) > 1:
             raise fail("zip axes of different lengths: "
-                       + ", ".join(f"{key} has {n} value{'s' if n != 1 else ''}" for key, n in lengths.items()))
+                       + ", ".join(f"{key} has {_many(n)} value{'s' if n != 1 else ''}" for key, n in lengths.items()))
         total *= lengths[group[0]]
         if total > max_points:
             break
     if total > max_points:
-        shape = " × ".join(str(sizes[g[0]]) for g in groups)
+        shape = " × ".join(_many(sizes[g[0]]) for g in groups)
         raise fail(f"the axes make {_count(groups, sizes)} points ({shape}), more than max_points = {max_points}; "
                    "set [sweep] max_points if you mean it")
     axes = {key: _axis_values(key, value, fail) for key, value in raw_axes.items()}
@@ -317,8 +322,7 @@ def _parse(data: Mapping[str, Any], path: str, base_dir: Path, text: str, overri
                 raise fail(f"{what} needs omega > 0; point {point.index} ({_params(point.params)}) "
                            f"has omega = {point.scene.omega!r}")
     _check_runs(points, fail)
-    digest = hashlib.sha256(json.dumps(_resolved(points, reductions), sort_keys=True,
-                                       allow_nan=False).encode()).hexdigest()
+    digest = _digest(points, reductions)
     return Spec(path=path, text=text, data=data, base=base_path, axes=axes, mode=mode, zip_groups=groups,
                 periods=periods, reductions=reductions, max_points=int(max_points),
                 timeout=float(timeout) if timeout is not None else None, description=description,
@@ -502,11 +506,34 @@ def _groups(zips: Any, mode: str, names: list[str], fail: Any) -> list[list[str]
     return out
 
 
-def _count(groups: list[list[str]], sizes: dict[str, int]) -> int:
+#: Counts up to this many digits are written out; larger ones as ``about 1e+300``.
+_DIGITS = 12
+
+
+def _many(count: int) -> str:
+    """A number of points or values as written, or compactly when it is huge (a step of 1e-300 gave
+    a count of 301 digits)."""
+    return str(count) if count < 10**_DIGITS else _about(math.log10(count))
+
+
+def _about(log10: float) -> str:
+    exponent = math.floor(log10)
+    mantissa = round(10 ** (log10 - exponent), 1)
+    if mantissa >= 10:
+        mantissa, exponent = mantissa / 10, exponent + 1
+    return f"about {mantissa:g}e+{exponent}"
+
+
+def _count(groups: list[list[str]], sizes: dict[str, int]) -> str:
+    """The number of points of the axes, as :func:`_many` writes it (from the sum of the logarithms
+    when it is huge: the product of a few such axes has thousands of digits)."""
+    log10 = sum(math.log10(sizes[group[0]]) for group in groups)
+    if log10 >= _DIGITS:
+        return _about(log10)
     total = 1
     for group in groups:
         total *= sizes[group[0]]
-    return total
+    return _many(total)
 
 
 def _combinations(axes: dict[str, list[Any]], groups: list[list[str]]) -> list[dict[str, Any]]:
@@ -551,7 +578,10 @@ def _periods(table: Any, fixed: dict[str, Any], axes: dict[str, list[Any]], fail
 
 
 def _reductions(table: Any, axes: list[str], fail: Any) -> dict[str, dict[str, Any]]:
+    from .reductions import columns
+
     out: dict[str, dict[str, Any]] = {}
+    owner: dict[str, str] = {}  # every reduction's columns (a strobe's NAME_offset, NAME_period): whose
     for name, body in table.items():
         if not _NAME.match(name):
             raise fail(f"reduction name {name!r}: use letters, digits and _")
@@ -584,6 +614,21 @@ def _reductions(table: Any, axes: list[str], fail: Any) -> dict[str, dict[str, A
             raise fail(f"[reductions.{name}] phase = {spec['phase']!r}; allowed: 0 <= phase < 1 (a fraction of T)")
         if spec.get("after") is not None and spec.get("after_periods") is not None:
             raise fail(f"[reductions.{name}]: give after (s) or after_periods, not both")
+        filled = columns(name, spec)
+        fills = f"a {kind} fills the columns {', '.join(filled)}" if len(filled) > 1 else ""
+        for column in filled:
+            if column != name and (column in BUILTIN_COLUMNS or column in axes or column in SCENE_KEYS):
+                raise fail(f"[reductions.{name}]: {fills}, and {column} is taken by a column of the summary; "
+                           "choose another name")
+            if column in owner:
+                other = owner[column]
+                theirs = columns(other, out[other])
+                if column == name:  # this name is a column another reduction fills
+                    raise fail(f"reduction name {name!r} is taken by a column of [reductions.{other}] (a "
+                               f"{out[other]['kind']} fills the columns {', '.join(theirs)}); choose another name")
+                raise fail(f"[reductions.{name}]: {fills}, and {column} is [reductions.{other}]; choose another "
+                           "name")
+        owner.update((column, name) for column in filled)
         out[name] = spec
     return out
 
@@ -629,6 +674,18 @@ def _check_runs(points: list[Point], fail: Any) -> None:
 
 def _params(params: dict[str, Any]) -> str:
     return ", ".join(f"{k}={v!r}" for k, v in params.items())
+
+
+def _digest(points: list[Point], reductions: dict[str, dict[str, Any]]) -> str:
+    """sha256 of ``json.dumps(_resolved(points, reductions), sort_keys=True, allow_nan=False)``, the same
+    text written point by point (the whole text of 100,000 points is some 200 MB)."""
+    digest = hashlib.sha256()
+    encode = json.JSONEncoder(sort_keys=True, allow_nan=False).encode
+    digest.update(f'{{"format": {encode(FORMAT)}, "points": ['.encode())
+    for i, point in enumerate(points):
+        digest.update(((", " if i else "") + encode({"params": point.params, "scene": point.scene.to_dict()})).encode())
+    digest.update(f'], "reductions": {encode(reductions)}}}'.encode())
+    return digest.hexdigest()
 
 
 def _resolved(points: list[Point], reductions: dict[str, dict[str, Any]]) -> dict[str, Any]:

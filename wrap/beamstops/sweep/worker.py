@@ -110,16 +110,39 @@ def _on_term(signum: int, frame: Any) -> None:
     os._exit(128 + signum)
 
 
+#: Longest single wait for the program (s). The wait polls with its time limit in milliseconds as
+#: a C int (at most 2**31 - 1 ms, 24.8 days; a batch waits its points' limits together), and a
+#: limit such as 1e300 s is beyond what Python's clock converts: a longer limit is waited in
+#: pieces of this length, so any time limit works (one longer than the run is no limit).
+_WAIT_PIECE = 86400.0
+
+
+def _communicate(process: subprocess.Popen[str], timeout: Optional[float]) -> tuple[str, str]:
+    """process.communicate(timeout=timeout) for any timeout > 0 (None: no limit), waited in pieces
+    of at most _WAIT_PIECE s (communicate may be called again after TimeoutExpired without losing
+    output); TimeoutExpired once ``timeout`` s have passed."""
+    if timeout is None:
+        return process.communicate()
+    deadline = time.monotonic() + timeout
+    while True:
+        left = deadline - time.monotonic()
+        try:
+            return process.communicate(timeout=max(0.0, min(left, _WAIT_PIECE)))
+        except subprocess.TimeoutExpired:
+            if left <= _WAIT_PIECE:
+                raise
+
+
 def _run(command: list[str], *, timeout: Optional[float],
          cwd: Optional[str] = None) -> subprocess.CompletedProcess[str]:
     """subprocess.run(command, capture_output=True, text=True, stdin=DEVNULL, timeout=...), the
-    running program known to _on_term."""
+    running program known to _on_term; any timeout > 0 works (a 30-day limit, 1e300 s)."""
     global _PROGRAM
     with subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
                           text=True, cwd=cwd) as process:
         _PROGRAM = process
         try:
-            stdout, stderr = process.communicate(timeout=timeout)
+            stdout, stderr = _communicate(process, timeout)
         except subprocess.TimeoutExpired:
             process.kill()
             process.communicate()
