@@ -1,0 +1,147 @@
+"""Outputs of ``plot``, ``plan`` and the studies (beamstops.output_files): no data destroyed, no
+half-written file, one line naming the file.
+
+Found by an audit: the studies wrote over any file at their fixed names (an HDF5 output named
+compliance.png, a namelist named convergence.md) and through symbolic links; a full disk left a
+truncated PNG in place of the old image, and a 0-byte scene that later plans refused; ``plan``
+invented /dev/stdin_plan.nml, hung on a FIFO at -o and found an unwritable -o only after its
+whole search."""
+
+from __future__ import annotations
+
+import csv
+import os
+import resource
+import stat
+import subprocess
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import beamstops
+from beamstops import cli, output_files
+from beamstops.output_files import IMAGE, WriteError
+
+PNG = b"\x89PNG\r\n\x1a\n"
+HDF5 = b"\x89HDF\r\n\x1a\n"
+SCENE = beamstops.Scene(law="none", t_end=0.05)
+PLAN = ["--qoi", "tip", "--until", "0.01", "--tol", "1e-2", "--quiet"]
+
+
+def command(*args: str | Path, cwd: Path, stdin: str | None = None,
+            preexec_fn: Callable[[], None] | None = None) -> subprocess.CompletedProcess[str]:
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    return subprocess.run([sys.executable, "-m", "beamstops", *map(str, args)], cwd=cwd, input=stdin,
+                          capture_output=True, text=True, timeout=300, env={**env, "MPLBACKEND": "Agg"},
+                          preexec_fn=preexec_fn)
+
+
+def file_size_limit(size: int) -> Callable[[], None]:
+    """RLIMIT_FSIZE in the child: a write past ``size`` bytes fails with EFBIG (Python ignores
+    SIGXFSZ), as a full disk fails with ENOSPC."""
+    def apply() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (size, resource.RLIM_INFINITY))
+
+    return apply
+
+
+@pytest.fixture(scope="module")
+def run_file(program: str, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    where = tmp_path_factory.mktemp("run")
+    SCENE.replace(snapshot_every=50, file="keep.h5").to_namelist(where / "scene.nml")
+    done = subprocess.run([program, "run", "scene.nml"], cwd=where, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    return where / "keep.h5"
+
+
+# ------------------------------------------------------------------ the helper itself
+
+def test_a_failed_write_leaves_the_old_file_and_no_temporary(tmp_path: Path) -> None:
+    old = tmp_path / "old.png"
+    old.write_bytes(PNG + b"old")
+
+    def fail(tmp: Path) -> None:
+        tmp.write_bytes(PNG + b"half")
+        raise OSError(28, "No space left on device")
+
+    with pytest.raises(WriteError) as error:
+        output_files.write(old, IMAGE, fail)
+    assert str(error.value) == f"cannot write {old}: No space left on device" and error.value.errno == 28
+    with pytest.raises(KeyboardInterrupt):
+        output_files.write(tmp_path / "new.png", IMAGE, lambda tmp: (_ for _ in ()).throw(KeyboardInterrupt()))
+    assert old.read_bytes() == PNG + b"old" and sorted(p.name for p in tmp_path.iterdir()) == ["old.png"]
+
+
+def test_a_written_file_gets_the_permissions_of_a_new_file(tmp_path: Path) -> None:
+    """The temporary file is made as a new file is (0666 less the umask), not 0600 as mkstemp makes it."""
+    mask = os.umask(0o022)
+    try:
+        path = output_files.write_text(tmp_path / "a.png", IMAGE, "<svg/>")
+    finally:
+        os.umask(mask)
+    assert stat.S_IMODE(path.stat().st_mode) == 0o644
+
+
+def test_check_refuses_links_special_files_and_unwritable_folders(tmp_path: Path) -> None:
+    (tmp_path / "image.png").write_bytes(PNG)
+    (tmp_path / "link.png").symlink_to(tmp_path / "image.png")
+    (tmp_path / "dangling.png").symlink_to(tmp_path / "absent.png")
+    os.mkfifo(tmp_path / "fifo.png")
+    for name in ("link.png", "dangling.png"):
+        with pytest.raises(FileExistsError, match=f"{name}: is a symbolic link; refusing to write an image through it"):
+            output_files.check(tmp_path / name, IMAGE)
+    with pytest.raises(FileExistsError, match="fifo.png: exists and is not a regular file"):
+        output_files.check(tmp_path / "fifo.png", IMAGE)
+    with pytest.raises(WriteError, match=r"cannot write .*/absent/x\.png: No such file or directory"):
+        output_files.check(tmp_path / "absent" / "x.png", IMAGE)
+    with pytest.raises(ValueError, match="an empty file name"):
+        output_files.check("", IMAGE)
+    assert not (tmp_path / "absent.png").exists() and (tmp_path / "image.png").read_bytes() == PNG
+    assert output_files.check(tmp_path / "image.png", IMAGE) == tmp_path / "image.png"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["dangling.png", "fifo.png", "image.png", "link.png"]
+
+
+# ------------------------------------------------------------------ plot
+
+def test_plot_on_a_write_that_fails_keeps_the_old_image(run_file: Path, tmp_path: Path) -> None:
+    """A failed write (here the file-size limit, EFBIG; a full disk is ENOSPC) had left a truncated
+    PNG in place of the old image, and a 0-byte file at a new name."""
+    assert command("plot", run_file, "-o", "old.png", cwd=tmp_path).returncode == 0
+    old = (tmp_path / "old.png").read_bytes()
+    for name in ("old.png", "new.png", "anim.gif"):
+        kind = "animation" if name.endswith("gif") else "all"
+        done = command("plot", run_file, "--kind", kind, "-o", name, cwd=tmp_path, preexec_fn=file_size_limit(4096))
+        assert done.returncode == 1 and done.stdout == "", done.stderr
+        assert done.stderr.strip() == f"beamstops: error: cannot write {name}: File too large"
+    assert (tmp_path / "old.png").read_bytes() == old
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["old.png"]
+
+
+def test_plot_refuses_an_empty_output_name(run_file: Path, tmp_path: Path) -> None:
+    """`plot -o ''` wrote the default name (run refuses it)."""
+    done = command("plot", run_file, "-o", "", cwd=tmp_path)
+    assert done.returncode == 2 and "argument -o/--output: '': allowed: an image file name" in done.stderr
+    assert list(tmp_path.iterdir()) == [] and not (run_file.parent / "keep_tip.png").exists()
+
+
+def test_plots_python_arguments_share_the_command_lines_checks(tmp_path: Path) -> None:
+    """save(result, f, kind='pdf', transient=-1) drew what --transient -1 refuses; save(None, ...)
+    raised AttributeError."""
+    result = beamstops.run(SCENE)
+    for transient, error, message in ((-1, ValueError, "transient -1: allowed: a time in s >= 0"),
+                                      (float("nan"), ValueError, "transient nan: allowed: a time in s >= 0"),
+                                      ("0.01", TypeError, "transient '0.01': allowed: a time in s >= 0")):
+        with pytest.raises(error, match=message):
+            beamstops.plots.save(result, tmp_path / "x.png", kind="pdf", transient=transient)
+        with pytest.raises(error, match=message):
+            beamstops.plots.figure(result, "psd", transient=transient)
+    with pytest.raises(TypeError, match="result: a beamstops.Result .*, not NoneType"):
+        beamstops.plots.save(None, tmp_path / "x.png")  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match="path: the image file to write .*, not NoneType"):
+        beamstops.plots.save(result, None)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="an empty name"):
+        beamstops.plots.save(result, "")
+    assert list(tmp_path.iterdir()) == []
