@@ -145,3 +145,33 @@ def test_plots_python_arguments_share_the_command_lines_checks(tmp_path: Path) -
     with pytest.raises(ValueError, match="an empty name"):
         beamstops.plots.save(result, "")
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("damage, message", [
+    (lambda f: f.__delitem__("energy"), "/energy/E: missing, where /tip/t has"),
+    (lambda f: f.__delitem__("tip/u"), "/tip/u: missing, where /tip/t has"),
+    (lambda f: (f.__delitem__("tip/u"), f.create_dataset("tip/u", data=np.zeros(3))), "/tip/u: 3 records where"),
+    (lambda f: (f.__delitem__("tip/v"), f.create_dataset("tip/v", data=np.zeros((3, 3)))), "/tip/v: 2 dimension(s)"),
+    (lambda f: (f.__delitem__("tip/u"), f.create_dataset("tip/u", data=np.array([b"a"] * 3))), "/tip/u: not numbers"),
+    (lambda f: (f.__delitem__("snapshots/x"), f.create_dataset("snapshots/x", data=np.zeros(3))),
+     "/snapshots/x: shape (3,), where the run's 19 elements have 19 + 1 nodes"),
+])
+def test_plot_of_a_file_missing_its_series_is_one_line_naming_it(run_file: Path, tmp_path: Path,
+                                                                  damage: Callable[..., object], message: str) -> None:
+    """Identity attributes in place but /energy or /tip/u missing, or /snapshots/x of the wrong size:
+    matplotlib's words without the file's name ('x and y must have same first dimension'), a
+    traceback for the snapshots."""
+    import h5py
+
+    path = tmp_path / "damaged.h5"
+    path.write_bytes(run_file.read_bytes())
+    with h5py.File(path, "r+") as f:
+        damage(f)
+    for kind in ("tip", "all"):
+        done = command("plot", path, "--kind", kind, "-o", "x.png", cwd=tmp_path)
+        assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
+        err = done.stderr.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith(f"beamstops: error: {path}: ") and message in err[0], err
+    with pytest.raises(ValueError, match="not the output of `beamstops run`, or damaged"):
+        beamstops.load(path)
+    assert not (tmp_path / "x.png").exists()
