@@ -175,3 +175,44 @@ def test_plot_of_a_file_missing_its_series_is_one_line_naming_it(run_file: Path,
     with pytest.raises(ValueError, match="not the output of `beamstops run`, or damaged"):
         beamstops.load(path)
     assert not (tmp_path / "x.png").exists()
+
+
+# ------------------------------------------------------------------ plan
+
+def test_plan_checks_its_output_before_searching(tmp_path: Path) -> None:
+    """A FIFO at -o hung; a missing folder was told after the whole search, in errno's words; a
+    link at -o was written through; a pipe gave the name /dev/stdin_plan.nml."""
+    SCENE.to_namelist(tmp_path / "s.nml")
+    os.mkfifo(tmp_path / "fifo.nml")
+    (tmp_path / "lnk.nml").symlink_to(tmp_path / "target.nml")
+    for out, message in (("fifo.nml", "fifo.nml: exists and is not a regular file (a FIFO, a device or a socket)"),
+                         ("absent/x.nml", "cannot write absent/x.nml: No such file or directory"),
+                         ("lnk.nml", "lnk.nml: is a symbolic link; refusing to write a scene through it")):
+        done = command("plan", "s.nml", *PLAN, "-o", out, cwd=tmp_path)
+        assert done.returncode == 1 and done.stdout == "", done.stderr  # no table: nothing was searched
+        err = done.stderr.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith(f"beamstops: error: {message}"), err
+    assert not (tmp_path / "target.nml").exists() and not (tmp_path / "absent").exists()
+    text = (tmp_path / "s.nml").read_text()
+    for source in ("/dev/stdin", "/dev/fd/0"):
+        done = command("plan", source, *PLAN, cwd=tmp_path, stdin=text)
+        assert done.returncode == 1 and done.stdout == "", done.stderr
+        assert done.stderr.strip() == (f"beamstops: error: {source}: a namelist read from a pipe, a device or an open "
+                                       "descriptor (/dev/stdin, /dev/fd/N, <(...)) gives no output name; allowed: "
+                                       "name the output, -o OUT.nml")
+    assert not Path("/dev/stdin_plan.nml").exists() and not Path("/dev/fd/0_plan.nml").exists()
+    done = command("plan", "/dev/stdin", *PLAN, "-o", "piped.nml", cwd=tmp_path, stdin=text)
+    assert done.returncode == 0, done.stderr
+    assert beamstops.Scene.from_namelist(tmp_path / "piped.nml").law == "none"
+
+
+def test_plan_on_a_write_that_fails_leaves_no_file(tmp_path: Path) -> None:
+    """A full disk left a 0-byte p.nml, which later plans refused as not theirs; an empty file at
+    -o is written over."""
+    SCENE.to_namelist(tmp_path / "s.nml")
+    done = command("plan", "s.nml", *PLAN, "-o", "p.nml", cwd=tmp_path, preexec_fn=file_size_limit(256))
+    assert done.returncode == 1 and done.stderr.strip().endswith("beamstops: error: cannot write p.nml: File too large")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.nml"]
+    (tmp_path / "p.nml").write_bytes(b"")
+    assert command("plan", "s.nml", *PLAN, "-o", "p.nml", cwd=tmp_path).returncode == 0
+    assert beamstops.Scene.from_namelist(tmp_path / "p.nml").law == "none"

@@ -15,6 +15,11 @@ from typing import Callable, NoReturn, Optional
 MAX_DPI = 2400
 
 
+class OptionError(ValueError):
+    """Options that do not go together (``--until`` without ``--qoi tip``): the subcommand's parser
+    reports it as it reports a bad option value, one line and exit status 2 (cli.main)."""
+
+
 class OneLineParser(argparse.ArgumentParser):
     """An ArgumentParser whose errors are one line on stderr, ``PROG: error: MESSAGE``, exit status 2,
     as the program's own (argparse's prints its usage block first); subcommands' parsers are of

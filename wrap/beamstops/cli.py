@@ -19,7 +19,7 @@ import sys
 from pathlib import Path
 from typing import Callable, Optional, Sequence
 
-from .arguments import MAX_DPI, OneLineParser, number, output_name, whole
+from .arguments import MAX_DPI, OneLineParser, OptionError, number, output_name, whole
 
 
 def _plot(args: argparse.Namespace) -> int:
@@ -133,6 +133,9 @@ def main(argv: Optional[Sequence[str]] = None, prog: str = "python -m beamstops"
     quiet_font_lookup()
     try:
         return int(args.handler(args))
+    except OptionError as exc:  # options that do not go together: as a bad option value
+        _subcommands(parser).choices[args.command].error(str(exc))
+        return 2  # not reached: error() exits with status 2
     except (OSError, ValueError) as exc:
         print(f"beamstops: error: {exc}", file=sys.stderr)
         return 1
