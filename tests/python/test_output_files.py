@@ -216,3 +216,106 @@ def test_plan_on_a_write_that_fails_leaves_no_file(tmp_path: Path) -> None:
     (tmp_path / "p.nml").write_bytes(b"")
     assert command("plan", "s.nml", *PLAN, "-o", "p.nml", cwd=tmp_path).returncode == 0
     assert beamstops.Scene.from_namelist(tmp_path / "p.nml").law == "none"
+
+
+# ------------------------------------------------------------------ studies
+
+#: A study, its options, and one name it writes of each kind (table, CSV, chart).
+STUDIES = [
+    ("converge", [], ["convergence.md", "dt_none_centered.csv", "h_none.md"]),
+    ("converge", ["--qoi", "tip_rms"], ["qoi_convergence.md", "qoi_convergence_tip_rms_dt.csv",
+                                        "qoi_convergence_tip_rms.png"]),
+    ("work-precision", [], ["work_precision.md", "work_precision.csv", "work_precision.png"]),
+    ("work-precision", ["--qoi", "tip_rms"], ["work_precision_statistics.md", "statistics_runs.csv",
+                                              "work_precision_tip_rms_dt.png"]),
+    ("stability-map", [], ["stability.md", "stability_beta.csv", "stability_map.png"]),
+    ("compliance", [], ["compliance.md", "compliance.csv", "compliance.png"]),
+    ("contact-laws", [], ["contact_laws.md", "contact_laws_energy.csv", "contact_laws.png"]),
+]
+
+
+@pytest.mark.parametrize("study, options, names", STUDIES)
+def test_a_study_refuses_before_running_to_write_over_what_is_not_its_own(
+        tmp_path: Path, study: str, options: list[str], names: list[str], capsys: pytest.CaptureFixture[str]) -> None:
+    """`cp run.h5 u/compliance.png; echo notes > u/compliance.md; beamstops compliance -o u` exited 0
+    with them gone; a link at compliance.png destroyed what it led to."""
+    run_h5, notes = HDF5 + b"\0" * 64, b"my notes\n"
+    precious = tmp_path / "precious.h5"
+    precious.write_bytes(run_h5)
+    for name, content in zip(names, (notes, run_h5, notes)):
+        folder = tmp_path / f"d_{name}"
+        folder.mkdir()
+        (folder / name).write_bytes(content)
+        (folder / "other.txt").write_bytes(notes)
+        assert cli.main([study, *options, "--quick", "--quiet", "-o", str(folder)]) == 1
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith(f"beamstops: error: {folder / name}: exists and "), err
+        assert "move it away or choose another -o folder" in err[0] or "name another file" in err[0], err
+        assert sorted(p.name for p in folder.iterdir()) == sorted([name, "other.txt"])  # nothing ran
+        assert (folder / name).read_bytes() == content
+        link = tmp_path / f"l_{name}"
+        link.mkdir()
+        (link / name).symlink_to(precious)
+        assert cli.main([study, *options, "--quick", "--quiet", "-o", str(link)]) == 1
+        assert f"{link / name}: is a symbolic link" in capsys.readouterr().err
+    assert precious.read_bytes() == run_h5
+
+
+def test_a_study_checks_every_file_of_both_parts_before_either_runs(tmp_path: Path,
+                                                                    capsys: pytest.CaptureFixture[str]) -> None:
+    """converge --qoi tip STAT runs the statistics' study, then the pointwise one: the namelist at
+    convergence.md was found (and kept) only after the first had run and written its files."""
+    (tmp_path / "convergence.md").write_text("&time dt = 1e-5 /\n")
+    assert cli.main(["converge", "--qoi", "stop_power", "tip", "--quick", "--quiet", "-o", str(tmp_path)]) == 1
+    assert "convergence.md: exists and is not a table the study convergence wrote" in capsys.readouterr().err
+    assert [p.name for p in tmp_path.iterdir()] == ["convergence.md"]
+
+
+def test_a_study_runs_again_over_its_own_outputs_only(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Its own earlier outputs are written over (their Markdown marked, their CSV listed with their
+    content's hash); a CSV changed since is not; an empty file is; the CSV stays a plain table."""
+    (tmp_path / "compliance.png").write_bytes(b"")
+    for _ in range(2):
+        assert cli.main(["compliance", "--quick", "--quiet", "-o", str(tmp_path)]) == 0
+    capsys.readouterr()
+    text = (tmp_path / "compliance.md").read_text(encoding="utf-8")
+    assert text.startswith("<!-- beamstops study compliance: rewritten when the study runs again into this folder "
+                           "-->\n### Normal compliance")
+    table = tmp_path / "compliance.csv"
+    with table.open(newline="", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    assert rows and float(rows[0]["Δt (s)"]) > 0
+    loaded = np.genfromtxt(table, delimiter=",", names=True, dtype=None, encoding="utf-8")
+    assert loaded.shape == (len(rows),) and "np.float64" not in table.read_text(encoding="utf-8")
+    assert (tmp_path / "compliance.png").read_bytes()[:8] == PNG
+    table.write_text(table.read_text(encoding="utf-8") + "my row\n", encoding="utf-8")
+    changed = table.read_bytes()
+    assert cli.main(["compliance", "--quick", "--quiet", "-o", str(tmp_path)]) == 1
+    assert "compliance.csv: exists and is not a table the study compliance wrote, unchanged since" in \
+        capsys.readouterr().err
+    assert table.read_bytes() == changed
+
+
+def test_a_study_on_a_write_that_fails_leaves_no_half_written_file(tmp_path: Path) -> None:
+    done = command("stability-map", "--quick", "--quiet", "-o", "out", cwd=tmp_path, preexec_fn=file_size_limit(1024))
+    assert done.returncode == 1, done.stderr
+    err = done.stderr.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("beamstops: error: cannot write out/") and \
+        err[0].endswith(": File too large"), err
+    for path in (tmp_path / "out").iterdir():  # what was written is whole (the tables below the limit), no temporary
+        assert ".tmp" not in path.name and path.stat().st_size > 0, path
+
+
+@pytest.mark.parametrize("study", ["converge", "compliance"])
+def test_a_study_refuses_an_empty_output_folder_name(tmp_path: Path, study: str, capsys: pytest.CaptureFixture[str],
+                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    from beamstops.studies import compliance
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exit_:
+        cli.main([study, "--quick", "--quiet", "-o", ""], prog="beamstops")
+    assert exit_.value.code == 2
+    assert f"beamstops {study}: error: argument -o/--output: '': allowed: a folder name" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+    with pytest.raises(ValueError, match="an empty output folder name"):
+        compliance.study("", quick=True, quiet=True)
