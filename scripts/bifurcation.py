@@ -40,6 +40,8 @@ from matplotlib import rc_context
 from matplotlib.figure import Figure
 
 from beamstops import sweep
+from beamstops.output_files import save_figure
+from beamstops.studies.outputs import StudyFolder
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = ROOT / "input" / "sweeps" / "bifurcation.toml"
@@ -122,8 +124,7 @@ def draw(rows: list[dict[str, Any]], path: Path, title: str = "", stops: Sequenc
             twin.set_ylabel("shocks per period", color="tab:orange")
             bottom.legend(loc="upper left", fontsize=7)
         bottom.set_xlabel("forcing frequency ω (rad/s)")
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(path, dpi=150)
+        save_figure(fig, path, dpi=150)
     return path
 
 
@@ -146,6 +147,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     png = args.png or out / "bifurcation.png"
     try:
         spec = sweep.load_spec(args.spec, overrides=overrides)
+        # the chart and its table checked before the sweep runs (beamstops.studies.outputs)
+        files = StudyFolder.prepare(png.parent, "bifurcation", [png.name, png.with_suffix(".md").name])
         outcome = sweep.run_sweep(spec, out, executor=args.executor, jobs=args.jobs,
                                   stream=None if args.quiet else sys.stderr)
         rows = sweep.read_summary(out)
@@ -163,9 +166,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     command = "python scripts/bifurcation.py" + (" --quick" if args.quick else "") + (
         f" --spec {shlex.quote(str(args.spec.relative_to(ROOT) if args.spec.is_relative_to(ROOT) else args.spec))}"
         if args.spec.resolve() != SPEC else "") + "".join(f" --set {shlex.quote(s)}" for s in args.set)
-    md = png.with_suffix(".md")
-    md.write_text(f"# {title.replace(chr(10), ': ')}\n\n![bifurcation diagram]({png.name})\n\n{periods_table(rows)}\n"
-                  f"Regenerate: `{command}`\n", encoding="utf-8")
+    files.markdown(png.with_suffix(".md").name, f"# {title.replace(chr(10), ': ')}\n\n![bifurcation diagram]({png.name})"
+                   f"\n\n{periods_table(rows)}\nRegenerate: `{command}`\n")
     print(f"{png}  ({outcome.complete}/{outcome.total} points complete; regenerate: {command})")
     return 0
 

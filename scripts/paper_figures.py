@@ -38,6 +38,8 @@ from tqdm import tqdm
 
 import beamstops
 from beamstops import plots
+from beamstops.output_files import save_figure
+from beamstops.studies.outputs import StudyFolder
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -150,7 +152,7 @@ def draw_figure(run: Run, path: Path) -> None:
     if paper.xticks is not None:
         ax.set_xticks(paper.xticks)
     with rc_context({"agg.path.chunksize": 20000}):
-        fig.savefig(path, dpi=120)
+        save_figure(fig, path, dpi=120)
 
 
 def common(a: Run, b: Run) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -202,7 +204,7 @@ def draw_agreement(runs: dict[int, Run], path: Path, until: float) -> None:
         ax.set_xlabel("t (s)")
         ax.set_ylabel("u(L, t) (m)")
         ax.legend(fontsize="small")
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
 
 
 def cpu_model() -> str:
@@ -318,15 +320,20 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     args = parse_args(argv)
     try:
         scenes = {n: scene_of(n, args.input, args.t_end) for n in sorted(set(args.figures))}
-        args.out.mkdir(parents=True, exist_ok=True)
+        out = StudyFolder.prepare(args.out, "paper_figures",  # every file checked before anything runs
+                                  [f"fig{n}.png" for n in scenes] + ["agreement.png", "report.md"])
         runs = run_all(scenes)
     except (OSError, ValueError) as exc:
         print(f"paper_figures: error: {exc}", file=sys.stderr)
         return 1
-    for n, run in runs.items():
-        draw_figure(run, args.out / f"fig{n}.png")
-    draw_agreement(runs, args.out / "agreement.png", until=min(0.3, max(r.attrs["t_end"] for r in runs.values())))
-    (args.out / "report.md").write_text(report(runs, args, argv), encoding="utf-8")
+    try:
+        for n, run in runs.items():
+            draw_figure(run, out.path(f"fig{n}.png"))
+        draw_agreement(runs, out.path("agreement.png"), until=min(0.3, max(r.attrs["t_end"] for r in runs.values())))
+        out.markdown("report.md", report(runs, args, argv))
+    except OSError as exc:
+        print(f"paper_figures: error: {exc}", file=sys.stderr)
+        return 1
     print(args.out / "report.md")
     return 0
 

@@ -19,7 +19,9 @@ from pathlib import Path
 from typing import Optional, Sequence
 
 import beamstops
+from beamstops.output_files import save_figure
 from beamstops.plan import Plan, plan
+from beamstops.studies.outputs import StudyFolder
 
 
 def draw(result: Plan, path: Path) -> Path:
@@ -50,8 +52,7 @@ def draw(result: Plan, path: Path) -> Path:
                  "cheapest green point wins", fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    fig.savefig(path, dpi=120)
-    return path
+    return save_figure(fig, path, dpi=120)
 
 
 def report(result: Plan, command: str, wall: float) -> str:
@@ -75,16 +76,20 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                         help="stop at the first candidate that qualifies (default: every candidate within the budget)")
     parser.add_argument("--quiet", action="store_true")
     args = parser.parse_args(argv)
-    args.output.mkdir(parents=True, exist_ok=True)
+    try:  # every file it writes checked before the search (beamstops.studies.outputs)
+        out = StudyFolder.prepare(args.output, "plan_chart", ["plan.png", "plan_paper_power.nml", "plan.md"])
+    except (OSError, ValueError) as exc:
+        print(f"plan_chart: error: {exc}", file=sys.stderr)
+        return 1
     scene = beamstops.Scene(t_end=1.0 + args.window, transient=1.0)
     start = time.perf_counter()
     result = plan(scene, args.qoi, args.tol, budget=args.budget, exhaustive=not args.first, quiet=args.quiet)
     wall = time.perf_counter() - start
-    draw(result, args.output / "plan.png")
+    draw(result, out.path("plan.png"))
     if result.scene is not None:
-        result.scene.replace(file="plan_paper_power.h5").to_namelist(args.output / "plan_paper_power.nml")
+        out.scene("plan_paper_power.nml", result.scene.replace(file="plan_paper_power.h5"))
     command = "python scripts/plan_chart.py " + " ".join(argv if argv is not None else sys.argv[1:])
-    (args.output / "plan.md").write_text(report(result, command.strip(), wall), encoding="utf-8")
+    out.markdown("plan.md", report(result, command.strip(), wall))
     print(result.table())
     print(result.summary())
     return 0

@@ -432,15 +432,13 @@ def test_command_line_does_not_flood_stderr_with_font_lookups(output: Path, tmp_
 
 
 def test_an_image_never_overwrites_an_hdf5_file(output: Path, tmp_path: Path, result: beamstops.Result) -> None:
-    """`plot run.png -o run.png` (an output named like an image), a link to the output, or any
-    other HDF5 file at -o (`-o noext` writes noext.png): refused, the file left as it was. The
-    image was written over it."""
+    """`plot run.png -o run.png` (an output named like an image) or any other HDF5 file at -o
+    (`-o noext` writes noext.png): refused, the file left as it was. The image was written over it."""
     data = output.read_bytes()
     for name in ("run.png", "other.pdf", "noext.png"):
         (tmp_path / name).write_bytes(data)
-    (tmp_path / "link.png").symlink_to(output)
-    for plotted, target, named in (("run.png", "run.png", "run.png"), (str(output), "link.png", "link.png"),
-                                   (str(output), "other.pdf", "other.pdf"), (str(output), "noext", "noext.png")):
+    for plotted, target, named in (("run.png", "run.png", "run.png"), (str(output), "other.pdf", "other.pdf"),
+                                   (str(output), "noext", "noext.png")):
         done = plot_command(plotted, "-o", target, cwd=tmp_path)
         assert done.returncode == 1 and done.stdout == "", done.stderr
         assert done.stderr.strip() == (f"beamstops: error: {named}: exists and is an HDF5 file (a run's output?); "
@@ -450,10 +448,30 @@ def test_an_image_never_overwrites_an_hdf5_file(output: Path, tmp_path: Path, re
     assert output.read_bytes() == data
     with pytest.raises(FileExistsError, match="exists and is an HDF5 file"):
         plots.save(result, tmp_path / "run.png", kind="energy")
-    (tmp_path / "link.gif").symlink_to(output)
-    with pytest.raises(FileExistsError, match="exists and is an HDF5 file"):
-        plots.save(result, tmp_path / "link.gif", kind="animation")
     assert output.read_bytes() == data
+
+
+@pytest.mark.parametrize("target", ["output", "image"])
+def test_an_image_is_never_written_through_a_link(target: str, output: Path, tmp_path: Path,
+                                                  result: beamstops.Result) -> None:
+    """-o naming a symbolic link, to a run's output or to an image: refused, the link and what it
+    leads to left as they were. An image at the link's end was written over through it (the link
+    kept), and a link to an HDF5 file refused only for what it led to."""
+    where = output if target == "output" else tmp_path / "old.png"
+    if target == "image":
+        plots.save(result, where, kind="energy")
+    data = where.read_bytes()
+    for name in ("link.png", "link.gif"):
+        (tmp_path / name).symlink_to(where)
+    done = plot_command(output, "-o", "link.png", cwd=tmp_path)
+    assert done.returncode == 1 and done.stdout == "", done.stderr
+    assert done.stderr.strip() == ("beamstops: error: link.png: is a symbolic link; refusing to write an image "
+                                   "through it or over it; name the file itself, or remove the link")
+    with pytest.raises(FileExistsError, match="is a symbolic link"):
+        plots.save(result, tmp_path / "link.gif", kind="animation", frames=2, dpi=20)
+    with pytest.raises(FileExistsError, match="is a symbolic link"):
+        plots.save(result, tmp_path / "link.png", kind="tip")
+    assert where.read_bytes() == data and (tmp_path / "link.png").is_symlink()
 
 
 def test_an_image_overwrites_only_an_image(output: Path, tmp_path: Path, result: beamstops.Result) -> None:

@@ -24,7 +24,8 @@ def logged(tmp_path: Path) -> Path:
     with h5py.File(path, "w") as f:
         f.attrs["status"] = "complete"
         f.create_dataset("tip/t", data=np.linspace(0, 1, 11))
-        f.create_dataset("tip/u", data=np.zeros(11))
+        for name in ("tip/u", "tip/v", "tip/reaction", "energy/E", "energy/work", "energy/dissipated"):
+            f.create_dataset(name, data=np.zeros(11))  # every series a run with records writes (load checks)
     return synthetic.write(path, synthetic.impacts(25, stops=2), synthetic.statistics(stops=2, bins=20),
                            {"transient": 0.25, "batches": 8, "bins": 20, "rest_time": 1e-3})
 

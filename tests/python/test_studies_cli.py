@@ -16,10 +16,13 @@ from beamstops import cli
     ("compliance", ["compliance.png", "compliance.csv", "compliance.md"]),
 ])
 def test_quick_study(tmp_path: Path, command: str, files: list[str], capsys: pytest.CaptureFixture[str]) -> None:
-    assert cli.main([command, "--quick", "--quiet", "-o", str(tmp_path)]) == 0
-    for name in files:
-        assert (tmp_path / name).stat().st_size > 0, name
-    assert str(tmp_path) in capsys.readouterr().out
+    """Run twice into one folder: the second run writes over the first's outputs (and only over them:
+    tests/python/test_output_files.py)."""
+    for _ in range(2):
+        assert cli.main([command, "--quick", "--quiet", "-o", str(tmp_path)]) == 0
+        for name in files:
+            assert (tmp_path / name).stat().st_size > 0, name
+        assert str(tmp_path) in capsys.readouterr().out
 
 
 @pytest.mark.parametrize("command, option, value, allowed", [

@@ -15,6 +15,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from .output_files import IMAGE, check, write
 from .plotbase import need_snapshots, stop_geometry, title
 from .result import Result
 from .transforms import frame_indices
@@ -55,12 +56,20 @@ def animate(result: Result, path: str | os.PathLike[str], *, frames: int = MAX_F
             dpi: int = 100) -> Path:
     """Write the animation of the beam to ``path`` (.gif or .mp4); gives the path.
 
-    ValueError without snapshots, for another extension, or for .mp4 without ffmpeg.
+    ValueError without snapshots, for another extension, or for .mp4 without ffmpeg. The file is
+    written as :func:`beamstops.output_files.write` writes (only an image or an empty file is
+    written over, through a temporary file renamed into place once complete).
     """
     need_snapshots(result)
     path = Path(path)
     writer = _writer(path, fps)
     shown = frame_indices(result.snapshot_t.size, frames)
+    check(path, IMAGE)
+    return write(path, IMAGE, lambda tmp: _draw(result, tmp, writer, shown, dpi))
+
+
+def _draw(result: Result, path: Path, writer: object, shown: np.ndarray, dpi: int) -> None:
+    """The frames ``shown`` of the snapshots, written by ``writer`` to ``path``."""
     x, u = result.snapshot_x, result.snapshot_u
     stops_x, lower, upper = stop_geometry(result)
     length = float(x[-1]) if x.size else 1.0
@@ -105,4 +114,3 @@ def animate(result: Result, path: str | os.PathLike[str], *, frames: int = MAX_F
                 at_stops.set_data([], [])
             clock.set_text(f"t = {result.snapshot_t[i]:.5f} s")
             writer.grab_frame()  # type: ignore[attr-defined]
-    return path

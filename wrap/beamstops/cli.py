@@ -19,7 +19,7 @@ import sys
 from pathlib import Path
 from typing import Callable, Optional, Sequence
 
-from .arguments import MAX_DPI, OneLineParser, number, whole
+from .arguments import MAX_DPI, OneLineParser, OptionError, number, output_name, whole
 
 
 def _plot(args: argparse.Namespace) -> int:
@@ -46,12 +46,12 @@ def _plot(args: argparse.Namespace) -> int:
 
 def register_plot(subparsers: argparse._SubParsersAction) -> None:
     """``plot OUT.h5 [-o PNG] [--kind KIND]``: draw a run written by ``beamstops run``."""
-    from .plot_kinds import KINDS
+    from .plot_kinds import KINDS, TRANSIENT
 
     parser = subparsers.add_parser("plot", help="plot the HDF5 output of `beamstops run`",
                                    description="Plot the HDF5 output of `beamstops run` (no display needed).")
     parser.add_argument("file", type=Path, help="HDF5 file written by `beamstops run`")
-    parser.add_argument("-o", "--output",
+    parser.add_argument("-o", "--output", type=output_name("an image file name"),
                         help="image file to write, not a folder; its extension gives the format (none: .png is added, "
                              ".gif for animation); "
                              "the name written is printed (default: FILE_KIND.png next to FILE; "
@@ -64,7 +64,7 @@ def register_plot(subparsers: argparse._SubParsersAction) -> None:
                              "of the tip displacement and the reaction; poincare: (u, v) of the tip at t = kT, "
                              "T = 2π/ω; animation: the beam between its stops (.gif, or .mp4 with ffmpeg); all: "
                              "every still kind the run has data for (default: tip)")
-    parser.add_argument("--transient", type=number("a time in s", strict=False), metavar="SECONDS",
+    parser.add_argument("--transient", type=number(TRANSIENT, strict=False), metavar="SECONDS",
                         help="pdf, psd, poincare: draw only t ≥ SECONDS (pdf: the engine's histogram covers its own "
                              "transient; another one draws a histogram of the records)")
     parser.add_argument("--frames", type=whole("frames"), default=200,
@@ -133,6 +133,9 @@ def main(argv: Optional[Sequence[str]] = None, prog: str = "python -m beamstops"
     quiet_font_lookup()
     try:
         return int(args.handler(args))
+    except OptionError as exc:  # options that do not go together: as a bad option value
+        _subcommands(parser).choices[args.command].error(str(exc))
+        return 2  # not reached: error() exits with status 2
     except (OSError, ValueError) as exc:
         print(f"beamstops: error: {exc}", file=sys.stderr)
         return 1

@@ -29,12 +29,16 @@ random numbers; the engine's runs are reproducible bit for bit).
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Sequence
 from typing import Any, Optional, Union
 
+from .arguments import bounded
+
 from .plan_runs import RECORDS, STEP_WORK, Ladder, Runner, distance, dt_ladder, mesh_ladder, ratio, reduced_available, \
     richardson
-from .plan_types import LAWS, QUANTITIES, STATISTICAL, Candidate, Check, Model, Plan, Quantity, parse_tolerance
+from .plan_types import LAWS, QUANTITIES, STATISTICAL, Candidate, Check, Model, Plan, Quantity, parse_laws, \
+    parse_tolerance, window_range
 from .scene import Scene
 from .studies.common import progress
 
@@ -47,52 +51,63 @@ MAX_RUNGS = 20
 
 # ----------------------------------------------------------------------------------- search
 
-def plan(scene: Scene, qoi: Union[str, Quantity], tol: Union[str, float], *, until: Optional[float] = None,
-         budget: Optional[float] = None, laws: Optional[Sequence[str]] = None, safety: Optional[float] = None,
-         coarser: int = 2, finer: int = 3, extend: int = 2, exhaustive: bool = False, max_window: Optional[float] = None,
-         quiet: bool = False) -> Plan:
+def plan(scene: Union[Scene, str, "os.PathLike[str]"], qoi: Union[str, Quantity], tol: Union[str, float], *,
+         until: Optional[float] = None, budget: Optional[float] = None, laws: Optional[Union[str, Sequence[str]]] = None,
+         safety: Optional[float] = None, coarser: int = 2, finer: int = 3, extend: int = 2, exhaustive: bool = False,
+         max_window: Optional[float] = None, quiet: bool = False) -> Plan:
     """The cheapest model of ``scene`` whose estimated error on ``qoi`` is ≤ ``tol``, and its check.
 
-    ``qoi``: 'tip' (with ``until``, s) or a statistic of :data:`STATISTICAL`; ``tol``: absolute in the
-    quantity's unit, or a percentage string ('2%') of the scene's own value. ``laws``: contact models
-    the search may use (keys of :data:`LAWS`; default the scene's own). ``budget``: engine CPU seconds
+    ``scene``: a :class:`Scene` or the path of a namelist file. ``qoi``: 'tip' (with ``until``, s:
+    one step of the scene ≤ until ≤ its t_end) or a statistic of :data:`STATISTICAL` (no
+    ``until``); ``tol``: absolute in the quantity's unit, or a percentage string ('2%') of the
+    scene's own value. ``laws``: contact models the search may use (keys of :data:`LAWS`: one name,
+    names separated by commas, or a sequence; default the scene's own). ``budget``: engine CPU seconds
     for the search (stops refining once the next runs would exceed it). ``safety``: factor on the
     estimates (default 2 for the tip, 1 for statistics, whose difference already carries both runs'
-    noise). ``coarser``/``finer``: Δt ladder from dt·2^coarser down to dt/2^finer. ``exhaustive``:
-    estimate every candidate (within the budget) instead of stopping at the first, in order of
-    predicted cost, that qualifies. ``extend``: when nothing qualifies, add up to this many finer rungs
-    (Δt/2 and 2J each) and go on. Raises ValueError on bad input (``until`` beyond the scene's
-    ``t_end`` among them: the chosen scene keeps the scene's ``t_end``). :attr:`Plan.met` says whether
-    the outcome meets the tolerance, :meth:`Plan.shortfall` why not.
+    noise). ``coarser``/``finer``: Δt ladder from dt·2^coarser down to dt/2^finer (rungs beyond the
+    tip's window or the scene's t_end left out). ``exhaustive``: estimate every candidate (within the
+    budget) instead of stopping at the first, in order of predicted cost, that qualifies.
+    ``extend``: when nothing qualifies, add up to this many finer rungs (Δt/2 and 2J each) and go
+    on. Raises ValueError on bad input and TypeError on arguments of the wrong type.
+    :attr:`Plan.met` says whether the outcome meets the tolerance, :meth:`Plan.shortfall` why not.
     """
-    quantity = qoi if isinstance(qoi, Quantity) else Quantity(qoi, until=until)
-    if quantity.deterministic and quantity.until is not None and not quantity.until <= scene.t_end:
-        raise ValueError(f"until {quantity.until!r} s is beyond the scene's t_end = {scene.t_end!r} s; allowed: "
-                         f"0 < until ≤ {scene.t_end!r} s (the chosen scene runs to the scene's own t_end)")
+    if isinstance(scene, (str, os.PathLike)):
+        scene = Scene.from_namelist(scene)
+    elif not isinstance(scene, Scene):
+        raise TypeError(f"scene: a beamstops.Scene or the path of a namelist file, not {type(scene).__name__}")
+    if isinstance(qoi, Quantity):
+        if until is not None and until != qoi.until:
+            raise ValueError(f"until {until!r} differs from the quantity's until {qoi.until!r}: give one")
+        quantity = qoi
+    else:
+        quantity = Quantity(qoi, until=until)
+    if quantity.deterministic:
+        assert quantity.until is not None
+        window_range(quantity.until, scene.t_end, scene.dt)
     fraction, relative = parse_tolerance(tol)
-    if budget is not None and not budget > 0:
-        raise ValueError(f"budget {budget!r}: CPU seconds > 0")
-    if not (0 <= coarser <= MAX_RUNGS and 2 <= finer <= MAX_RUNGS and 0 <= extend <= MAX_RUNGS):
-        raise ValueError(f"the Δt ladder (coarser {coarser}, finer {finer}, extend {extend}) needs "
-                         f"0 <= coarser <= {MAX_RUNGS}, 2 <= finer <= {MAX_RUNGS} and 0 <= extend <= {MAX_RUNGS} "
-                         f"(powers of 2 of the scene's Δt)")
-    if max_window is not None and not (math.isfinite(max_window) and max_window > 0):
-        raise ValueError(f"max_window {max_window!r}: allowed: a window after the transient > 0 s")
+    if budget is not None:
+        bounded(budget, "engine CPU seconds", name="budget")
+    for name, value, low in (("coarser", coarser, 0), ("finer", finer, 2), ("extend", extend, 0)):
+        if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= MAX_RUNGS:
+            raise ValueError(f"{name} {value!r}: allowed: a whole number {low} ... {MAX_RUNGS} (powers of 2 of the "
+                             f"scene's Δt: the Δt ladder runs from dt·2^coarser to dt/2^finer)")
+    if max_window is not None:
+        bounded(max_window, "a window after the transient in s", name="max_window")
     reference_law = "redistributed" if (scene.law == "signorini" and scene.mass == "redistributed") else scene.law
-    chosen_laws = list(dict.fromkeys(laws)) if laws else [reference_law]
-    unknown = [law for law in chosen_laws if law not in LAWS]
-    if unknown:
-        raise ValueError(f"unknown law(s) {', '.join(unknown)}; choose among {', '.join(LAWS)}")
+    chosen_laws = parse_laws(laws) if laws is not None else [reference_law]
     if "compliance" in chosen_laws and not scene.stiffness_per_mass > 0:
         raise ValueError("law 'compliance' needs a stiffness in the scene (&stops stiffness or stiffness_per_mass)")
     if reference_law not in chosen_laws:
         chosen_laws.append(reference_law)  # the finer runs use the scene's law
+    if safety is not None:
+        bounded(safety, "a factor on the error estimates", name="safety")
     factor = safety if safety is not None else (2.0 if quantity.deterministic else 1.0)
-    if not factor > 0:
-        raise ValueError(f"safety {safety!r}: > 0")
 
     base = scene.replace(snapshot_every=0, checkpoint_every=0, members=1)
-    dts = dt_ladder(base, coarser, finer)
+    ladder = dt_ladder(base, coarser, finer)
+    # a rung longer than the tip's window, or than the run, has no step in it: left out, as the engine
+    # would refuse the second (dt <= t_end); the scene's own dt is never one of them
+    dts = [dt for dt in ladder if dt <= (quantity.until if quantity.until is not None else base.t_end)]
     grid = None
     if quantity.deterministic:
         assert quantity.until is not None
@@ -103,7 +118,7 @@ def plan(scene: Scene, qoi: Union[str, Quantity], tol: Union[str, float], *, unt
     if not quantity.deterministic and not base.t_end > base.transient:
         raise ValueError(f"the scene's window after its transient is empty (t_end {base.t_end} ≤ transient "
                          f"{base.transient})")
-    meshes = mesh_ladder(base)
+    meshes = mesh_ladder(base, reduced=scene.members == 1)  # no reduced model runs an ensemble
     runner = pilot_runner = Runner(base, quantity, grid, budget)
     own = Model(reference_law, base.elements, int(getattr(base, "modes")) if reduced_available() else 0, base.dt)
     pilot = runner.get(own)
@@ -128,6 +143,7 @@ def plan(scene: Scene, qoi: Union[str, Quantity], tol: Union[str, float], *, unt
         if needed != window:
             t_end = base.transient + needed
             base = base.replace(t_end=t_end, record_every=max(1, math.ceil(t_end / min(dts) / RECORDS)))
+            dts = [dt for dt in ladder if dt <= t_end]  # a longer window may take coarser rungs back
             pilot_runner, runner = runner, Runner(base, quantity, grid, budget)
             runner.cpu, runner.rate, runner.shock_rate = pilot_runner.cpu, pilot_runner.rate, pilot_runner.shock_rate
     done: set[Model] = set()
@@ -178,7 +194,7 @@ def plan(scene: Scene, qoi: Union[str, Quantity], tol: Union[str, float], *, unt
             out.scene = chosen.replace(snapshot_every=0, **keep)
             out.notes.append(f"the chosen scene has no snapshots ({exc})")
         out.check = _check(out.choice, runner, meshes, reference_law, tolerance)
-    if out.choice is not None and out.choice.qualifies and out.choice.model.dt == dts[0]:
+    if out.choice is not None and out.choice.qualifies and out.choice.model.dt == dts[0] == ladder[0]:
         out.notes.append("the choice is on the coarsest Δt rung: a coarser Δt may qualify too "
                          f"(coarser={coarser + 1} from Python, --coarser {coarser + 1} on the command line)")
     if out.choice is not None and out.choice.qualifies and (out.choice.model.elements, out.choice.model.modes) == meshes.rungs[0]:

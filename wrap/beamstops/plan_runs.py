@@ -59,7 +59,9 @@ class Ladder:
         self.rungs.append((2 * top, 0))
 
 
-def mesh_ladder(scene: Scene) -> Ladder:
+def mesh_ladder(scene: Scene, reduced: bool = True) -> Ladder:
+    """The meshes of the search around ``scene``'s J; with ``reduced`` (and an engine that has them)
+    the reduced models at that J too (not for an ensemble scene: the engine runs none reduced)."""
     j = scene.elements
     full: list[Rung] = []
     for factor in (0.25, 0.5, 1.0, 2.0):
@@ -70,7 +72,7 @@ def mesh_ladder(scene: Scene) -> Ladder:
             full.append((n, 0))
     finer = {a: b for a, b in zip(full, full[1:])}
     rungs = list(full)
-    if reduced_available():
+    if reduced and reduced_available():
         modes = [(j, r) for r in (4, 8, 16, 32, 64) if r < 2 * j - max(len(scene.nodes), 1)]
         chain = modes + [(j, 0)]
         finer.update({a: b for a, b in zip(chain, chain[1:])})

@@ -4,13 +4,16 @@ and the plan itself with its table and summary (see :mod:`beamstops.plan`)."""
 from __future__ import annotations
 
 import math
+import numbers
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Optional, Union
 
+from .arguments import bounded
 from .scene import Scene
 
 __all__ = ["QUANTITIES", "STATISTICAL", "LAWS", "Quantity", "Model", "Candidate", "Check", "Plan",
-           "parse_tolerance"]
+           "parse_tolerance", "parse_laws", "window_range", "TOLERANCE"]
 
 #: Statistical quantities: the engine's statistic of that name (entry ``stop``).
 STATISTICAL: tuple[str, ...] = ("power", "impulse_rate", "shocks_per_second", "contact_fraction", "tip_rms")
@@ -25,17 +28,49 @@ LAWS: dict[str, dict[str, str]] = {
 }
 
 
+#: The tolerance's range, in the messages of ``--tol`` and ``tol`` alike.
+TOLERANCE = ("a finite number > 0 (absolute, in the quantity's unit: m, W, N, 1/s, 1), or a finite percentage > 0 "
+             "such as 2%")
+
+
 def parse_tolerance(text: Union[str, float]) -> tuple[float, bool]:
-    """``'2%'`` → (0.02, True) (relative); ``'0.01'`` or 0.01 → (0.01, False) (absolute). Must be > 0."""
+    """``'2%'`` → (0.02, True) (relative); ``'0.01'`` or 0.01 → (0.01, False) (absolute). Must be finite
+    and > 0: ValueError out of range, TypeError for what is neither a number nor a text (a bool, None)."""
+    if isinstance(text, bool) or not isinstance(text, (str, numbers.Real)):
+        raise TypeError(f"tolerance {text!r}: allowed: {TOLERANCE} (a real number or a text)")
     relative = isinstance(text, str) and text.strip().endswith("%")
     body = text.strip()[:-1] if relative and isinstance(text, str) else text
     try:
         value = float(body)
     except ValueError:
-        raise ValueError(f"tolerance {text!r}: a number > 0, or a percentage such as 2%") from None
+        value = math.nan
     if not (value > 0 and math.isfinite(value)):
-        raise ValueError(f"tolerance {text!r}: must be > 0")
+        raise ValueError(f"tolerance {text!r}: allowed: {TOLERANCE}")
     return (value / 100.0 if relative else value), relative
+
+
+def parse_laws(laws: Union[str, Sequence[str]]) -> list[str]:
+    """The contact models a plan may use: one name, names separated by commas, or a sequence of
+    names; each of :data:`LAWS`, at least one (ValueError; TypeError for what is not text)."""
+    items = laws.split(",") if isinstance(laws, str) else laws
+    if not isinstance(items, Sequence) or not all(isinstance(law, str) for law in items):
+        raise TypeError(f"laws {laws!r}: allowed: a law or a sequence of laws among {', '.join(LAWS)}")
+    names = [law.strip() for law in items if law.strip()]
+    unknown = [law for law in names if law not in LAWS]
+    if unknown or not names:
+        what = f"unknown law(s) {', '.join(map(repr, unknown))}" if unknown else f"laws {laws!r}: no law given"
+        raise ValueError(f"{what}; allowed: one or more of {', '.join(LAWS)} (separated by commas)")
+    return list(dict.fromkeys(names))
+
+
+def window_range(until: float, t_end: float, dt: float, name: str = "until") -> None:
+    """Refuse a window [0, until] of the tip beyond the scene's ``t_end`` (the chosen scene runs to
+    it) or shorter than one of its steps ``dt`` (nothing to compare but the start)."""
+    if not dt <= until <= t_end:
+        where = "beyond the scene's t_end" if until > t_end else "shorter than one step of the scene"
+        raise ValueError(f"{name} {until!r} s: {where} (dt = {dt!r} s, t_end = {t_end!r} s); allowed: "
+                         f"{dt!r} <= {name} <= {t_end!r} s (one step of the scene to its t_end; a longer "
+                         f"window needs a longer &time t_end)")
 
 
 @dataclass(frozen=True)
@@ -49,10 +84,18 @@ class Quantity:
     """Statistical: which entry of a per-stop statistic (0: the tip's stops, or the first stop)."""
 
     def __post_init__(self) -> None:
+        if not isinstance(self.name, str):
+            raise TypeError(f"quantity {self.name!r}: allowed: one of {', '.join(QUANTITIES)} (a text)")
         if self.name not in QUANTITIES:
             raise ValueError(f"unknown quantity {self.name!r}; choose one of {', '.join(QUANTITIES)}")
-        if self.deterministic and not (self.until is not None and self.until > 0):
+        if self.deterministic and self.until is None:
             raise ValueError("quantity 'tip' needs a window end until > 0 (s), e.g. --until 0.08")
+        if not self.deterministic and self.until is not None:
+            raise ValueError(f"until {self.until!r}: the window [0, until] is the tip's (quantity 'tip') only; "
+                             f"a statistic such as {self.name!r} is taken after the scene's &statistics transient "
+                             f"to its t_end: leave until out")
+        if self.until is not None:
+            bounded(self.until, "a time in s", name="until")
         if isinstance(self.stop, bool) or not isinstance(self.stop, int) or self.stop < 0:
             raise ValueError(f"stop {self.stop!r}: allowed: an entry 0, 1, ... of the per-stop statistic "
                              "(0: the tip's stops, or the first stop along the span)")

@@ -10,3 +10,5 @@ KINDS = ("tip", "shape", "spacetime", "energy", "phase", "reaction", "stops", "i
 FIGURE_KINDS = tuple(kind for kind in KINDS if kind != "animation")
 #: Kinds that take ``transient`` (s): only what comes after it is drawn.
 TRANSIENT_KINDS = ("pdf", "psd", "poincare")
+#: What ``transient`` is, in the messages of the command line (``--transient``) and of Python alike.
+TRANSIENT = "a time in s"

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import math
 import os
-import stat
 from pathlib import Path
 from typing import Any, Callable, Optional
 
@@ -36,8 +35,9 @@ from matplotlib import rc_context, rcParams
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from .arguments import MAX_DPI
-from .plot_kinds import FIGURE_KINDS, KINDS, TRANSIENT_KINDS
+from .arguments import MAX_DPI, bounded
+from .output_files import IMAGE, check, save_figure
+from .plot_kinds import FIGURE_KINDS, KINDS, TRANSIENT, TRANSIENT_KINDS
 from .plotbase import LINE as _LINE
 from .plotbase import STOP as _STOP
 from .plotbase import envelope as _envelope
@@ -52,7 +52,7 @@ from .transforms import after, stroboscopic
 
 __all__ = ["KINDS", "FIGURE_KINDS", "plot_tip", "plot_shape", "plot_spacetime", "plot_energy", "plot_phase",
            "plot_reaction", "plot_stop", "plot_impulses", "plot_impact_velocities", "plot_pdf", "plot_psd",
-           "plot_poincare", "missing", "figure", "save"]
+           "plot_poincare", "missing", "figure", "save", "check_transient"]
 
 
 def plot_tip(result: Result, ax: Optional[Axes] = None, *, stops: bool = True,
@@ -287,6 +287,7 @@ def figure(result: Result, kind: str = "tip", *, transient: Optional[float] = No
     """
     if kind not in KINDS:
         raise ValueError(f"unknown plot kind {kind!r}; allowed: {', '.join(KINDS)}")
+    transient = check_transient(transient)
     if kind == "animation":
         raise ValueError("'animation' is not a still figure: save(result, 'OUT.gif', kind='animation') writes it")
     if kind == "all":
@@ -324,15 +325,31 @@ def names_folder(path: str | os.PathLike[str]) -> bool:
     return raw.endswith(("/", os.sep)) or os.path.isdir(raw)
 
 
+def check_transient(transient: Optional[float]) -> Optional[float]:
+    """``transient`` (s) as the command line's ``--transient`` takes it: None, or a finite time >= 0
+    (the one check of both; ValueError out of range, TypeError for what is not a number)."""
+    return None if transient is None else bounded(transient, TRANSIENT, strict=False, name="transient")
+
+
 def save(result: Result, path: str | os.PathLike[str], kind: str = "tip", dpi: int = 120, **options: Any) -> Path:
     """Draw a figure of one kind and write it; gives the path of the file written.
 
     The format follows the file's extension; a name without one gets matplotlib's default
     format's (``savefig.format``, .png), and the path given back has it. A folder is refused
-    (IsADirectoryError). ``kind='animation'`` writes the beam moving between its stops to a .gif
-    (or .mp4 with ffmpeg; a name without extension gets .gif); its options are ``frames`` (at
+    (IsADirectoryError), and so is a name where the image would destroy data or go through a
+    link (:func:`beamstops.output_files.check`: only an image or an empty file is written over).
+    The image is written to a temporary file beside it and renamed into place once complete: a
+    failed write (:class:`~beamstops.output_files.WriteError`, ``cannot write FILE: REASON``)
+    leaves the file as it was. ``kind='animation'`` writes the beam moving between its stops to a
+    .gif (or .mp4 with ffmpeg; a name without extension gets .gif); its options are ``frames`` (at
     most this many, default 200) and ``fps``.
     """
+    if not isinstance(result, Result):
+        raise TypeError(f"result: a beamstops.Result (from beamstops.run or beamstops.load), not {type(result).__name__}")
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path: the image file to write (a str or a path), not {type(path).__name__}")
+    if os.fspath(path) == "":
+        raise ValueError("path '': an empty name; name the image file to write")
     if names_folder(path):
         raise IsADirectoryError(f"{os.fspath(path)}: is a folder; name the image file to write, e.g. "
                                 f"{Path(path) / ('animation.gif' if kind == 'animation' else kind + '.png')}")
@@ -344,55 +361,10 @@ def save(result: Result, path: str | os.PathLike[str], kind: str = "tip", dpi: i
 
         if not path.suffix:  # the animation's own default format, as without -o
             path = path.with_name(f"{path.name}.gif")
-        refuse_data_file(path)
         return animate(result, path, dpi=dpi, **options)
     if not path.suffix:  # what matplotlib would do, named here so that the caller knows the file
         path = path.with_name(f"{path.name}.{rcParams['savefig.format']}")
-    refuse_data_file(path)
+    check(path, IMAGE)
     fig = figure(result, kind, **options)
     with rc_context({"agg.path.chunksize": 20000}):
-        fig.savefig(path, dpi=dpi)
-    return path
-
-
-#: The first bytes of an HDF5 file.
-_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
-
-#: The first bytes of the images and animations matplotlib writes: what an existing file must
-#: start with to be written over (PostScript, PNG, PDF, JPEG, GIF, TIFF, WebP, MP4; SVG, text,
-#: is told apart by its first tag).
-_IMAGE_SIGNATURES = (b"%!PS", b"\x89PNG\r\n\x1a\n", b"%PDF", b"\xff\xd8\xff", b"GIF87a", b"GIF89a", b"II*\x00",
-                     b"MM\x00*", b"\xc5\xd0\xd3\xc6")
-
-
-def _is_image(head: bytes) -> bool:
-    if head.startswith(_IMAGE_SIGNATURES) or (head[:4] == b"RIFF" and head[8:12] == b"WEBP") or head[4:8] == b"ftyp":
-        return True
-    text = head.lstrip(b"\xef\xbb\xbf \t\r\n")
-    return text.startswith((b"<?xml", b"<svg", b"<!DOCTYPE svg"))
-
-
-def refuse_data_file(path: Path) -> None:
-    """Refuse to write an image over a file that is not an image: an HDF5 file (a run's output,
-    the very file plotted under another name or a link) or anything else (a text, a namelist, a
-    table): FileExistsError naming it. An empty file or an image (a plot drawn before) is
-    written over."""
-    try:
-        mode = os.stat(path).st_mode
-    except OSError:
-        return  # not there (or unreachable): savefig says what is wrong when it writes
-    if not stat.S_ISREG(mode):  # a FIFO or a terminal would hang the read, a device take the image
-        raise FileExistsError(f"{path}: exists and is not a regular file (a FIFO, a device or a socket); refusing "
-                              f"to write an image there; name another file")
-    try:
-        with open(path, "rb") as f:
-            head = f.read(64)
-    except OSError:
-        return  # unreadable: savefig says what is wrong when it writes
-    if head.startswith(_HDF5_SIGNATURE):
-        raise FileExistsError(f"{path}: exists and is an HDF5 file (a run's output?); refusing to overwrite it "
-                              f"with an image; name another file")
-    if head and not _is_image(head):
-        raise FileExistsError(f"{path}: exists and is not an image (not PNG, PDF, SVG, PostScript, JPEG, GIF, "
-                              f"TIFF, WebP or MP4); refusing to overwrite it with an image; name another file or "
-                              f"remove it")
+        return save_figure(fig, path, dpi)

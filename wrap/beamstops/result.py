@@ -169,11 +169,54 @@ def _read(path: str) -> tuple[dict[str, Any], dict[str, np.ndarray], dict[str, n
         arrays: dict[str, np.ndarray] = {}
         for name, dataset in ARRAYS.items():
             if dataset in f:
-                arrays[name] = np.asarray(f[dataset][()], dtype=np.float64)
+                try:
+                    arrays[name] = np.asarray(f[dataset][()], dtype=np.float64)
+                except (TypeError, ValueError, AttributeError):
+                    raise ValueError(f"{path}: /{dataset}: not numbers (it holds {_holds(f[dataset])}); not the "
+                                     f"output of `beamstops run`, or damaged") from None
         impacts = read_impacts(f, path)
         statistics, statistics_attrs = read_statistics(f, path)
         ensemble, _ = read_statistics(f, path, "ensemble")
     return attrs, arrays, impacts, statistics, statistics_attrs, ensemble
+
+
+def _holds(item: Any) -> str:
+    """What an HDF5 item holds, in words: a dataset's type and shape, or a group."""
+    dtype = getattr(item, "dtype", None)
+    return f"{dtype} of shape {item.shape}" if dtype is not None else "a group, not a dataset"
+
+
+#: The series every output with records holds (``damped`` and the snapshots' abscissae came later).
+REQUIRED = ("t", "tip_u", "tip_v", "reaction", "energy", "work", "dissipated")
+
+
+def _check_layout(path: str, arrays: dict[str, np.ndarray], attrs: dict[str, Any]) -> None:
+    """Refuse a file whose series are missing (a run that recorded writes them all) or do not fit
+    together (a series per record, the snapshots' shape), naming the file and the dataset: the
+    plots would fail later in matplotlib's words, without the file's name."""
+    def fail(name: str, what: str) -> None:
+        raise ValueError(f"{path}: /{ARRAYS[name]}: {what}; not the output of `beamstops run`, or damaged")
+
+    records = arrays["t"].shape[0] if "t" in arrays and arrays["t"].ndim == 1 else None
+    for name in REQUIRED if records else ():
+        if name not in arrays:
+            fail(name, f"missing, where /tip/t has {records} records")
+    for name in RECORD_SERIES:
+        if name in arrays:
+            value, ndim = arrays[name], (2 if name.startswith("stops_") else 1)
+            if value.ndim != ndim:
+                fail(name, f"{value.ndim} dimension(s) of shape {value.shape}, where a series has {ndim}")
+            if records is not None and value.shape[0] != records:
+                fail(name, f"{value.shape[0]} records where /tip/t has {records}")
+    x, u, t = arrays.get("snapshot_x"), arrays.get("snapshot_u"), arrays.get("snapshot_t")
+    elements = attrs.get("elements")
+    if x is not None:
+        if x.ndim != 1 or (x.size and isinstance(elements, (int, np.integer)) and x.size != int(elements) + 1):
+            fail("snapshot_x", f"shape {x.shape}, where the run's {elements} elements have {elements} + 1 nodes")
+        if u is not None and (u.ndim != 2 or u.shape[1] != x.size):
+            fail("snapshot_u", f"shape {u.shape}, where /snapshots/x has {x.size} nodes")
+    if u is not None and t is not None and (t.ndim != 1 or u.shape[0] != t.shape[0]):
+        fail("snapshot_u", f"{u.shape[0]} snapshots where /snapshots/t has shape {t.shape}")
 
 
 def _raise_eoa(path: str) -> bool:
@@ -235,6 +278,9 @@ def load(path: str | os.PathLike[str], allow_incomplete: bool = False) -> Result
     arrays.setdefault("snapshot_u", np.empty((0, nodes)))
     if attrs.get("status") != "complete":
         _common_records(arrays)
+        shown = min(arrays["snapshot_t"].shape[0], arrays["snapshot_u"].shape[0])  # the snapshots both hold
+        arrays["snapshot_t"], arrays["snapshot_u"] = arrays["snapshot_t"][:shown], arrays["snapshot_u"][:shown]
+    _check_layout(path, arrays, attrs)
     records = arrays["t"].size if "t" in arrays else 0
     arrays.setdefault("stops_u", np.empty((records, 0)))
     arrays.setdefault("stops_reaction", np.empty((records, 0)))

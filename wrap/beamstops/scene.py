@@ -32,6 +32,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterable, Literal, Optional, Union
 
+from .output_files import text_kind
+
 __all__ = ["Scene", "GROUPS", "ROUTES", "namelist_value"]
 
 Law = Literal["signorini", "compliance", "none"]
@@ -240,7 +242,11 @@ class Scene:
 
     def to_namelist(self, path: PathLike) -> None:
         """Write the scene as a namelist file the program reads (reals read back exactly)."""
-        Path(path).write_text(NAMELIST_HEADER + "\n" + self.to_text(), encoding="utf-8")
+        Path(path).write_text(self.namelist_file_text(), encoding="utf-8")
+
+    def namelist_file_text(self) -> str:
+        """What :meth:`to_namelist` writes: its first line :data:`NAMELIST_HEADER`, then :meth:`to_text`."""
+        return NAMELIST_HEADER + "\n" + self.to_text()
 
     def to_dict(self) -> dict[str, Any]:
         """The fields as a flat dictionary (their values are immutable: numbers, texts, tuples; a
@@ -275,6 +281,9 @@ _FIELD_NAMES: tuple[str, ...] = tuple(field.name for field in dataclasses.fields
 
 #: The first line of a namelist file Scene.to_namelist writes.
 NAMELIST_HEADER = "! beamstops scene (written by beamstops.Scene.to_namelist)"
+#: A namelist file :meth:`Scene.to_namelist` wrote, for :mod:`beamstops.output_files`: ``plan -o`` (and a
+#: study) writes a scene over nothing else.
+NAMELIST_FILE = text_kind("a scene", NAMELIST_HEADER, f"a scene beamstops wrote (first line {NAMELIST_HEADER!r})")
 
 def namelist_value(value: Any, key: str = "value") -> str:
     """A Python value as a namelist value: reals that read back exactly, lists by commas (nested lists

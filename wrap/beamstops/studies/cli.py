@@ -10,8 +10,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Optional
 
-from ..arguments import OneLineParser
-from .common import out_dir
+from ..arguments import OneLineParser, output_name
+from .outputs import study_folder
 
 
 @dataclass(frozen=True)
@@ -35,13 +35,15 @@ class StudyCommand:
     study makes of the options, :mod:`beamstops.studies.options`)."""
 
     def arguments(self, parser: argparse.ArgumentParser) -> None:
-        parser.add_argument("-o", "--output", type=Path, help=f"output folder (default out/{self.stem})")
+        parser.add_argument("-o", "--output", type=output_name("a folder name (. for the current folder)"),
+                            help=f"output folder (default out/{self.stem}); a file there is written over only when "
+                                 f"it is this study's own earlier output (or an image where it writes a chart)")
         parser.add_argument("--quick", action="store_true", help="small sizes (seconds), for tests and CI")
         self.options(parser)
         parser.add_argument("--quiet", action="store_true", help="no progress bars")
 
     def handler(self, args: argparse.Namespace) -> int:
-        print(self.run(out_dir(args.output, self.stem), args))
+        print(self.run(study_folder(args.output, self.stem), args))
         return 0
 
     def checked(self, parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:

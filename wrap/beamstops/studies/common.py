@@ -10,8 +10,8 @@ instants, never interpolations.
 from __future__ import annotations
 
 import csv
+import io
 import math
-import os
 import sys
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
@@ -25,9 +25,10 @@ from ..engine_call import engine_call
 from ..engine import _check, _scene_text, _text, interruptible, raise_stop_signal, run, sizes
 from ..result import IncompleteRunError, Result
 from ..scene import Scene
+from .outputs import StudyFolder
 
 __all__ = ["Table", "States", "TipError", "progress", "run_tip", "run_three_level", "states", "every",
-           "tip_error", "energy_norm", "prolong", "observed_orders", "out_dir"]
+           "tip_error", "energy_norm", "prolong", "observed_orders", "csv_cell", "csv_text"]
 
 T = TypeVar("T")
 
@@ -43,15 +44,6 @@ def progress(items: Iterable[T], desc: str, total: Optional[int] = None, quiet: 
         yield from items
         return
     yield from tqdm(items, desc=desc, total=total, file=sys.stderr, leave=False, dynamic_ncols=True)
-
-
-def out_dir(path: Optional[os.PathLike[str] | str], study: str) -> Path:
-    """The output folder of a study (default out/<study>), created."""
-    folder = Path(path) if path is not None else Path("out") / study
-    if folder.exists() and not folder.is_dir():
-        raise NotADirectoryError(f"{folder}: exists and is not a folder (-o takes the study's output folder)")
-    folder.mkdir(parents=True, exist_ok=True)
-    return folder
 
 
 def every(grid: float, dt: float) -> int:
@@ -225,16 +217,26 @@ class Table:
             lines.append("| " + " | ".join(cell(name, x) for name, x in zip(self.columns, row)) + " |")
         return "\n".join(lines) + "\n"
 
-    def write(self, folder: Path, stem: str) -> tuple[Path, Path]:
-        md = folder / f"{stem}.md"
-        md.write_text(self.markdown(), encoding="utf-8")
-        return md, self.write_csv(folder / f"{stem}.csv")
+    def write(self, out: StudyFolder, stem: str) -> tuple[Path, Path]:
+        """``stem``.md and ``stem``.csv in the study's folder."""
+        return out.markdown(f"{stem}.md", self.markdown()), out.csv(f"{stem}.csv", self.csv())
 
-    def write_csv(self, csv_path: Path) -> Path:
-        """The rows as CSV (reals written so that they read back exactly)."""
-        with csv_path.open("w", newline="", encoding="utf-8") as f:
-            writer = csv.writer(f)
-            writer.writerow(self.columns)
-            for row in self.rows:
-                writer.writerow([repr(x) if isinstance(x, float) else x for x in row])
-        return csv_path
+    def csv(self) -> str:
+        """The rows as CSV text (reals written so that they read back exactly)."""
+        return csv_text(self.columns, self.rows)
+
+
+def csv_cell(x: Any) -> Any:
+    """A cell of a CSV table: a real (numpy's too) as its shortest exact text, ``1e-06`` (numpy 2's
+    repr of its scalars, ``np.float64(1e-06)``, is no number for a reader), anything else as is."""
+    return repr(float(x)) if isinstance(x, (float, np.floating)) else x
+
+
+def csv_text(columns: Sequence[str], rows: Iterable[Sequence[Any]]) -> str:
+    """A CSV table: a line of column names, then one line per row (:func:`csv_cell`)."""
+    text = io.StringIO()
+    writer = csv.writer(text)
+    writer.writerow(columns)
+    for row in rows:
+        writer.writerow([csv_cell(x) for x in row])
+    return text.getvalue()

@@ -28,7 +28,9 @@ from ..result import Result
 from ..scene import Scene
 from ..arguments import number
 from .cli import StudyCommand
-from .common import Table, out_dir, progress
+from ..output_files import save_figure
+from .common import Table, progress
+from .outputs import StudyFolder
 
 __all__ = ["reversals", "hf_fraction", "study", "main", "register"]
 
@@ -61,10 +63,14 @@ def hf_fraction(result: Result, cutoff: float) -> float:
     return float(spectrum[freq > cutoff].sum()) / total if total > 0 else math.nan
 
 
+#: The files the study writes into its folder.
+FILES = ("compliance.md", "compliance.csv", "compliance.png")
+
+
 def study(folder: Optional[Path] = None, *, quick: bool = False, cutoff: float = 5000.0,
           quiet: bool = False) -> Table:
     """Run compliance over (1/ε, Δt) and the Signorini baseline; write compliance.{md,csv,png}."""
-    folder = out_dir(folder, "compliance")
+    out = StudyFolder.prepare(folder, "compliance", FILES)
     if quick:
         base, stiffnesses, dts = Scene(t_end=0.12, beta=0.25), (1e6, 1e8, 1e10), (5e-6, 2e-6)
     else:
@@ -86,8 +92,8 @@ def study(folder: Optional[Path] = None, *, quick: bool = False, cutoff: float =
     table.note = (f"paper's scene, β = {base.beta:g} (compliance), J = {base.elements}; reversals: sign changes of "
                   "the tip velocity during contact per contact episode (1 for a clean impact); HF fraction: share of "
                   "the tip velocity's spectral energy above the cut-off; penetration: the engine's max_violation.")
-    table.write(folder, "compliance")
-    draw(table, folder / "compliance.png")
+    table.write(out, "compliance")
+    draw(table, out.path("compliance.png"))
     return table
 
 
@@ -125,8 +131,7 @@ def draw(table: Table, path: Path) -> Path:
     for ax in axes:
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
-    fig.savefig(path, dpi=120)
-    return path
+    return save_figure(fig, path, dpi=120)
 
 
 def _options(parser: argparse.ArgumentParser) -> None:

@@ -35,7 +35,8 @@ from ..engine import run
 from ..result import Result
 from ..scene import Scene
 from .cli import StudyCommand
-from .common import Table, observed_orders, out_dir, progress, run_tip, tip_error
+from .common import Table, observed_orders, progress, run_tip, tip_error
+from .outputs import StudyFolder
 
 __all__ = ["LAWS", "Plan", "PLANS", "chatter", "shock_log", "inconsistent", "energy_table", "energy_sentence", "convergence_table", "headline",
            "study", "main", "register"]
@@ -263,11 +264,16 @@ def energy_sentence(energy: Table) -> str:
     return f"**Energy over {float(t):g} s at Δt = {float(dt):g} s (measured):** " + "; ".join(parts) + "."  # type: ignore
 
 
+#: The files the study writes into its folder.
+FILES = tuple(f"contact_laws_{name}.csv" for name in ("energy", "convergence", "headline")) \
+    + ("contact_laws.png", "contact_laws.md")
+
+
 def study(folder: Optional[Path] = None, *, quick: bool = False, quiet: bool = False) -> dict[str, Table]:
     """Run the study; write contact_laws.{png,md} and the tables' CSV into ``folder``."""
     from .contact_laws_draw import draw
 
-    folder = out_dir(folder, "contact_laws")
+    out = StudyFolder.prepare(folder, "contact_laws", FILES)
     plan = PLANS["quick" if quick else "full"]
     base = base_scene()
     runs = energy_runs(base, plan, quiet)
@@ -276,12 +282,12 @@ def study(folder: Optional[Path] = None, *, quick: bool = False, quiet: bool = F
     summary, sentence = headline(convergence, plan)
     tables = {"energy": energy, "convergence": convergence, "headline": summary}
     for name, table in tables.items():
-        table.write_csv(folder / f"contact_laws_{name}.csv")
-    draw(runs, convergence, plan, folder / "contact_laws.png")
+        out.csv(f"contact_laws_{name}.csv", table.csv())
+    draw(runs, convergence, plan, out.path("contact_laws.png"))
     text = [f"# Contact laws on the paper's scene{' (quick)' if quick else ''}", "", sentence, "",
             energy_sentence(energy), "",
             "![contact laws](contact_laws.png)", "", summary.markdown(), energy.markdown(), convergence.markdown()]
-    (folder / "contact_laws.md").write_text("\n".join(text), encoding="utf-8")
+    out.markdown("contact_laws.md", "\n".join(text))
     return tables
 
 

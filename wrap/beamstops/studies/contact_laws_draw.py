@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..output_files import save_figure
 from ..result import Result
 from .common import Table
 
@@ -75,5 +76,4 @@ def draw(runs: dict[str, Result], convergence: Table, plan: "Plan", path: Path) 
     for k, a in enumerate(ax):
         a.grid(True, which="both", alpha=0.3)
         a.legend(fontsize=7, loc="upper left" if k < 2 else "best")
-    fig.savefig(path, dpi=110)
-    return path
+    return save_figure(fig, path, dpi=110)

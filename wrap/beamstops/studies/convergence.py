@@ -30,8 +30,9 @@ import numpy as np
 from ..result import Result
 from ..scene import Scene
 from .cli import StudyCommand
-from .common import States, Table, energy_norm, observed_orders, out_dir, progress, prolong, run_three_level, run_tip, \
+from .common import States, Table, energy_norm, observed_orders, progress, prolong, run_three_level, run_tip, \
     states, tip_error
+from .outputs import StudyFolder
 
 __all__ = ["dt_table", "h_table", "study", "main", "register"]
 
@@ -166,10 +167,21 @@ def _scene_text(scene: Scene) -> str:
             f"J = {scene.elements}, Δt = {scene.dt:g} s, T = {scene.t_end:g} s")
 
 
+#: The tables the study writes into its folder (each as .md and .csv), and convergence.md gathering them.
+TABLES = ("dt_none_centered", "dt_none_paper", "dt_none_centered_J19", "dt_none_paper_J19", "roundoff_three_level",
+          "h_none", "dt_signorini", "h_signorini")
+
+
+def outputs(folder: Optional[Path] = None) -> StudyFolder:
+    """The study's folder (default out/convergence), its files checked before anything runs."""
+    return StudyFolder.prepare(folder, "convergence",
+                               [f"{stem}.{ext}" for stem in TABLES for ext in ("md", "csv")] + ["convergence.md"])
+
+
 def study(folder: Optional[Path] = None, *, quick: bool = False, three_level: bool = True,
           quiet: bool = False) -> dict[str, Table]:
     """The convergence tables of issue 6, written to ``folder`` (default out/convergence)."""
-    folder = out_dir(folder, "convergence")
+    out = outputs(folder)
     base = Scene(beta=0.25)
     if quick:
         free_dts, free_t, free_times = [4e-5 / 2**k for k in range(4)], 0.1, (0.05, 0.1)
@@ -212,11 +224,12 @@ def study(folder: Optional[Path] = None, *, quick: bool = False, three_level: bo
         ("h_signorini", lambda: h_table(base.replace(beta=0.5, dt=h_dt), h_j, h_ref, stop_windows, stop_times,
                                         grid=4e-5, quiet=quiet, title="h convergence with stops (Signorini, β = 1/2)")),
     ]
+    assert [stem for stem, _ in todo] == list(TABLES)
     for stem, make in progress(todo, "convergence tables", quiet=quiet):
         table = make()
-        table.write(folder, stem)
+        table.write(out, stem)
         tables[stem] = table
-    (folder / "convergence.md").write_text("\n".join(t.markdown() for t in tables.values()), encoding="utf-8")
+    out.markdown("convergence.md", "\n".join(t.markdown() for t in tables.values()))
     return tables
 
 
@@ -241,6 +254,10 @@ def _run(folder: Path, args: argparse.Namespace) -> Path:
 
     pointwise, statistical = split_qois(args.qoi)
     printed = folder / "convergence.md"
+    if statistical:  # every file of both checked before either runs
+        qoi_convergence.outputs(folder, statistical)
+    if pointwise:
+        outputs(folder)
     if statistical:
         qoi_convergence.study(folder, qois=statistical, quick=args.quick, half_width=HalfWidth.parse(args.half_width),
                               transient=args.transient, window=args.stat_window, reference_window=args.reference_window,

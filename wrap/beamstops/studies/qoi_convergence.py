@@ -17,7 +17,9 @@ from pathlib import Path
 from typing import Optional
 
 from ..scene import Scene
-from .common import Table, out_dir, progress
+from ..output_files import save_figure
+from .common import Table, progress
+from .outputs import StudyFolder
 from .qoi import HalfWidth, Measured, measure, statistic_name
 from .qoi_report import errorbar_panel, table
 from .qoi_workprecision import Settings, settings
@@ -113,8 +115,16 @@ def draw(runs: Runs, qoi: str, path: Path) -> Path:
         errorbar_panel(fig.add_subplot(1, 3, 3), [m.scene.modes for m in runs.by_r], runs.by_r, runs.r_reference,
                        qoi, reference_x=full, xlabel="modes r (reduced model; rightmost: the full model)",
                        title=f"{statistic_name(qoi)} against modes r (J = {runs.base.elements})")
-    fig.savefig(path, dpi=110)
-    return path
+    return save_figure(fig, path, dpi=110)
+
+
+def outputs(folder: Optional[Path], qois: Sequence[str]) -> StudyFolder:
+    """The study's folder (default out/convergence), its files for ``qois`` checked before anything runs."""
+    for q in qois:
+        statistic_name(q)  # refuse unknown names before anything is written
+    names = [f"qoi_convergence_{q}_{axis}.{ext}" for q in qois for axis in ("dt", "J", "modes") for ext in ("md", "csv")]
+    names += [f"qoi_convergence_{q}.png" for q in qois] + ["qoi_convergence.md"]
+    return StudyFolder.prepare(folder, "qoi_convergence", names)
 
 
 def study(folder: Optional[Path] = None, *, qois: Sequence[str] = ("stop_power",), quick: bool = False,
@@ -122,21 +132,18 @@ def study(folder: Optional[Path] = None, *, qois: Sequence[str] = ("stop_power",
           window: Optional[float] = None, reference_window: Optional[float] = None, members: Optional[int] = None,
           quiet: bool = False) -> dict[str, tuple[Table, Table, Table]]:
     """Run both ladders once; write the tables and the chart of every QoI."""
-    for q in qois:
-        statistic_name(q)
-    folder = out_dir(folder, "convergence")
+    files = outputs(folder, qois)
     s, _ = settings(quick, transient, window, reference_window, members)
     runs = run_ladders(Scene(beta=0.5), ladders(quick), s, quiet)
     out: dict[str, tuple[Table, Table, Table]] = {}
     text = []
     for q in qois:
         by_dt, by_j, by_r = tables(runs, q, half_width, s)
-        by_dt.write(folder, f"qoi_convergence_{q}_dt")
-        by_j.write(folder, f"qoi_convergence_{q}_J")
-        by_r.write(folder, f"qoi_convergence_{q}_modes")
-        draw(runs, q, folder / f"qoi_convergence_{q}.png")
+        by_dt.write(files, f"qoi_convergence_{q}_dt")
+        by_j.write(files, f"qoi_convergence_{q}_J")
+        by_r.write(files, f"qoi_convergence_{q}_modes")
+        draw(runs, q, files.path(f"qoi_convergence_{q}.png"))
         text += [by_dt.markdown(), by_j.markdown(), by_r.markdown()]
         out[q] = (by_dt, by_j, by_r)
-    (folder / "qoi_convergence.md").write_text("# Convergence of statistics in Δt, J and modes r\n\n" + "\n".join(text),
-                                                encoding="utf-8")
+    files.markdown("qoi_convergence.md", "# Convergence of statistics in Δt, J and modes r\n\n" + "\n".join(text))
     return out

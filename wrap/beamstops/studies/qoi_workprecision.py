@@ -11,7 +11,6 @@ and ``work_precision_statistics.md`` (settings, headline per QoI and law, the ta
 
 from __future__ import annotations
 
-import csv
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -21,7 +20,9 @@ from typing import Optional
 import numpy as np
 
 from ..scene import Scene
-from .common import Table, out_dir, progress
+from ..output_files import save_figure
+from .common import Table, csv_text, progress
+from .outputs import StudyFolder
 from .qoi import HalfWidth, Law, Measured, laws, measure, statistic_name
 from .qoi_report import errorbar_panel, table
 
@@ -199,8 +200,7 @@ def draw_work_precision(results: Sequence[LawRuns], qoi: str, half_width: HalfWi
     for ax in axes:
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
-    fig.savefig(path, dpi=110)
-    return path
+    return save_figure(fig, path, dpi=110)
 
 
 def draw_convergence(results: Sequence[LawRuns], qoi: str, path: Path) -> Path:
@@ -212,27 +212,34 @@ def draw_convergence(results: Sequence[LawRuns], qoi: str, path: Path) -> Path:
         ax = fig.add_subplot(1, len(results), i + 1)
         errorbar_panel(ax, [m.scene.dt for m in r.runs], r.runs, r.reference, qoi, reference_x=r.reference.scene.dt,
                        xlabel="Δt (s)", title=f"{r.law.label}: {statistic_name(qoi)} against Δt")
-    fig.savefig(path, dpi=110)
-    return path
+    return save_figure(fig, path, dpi=110)
 
 
-def write_runs(results: Sequence[LawRuns], path: Path) -> Path:
-    """Every run with every scalar statistic: value and half-width (the reference's ensemble too)."""
+def runs_csv(results: Sequence[LawRuns]) -> str:
+    """Every run with every scalar statistic: value and half-width (the reference's ensemble too), as CSV."""
     names = sorted({n for r in results for m in r.runs + [r.reference] for n in m.statistics})
-    with path.open("w", newline="", encoding="utf-8") as f:
-        writer = csv.writer(f)
-        writer.writerow(["law", "role", "dt", "transient", "window", "members", "cpu_seconds", "status"]
-                        + [f"{n}{suffix}" for n in names for suffix in ("", "_half_width")])
-        for r in results:
-            for role, m in [("run", m) for m in r.runs] + [("reference", r.reference)]:
-                for kind, table_ in (("", m.statistics), (" (ensemble)", m.ensemble)):
-                    if not table_:
-                        continue
-                    values = [repr(x) for n in names for x in ((table_[n].value, table_[n].half_width)
-                                                                if n in table_ else (math.nan, math.nan))]
-                    writer.writerow([r.law.label, role + kind, repr(m.scene.dt), repr(m.transient), repr(m.window),
-                                     m.members, repr(m.cpu_seconds), m.status] + values)
-    return path
+    rows = []
+    for r in results:
+        for role, m in [("run", m) for m in r.runs] + [("reference", r.reference)]:
+            for kind, table_ in (("", m.statistics), (" (ensemble)", m.ensemble)):
+                if not table_:
+                    continue
+                values = [x for n in names for x in ((table_[n].value, table_[n].half_width)
+                                                     if n in table_ else (math.nan, math.nan))]
+                rows.append([r.law.label, role + kind, m.scene.dt, m.transient, m.window, m.members, m.cpu_seconds,
+                             m.status] + values)
+    return csv_text(["law", "role", "dt", "transient", "window", "members", "cpu_seconds", "status"]
+                    + [f"{n}{suffix}" for n in names for suffix in ("", "_half_width")], rows)
+
+
+def outputs(folder: Optional[Path], qois: Sequence[str]) -> StudyFolder:
+    """The study's folder (default out/work_precision_statistics), its files for ``qois`` checked before
+    anything runs."""
+    for q in qois:
+        statistic_name(q)  # refuse unknown names before anything is written
+    names = [f"work_precision_{q}{end}" for q in qois for end in (".md", ".csv", ".png", "_dt.png")]
+    return StudyFolder.prepare(folder, "work_precision_statistics",
+                               names + ["statistics_runs.csv", "work_precision_statistics.md"])
 
 
 def study(folder: Optional[Path] = None, *, qois: Sequence[str] = ("stop_power",), quick: bool = False,
@@ -245,14 +252,12 @@ def study(folder: Optional[Path] = None, *, qois: Sequence[str] = ("stop_power",
     interval is run again with the window T* (when its cost* ≤ ``check_cpu`` s, default 30, quick 3);
     the run is a row "(check at T*)" of that QoI's table.
     """
-    for q in qois:
-        statistic_name(q)  # refuse unknown names before running anything
-    folder = out_dir(folder, "work_precision_statistics")
+    out = outputs(folder, qois)
     s, chosen = settings(quick, transient, window, reference_window, members)
     base = Scene(beta=0.5)
     results = run_laws(base, chosen, s, quiet)
     checked = check(results[0], qois[0], half_width, s, check_cpu if check_cpu is not None else (3.0 if quick else 30.0))
-    write_runs(results, folder / "statistics_runs.csv")
+    out.csv("statistics_runs.csv", runs_csv(results))
     tables: dict[str, Table] = {}
     heads, texts = [], []
     notes = "; ".join(f"{law.label}: {law.note}" for law in chosen if law.note)
@@ -267,9 +272,9 @@ def study(folder: Optional[Path] = None, *, qois: Sequence[str] = ("stop_power",
                   "Each law against its own reference (its finest Δt, longer window); within: |v − v_ref| ≤ h + h_ref; "
                   "T* = T (h/h*)², cost* = CPU (transient + T*)/(transient + T); CPU: the engine's cpu_seconds "
                   "(an ensemble row: members × member 1's).")
-        t.write(folder, f"work_precision_{q}")
-        draw_work_precision(results, q, half_width, folder / f"work_precision_{q}.png")
-        draw_convergence(results, q, folder / f"work_precision_{q}_dt.png")
+        t.write(out, f"work_precision_{q}")
+        draw_work_precision(results, q, half_width, out.path(f"work_precision_{q}.png"))
+        draw_convergence(results, q, out.path(f"work_precision_{q}_dt.png"))
         heads.append(headline(results, q, half_width, checked if q == qois[0] else None))
         texts.append(t.markdown())
         tables[q] = t
@@ -281,5 +286,5 @@ def study(folder: Optional[Path] = None, *, qois: Sequence[str] = ("stop_power",
     if notes:
         summary += [f"Note — {notes}.", ""]
     summary += ["## Headlines", ""] + heads + ["## Tables", ""] + texts
-    (folder / "work_precision_statistics.md").write_text("\n".join(summary), encoding="utf-8")
+    out.markdown("work_precision_statistics.md", "\n".join(summary))
     return tables

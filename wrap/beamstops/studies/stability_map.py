@@ -29,7 +29,9 @@ from ..result import IncompleteRunError, Result
 from ..scene import Scene
 from ..arguments import number
 from .cli import StudyCommand
-from .common import Table, out_dir, progress
+from ..output_files import save_figure
+from .common import Table, progress
+from .outputs import StudyFolder
 
 __all__ = ["classify", "energy_scale", "beta_map", "mesh_map", "answer", "study", "main", "register"]
 
@@ -155,14 +157,18 @@ def draw(beta_table: Optional[Table], mesh_tables: Sequence[Table], path: Path, 
         ax.set_title(table.title, fontsize=10)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7, loc="lower left" if by_beta else "upper right")
-    fig.savefig(path, dpi=120)
-    return path
+    return save_figure(fig, path, dpi=120)
+
+
+#: The files the study writes into its folder.
+FILES = tuple(f"stability_{stem}.{ext}" for stem in ("beta", "mesh_beta0", "mesh_beta025") for ext in ("md", "csv")) \
+    + ("stability.md", "stability_map.png")
 
 
 def study(folder: Optional[Path] = None, *, quick: bool = False, threshold: float = 10.0,
           quiet: bool = False) -> dict[str, Table]:
     """The (β, Δt) map and the (J, Δt) maps at β = 0 and β = 1/4; PNG, md, CSV in ``folder``."""
-    folder = out_dir(folder, "stability_map")
+    out = StudyFolder.prepare(folder, "stability_map", FILES)
     if quick:
         base, betas, dts = Scene(t_end=0.05, elements=8), (0.0, 0.2, 0.25, 0.5), list(np.geomspace(1e-6, 1e-3, 4))
         meshes, mesh_dts, mesh_t = (2, 8), list(np.geomspace(1e-6, 1e-3, 4)), 0.05
@@ -176,11 +182,11 @@ def study(folder: Optional[Path] = None, *, quick: bool = False, threshold: floa
         tables[stem] = mesh_map(base.replace(beta=beta, t_end=mesh_t), meshes, mesh_dts, threshold, quiet)
     text = []
     for stem, table in tables.items():
-        table.write(folder, f"stability_{stem}")
+        table.write(out, f"stability_{stem}")
         text.append(table.markdown())
     summary = "### Answer from the (β, Δt) map\n\n" + answer(tables["beta"])
-    (folder / "stability.md").write_text(summary + "\n" + "\n".join(text), encoding="utf-8")
-    draw(tables["beta"], [tables["mesh_beta0"], tables["mesh_beta025"]], folder / "stability_map.png", base)
+    out.markdown("stability.md", summary + "\n" + "\n".join(text))
+    draw(tables["beta"], [tables["mesh_beta0"], tables["mesh_beta025"]], out.path("stability_map.png"), base)
     return tables
 
 

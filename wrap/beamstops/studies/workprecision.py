@@ -29,7 +29,9 @@ import numpy as np
 from ..scene import Scene
 from ..arguments import number, whole
 from .cli import StudyCommand
-from .common import Table, out_dir, progress, run_tip, tip_error
+from ..output_files import save_figure
+from .common import Table, progress, run_tip, tip_error
+from .outputs import StudyFolder
 
 __all__ = ["Method", "methods", "study", "draw", "qoi_options", "split_qois", "main", "register"]
 
@@ -63,6 +65,10 @@ def methods(quick: bool = False) -> list[Method]:
     return out
 
 
+#: The files the study writes into its folder.
+FILES = ("work_precision.md", "work_precision.csv", "work_precision.png")
+
+
 def study(folder: Optional[Path] = None, *, quick: bool = False, windows: Sequence[float] = (0.08, 0.2),
           quiet: bool = False) -> Table:
     """Run every method at every Δt, write work_precision.{md,csv,png}; return the table.
@@ -70,7 +76,7 @@ def study(folder: Optional[Path] = None, *, quick: bool = False, windows: Sequen
     Errors on each window [0, w]; the default windows are before the first impact (t < 0.0878 s)
     and the first contact period (t ≤ 0.2 s).
     """
-    folder = out_dir(folder, "work_precision")
+    out = StudyFolder.prepare(folder, "work_precision", FILES)
     grid = 4e-5
     if quick:
         windows = tuple(min(w, 0.05) for w in windows[:1])
@@ -92,8 +98,8 @@ def study(folder: Optional[Path] = None, *, quick: bool = False, windows: Sequen
     table = Table("Work-precision", columns + ["max violation (m)", "status"], rows)
     table.note = (f"paper's scene (J = {base.elements}), T = {base.t_end:g} s; reference: Signorini β = 1/2, centred "
                   f"load, Δt = {finest / 8:g} s; CPU: the engine's time-loop CPU time of each run.")
-    table.write(folder, "work_precision")
-    draw(table, folder / "work_precision.png", windows)
+    table.write(out, "work_precision")
+    draw(table, out.path("work_precision.png"), windows)
     return table
 
 
@@ -118,8 +124,7 @@ def draw(table: Table, path: Path, windows: Sequence[float]) -> Path:
         ax.set_title(f"tip error on [0, {w:g}] s — lower left is better", fontsize=10)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7, ncol=2)
-    fig.savefig(path, dpi=120)
-    return path
+    return save_figure(fig, path, dpi=120)
 
 
 def qoi_options(parser: argparse.ArgumentParser) -> None:
@@ -191,6 +196,10 @@ def _run(folder: Path, args: argparse.Namespace) -> Path:
 
     pointwise, statistical = split_qois(args.qoi)
     printed = folder / "work_precision.png"
+    if statistical:  # every file of both checked before either runs
+        qoi_workprecision.outputs(folder, statistical)
+    if pointwise:
+        StudyFolder.prepare(folder, "work_precision", FILES)
     if statistical:
         qoi_workprecision.study(folder, qois=statistical, quick=args.quick, half_width=HalfWidth.parse(args.half_width),
                                 transient=args.transient, window=args.stat_window,
