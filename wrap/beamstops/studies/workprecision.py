@@ -52,7 +52,7 @@ GRID = 4e-5
 def methods(quick: bool = False) -> list[Method]:
     """The methods of the chart, each with Δt = grid/2^k (β = 0 below its stability limit)."""
     k = 3 if quick else 7
-    coarse = tuple(4e-5 / 2**i for i in range(k))
+    coarse = tuple(GRID / 2**i for i in range(k))
     explicit = tuple(1e-5 / 2**i for i in range(k - 2 if not quick else 2))
     out = [Method("Signorini β=0", {"beta": 0.0}, explicit),
            Method("Signorini β=1/4", {"beta": 0.25}, coarse),
@@ -77,7 +77,7 @@ def study(folder: Optional[Path] = None, *, quick: bool = False, windows: Sequen
     and the first contact period (t ≤ 0.2 s).
     """
     out = StudyFolder.prepare(folder, "work_precision", FILES)
-    grid = 4e-5
+    grid = GRID
     if quick:
         windows = tuple(min(w, 0.05) for w in windows[:1])
     base = Scene(t_end=max(windows))
