@@ -369,3 +369,25 @@ def test_a_source_that_is_not_text_is_a_type_error(call: str) -> None:
         calls[call]()
     with pytest.raises(TypeError, match=r"^path = None: allowed: a str or an os\.PathLike"):
         Scene.from_namelist(None)  # type: ignore[arg-type]
+
+
+def test_to_namelist_writes_over_its_own_scenes_only(tmp_path: Path) -> None:
+    """Scene.to_namelist wrote over anything at its path, through a symbolic link too: a run's
+    output, a hand-written namelist. It writes over an empty file or a scene it wrote before only,
+    whole, as every other file beamstops writes."""
+    own = tmp_path / "own.nml"
+    Scene(dt=1e-5).to_namelist(own)
+    Scene(dt=2e-5).to_namelist(own)
+    assert Scene.from_namelist(own).dt == 2e-5
+    output = tmp_path / "run.h5"
+    output.write_bytes(b"\x89HDF\r\n\x1a\n" + bytes(100))
+    hand = tmp_path / "hand.nml"
+    hand.write_text("&time dt = 1e-5 /\n")
+    link = tmp_path / "link.nml"
+    link.symlink_to(hand)
+    for path in (output, hand, link):
+        before = path.read_bytes()
+        with pytest.raises(OSError, match=re.escape(path.name)):
+            Scene().to_namelist(path)
+        assert path.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["hand.nml", "link.nml", "own.nml", "run.h5"]

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterable, Literal, Optional, Union
 
-from .output_files import text_kind
+from .output_files import text_kind, write_text
 
 __all__ = ["Scene", "GROUPS", "ROUTES", "namelist_value"]
 
@@ -241,8 +241,11 @@ class Scene:
         return out
 
     def to_namelist(self, path: PathLike) -> None:
-        """Write the scene as a namelist file the program reads (reals read back exactly)."""
-        Path(path).write_text(self.namelist_file_text(), encoding="utf-8")
+        """Write the scene as a namelist file the program reads (reals read back exactly): whole (a
+        temporary file renamed into place), over an empty file or a scene written so before only
+        (never through a symbolic link, over a run's output, a hand-written namelist or a FIFO:
+        :func:`beamstops.output_files.check`, the rule of every file beamstops writes)."""
+        write_text(path, NAMELIST_FILE, self.namelist_file_text())
 
     def namelist_file_text(self) -> str:
         """What :meth:`to_namelist` writes: its first line :data:`NAMELIST_HEADER`, then :meth:`to_text`."""
