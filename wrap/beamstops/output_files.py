@@ -13,6 +13,7 @@ a failure is one :class:`WriteError`, ``cannot write FILE: REASON``.
 
 from __future__ import annotations
 
+import hashlib
 import os
 import secrets
 import stat
@@ -21,7 +22,7 @@ from pathlib import Path
 from typing import Any, Callable, Optional, Union
 
 __all__ = ["Kind", "IMAGE", "WriteError", "check", "write", "write_text", "save_figure", "text_kind", "is_image",
-           "names_no_file", "HDF5_SIGNATURE"]
+           "names_no_file", "HDF5_SIGNATURE", "file_sha256"]
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -207,3 +208,10 @@ def names_no_file(path: PathLike) -> bool:
         return not stat.S_ISREG(os.stat(raw).st_mode)
     except OSError:
         return False
+
+
+def file_sha256(path: PathLike) -> str:
+    """The SHA-256 of a file's content, in hex (the studies' list of their tables, a sweep's
+    program)."""
+    with open(path, "rb") as f:
+        return hashlib.file_digest(f, "sha256").hexdigest()

@@ -13,14 +13,13 @@ through a temporary file renamed into place (:func:`beamstops.output_files.write
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, Optional
 
-from ..output_files import IMAGE, Kind, check, text_kind, write_text
+from ..output_files import IMAGE, Kind, check, file_sha256, text_kind, write_text
 from ..scene import NAMELIST_FILE, Scene
 
 __all__ = ["StudyFolder", "MANIFEST", "marker", "study_folder"]
@@ -45,14 +44,6 @@ def study_folder(path: Optional[os.PathLike[str] | str], study: str) -> Path:
         raise NotADirectoryError(f"{folder}: exists and is not a folder (-o takes the study's output folder)")
     folder.mkdir(parents=True, exist_ok=True)
     return folder
-
-
-def _sha256(path: Path) -> str:
-    digest = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
 
 
 def _is_manifest(head: bytes) -> bool:
@@ -112,7 +103,7 @@ class StudyFolder:
 
     def _listed(self, path: Path) -> bool:
         entry = self._manifest()["files"].get(path.name)
-        return isinstance(entry, dict) and entry.get("study") == self.study and entry.get("sha256") == _sha256(path)
+        return isinstance(entry, dict) and entry.get("study") == self.study and entry.get("sha256") == file_sha256(path)
 
     def markdown(self, name: str, text: str) -> Path:
         """Write a Markdown file, its first line the study's marker."""
@@ -126,7 +117,7 @@ class StudyFolder:
         """Write a CSV file and list it, with the SHA-256 of its content, in the folder's manifest."""
         path = write_text(self.path(name), self.kind(name), text, self.advice)
         manifest = self._manifest()
-        manifest["files"][name] = {"study": self.study, "sha256": _sha256(path)}
+        manifest["files"][name] = {"study": self.study, "sha256": file_sha256(path)}
         write_text(self.path(MANIFEST), self._manifest_kind(), json.dumps(manifest, indent=1, sort_keys=True) + "\n",
                    self.advice)
         return path

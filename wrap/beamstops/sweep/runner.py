@@ -44,6 +44,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional, TextIO
 
+from ..output_files import file_sha256
 from .reductions import columns as reduction_columns
 from .spec import Spec
 from .worker import FINISHED, arm, read_status, run_batch
@@ -211,22 +212,12 @@ def _spawned(factory: Any, workers: int) -> Executor:
 # ---------------------------------------------------------------------- folder
 
 
-def _program_hash(program: str) -> str:
-    """sha256 of the program's file: a rebuilt engine may differ at round-off, which impacts amplify."""
-    import hashlib
-
-    digest = hashlib.sha256()
-    with open(program, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
-
-
 def _manifest(spec: Spec, program: str) -> dict[str, Any]:
     from .. import version
 
+    # the program's sha256: a rebuilt engine may differ at round-off, which impacts amplify
     return {"format": _MANIFEST_FORMAT, "spec_hash": spec.hash, "spec_file": os.path.abspath(spec.path),
-            "program": program, "program_sha256": _program_hash(program),
+            "program": program, "program_sha256": file_sha256(program),
             "overrides": list(spec.overrides), "points": len(spec.points), "mode": spec.mode,
             "axes": spec.axes, "zip": spec.zip_groups, "periods": spec.periods, "reductions": spec.reductions,
             "base": spec.base, "description": spec.description, "engine_version": version(),
@@ -340,7 +331,7 @@ def prepare_folder(spec: Spec, out: Path, program: str) -> tuple[Path, Optional[
                              f"the specification). Use another -o, or remove {out} to start again")
         from .. import version
 
-        if old.get("engine_version") != version() or old.get("program_sha256") != _program_hash(program):
+        if old.get("engine_version") != version() or old.get("program_sha256") != file_sha256(program):
             note = (f"the points done before ran with another build of the engine ({old.get('engine_version')}, "
                     f"{old.get('program')}); this is {version()}, {program}: results may differ at round-off, "
                     "which impacts amplify; use a new folder for one build throughout")
