@@ -37,7 +37,7 @@ contains
          line = text
          return
       end if
-      allocate (character(len=8*len(text)) :: line)
+      allocate (character(len=4*len(text)) :: line)
       n = 0
       i = 1
       do while (i <= len(text))

@@ -166,13 +166,7 @@ contains
       summary%contact_phases = state%impacts
       call close_ledger(scene, model, state, summary)
       if (summary%status == status_running .and. state%step > steps_of(scene)) summary%status = status_complete
-      if (state%observer%active .and. summary%status /= status_running) &
-         & call state%observer%finish(summary%shocks, summary%statistics)
-      ! the shocks so far (an interrupted run's too: its count had been the contact phases')
-      if (state%observer%active) then
-         summary%impacts = state%observer%shocks%shock_count()
-         summary%contact_phases = state%observer%shocks%phase_count()
-      end if
+      call state%observer%book_summary(summary)
    end subroutine finish_member
 
    !> The lanes of the group, zero (padding lanes stay at rest).

@@ -314,13 +314,7 @@ contains
       summary%max_violation = state%max_violation
       if (summary%status == status_running .and. state%step > steps) summary%status = status_complete
       call close_ledger(scene, reduced, state, summary)
-      if (state%observer%active .and. summary%status /= status_running) &
-         & call state%observer%finish(summary%shocks, summary%statistics)
-      ! the shocks so far (an interrupted run's too: its count had been the contact phases')
-      if (state%observer%active) then
-         summary%impacts = state%observer%shocks%shock_count()
-         summary%contact_phases = state%observer%shocks%phase_count()
-      end if
+      call state%observer%book_summary(summary)
    end subroutine run_reduced
 
    !> The energy ledger of the summary (J): work, the stops' and the damping's losses and the

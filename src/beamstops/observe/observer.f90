@@ -9,6 +9,7 @@ module beamstops_observe_observer
    use beamstops_observe_shocks, only: shock_log, shock_row, new_shock_log, shock_row_values, n_shock_columns
    use beamstops_observe_statistics, only: statistics_type, statistics_table, new_statistics
    use beamstops_scene, only: scene_type, steps_of, shock_log_rows
+   use beamstops_summary, only: run_summary, status_running
    implicit none
    private
    public :: observer_type, new_observer, observe_scene
@@ -52,6 +53,8 @@ module beamstops_observe_observer
       procedure :: drain
       !> Close the open shocks and the last batch at the end of the run; the table of statistics.
       procedure :: finish
+      !> The observer's counts (and, once the run has ended, its tables) in the loop's summary.
+      procedure :: book_summary
       !> The whole observer as one vector of reals (checkpoints).
       procedure :: pack => pack_observer
       !> The observer from a vector of pack.
@@ -259,6 +262,21 @@ contains
       table = self%stats%results()
       shocks = self%rows(:, :self%shocks_kept)
    end subroutine finish
+
+   !> The observer's part of a time loop's summary (the full loop's, the reduced one's, a lockstep
+   !> member's): the shocks closed so far and the contact phases, an interrupted run's too (its
+   !> count had been the contact phases'), after the shock log and the statistics are finished
+   !> once the run has ended (its status no longer running). Nothing when the observer is off.
+   subroutine book_summary(self, summary)
+      !> Observer.
+      class(observer_type), intent(inout) :: self
+      !> The loop's summary.
+      type(run_summary), intent(inout) :: summary
+      if (.not. self%active) return
+      if (summary%status /= status_running) call self%finish(summary%shocks, summary%statistics)
+      summary%impacts = self%shocks%shock_count()
+      summary%contact_phases = self%shocks%phase_count()
+   end subroutine book_summary
 
    !> The whole observer as reals: [m, rho, dt, dissipated_seen, t_stop, kept, size of the log's
    !> vector, the log's vector (shock_log%pack), size of the statistics' vector, its vector
