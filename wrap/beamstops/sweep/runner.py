@@ -352,14 +352,21 @@ _MANIFEST_TYPES: dict[str, type] = {"format": int, "spec_hash": str, "spec_file"
 _HASH = re.compile(r"^[0-9a-f]{64}$")
 
 
+def _json_object(path: Path) -> Optional[dict[str, Any]]:
+    """The JSON object a file holds, or None when it cannot be read, is not JSON (or nests too
+    deep) or holds something else."""
+    try:
+        content = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):
+        return None
+    return content if isinstance(content, dict) else None
+
+
 def _read_manifest(path: Path) -> Optional[dict[str, Any]]:
     """A folder's sweep.json, or None when it is not one _manifest wrote: not JSON, not an object,
     an entry a resume reads missing or of another type (``"spec_hash": 5``), another format."""
-    try:
-        old = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError, RecursionError):
-        return None
-    if not isinstance(old, dict):
+    old = _json_object(path)
+    if old is None:
         return None
     for key, kind in _MANIFEST_TYPES.items():
         if not isinstance(old.get(key), kind) or isinstance(old.get(key), bool):
@@ -427,11 +434,8 @@ def _read_record(path: Path) -> Optional[dict[str, Any]]:
     """A point's record (NNNNN.json), or None when it is not one the worker wrote (then the point's
     finished output is reduced again): its figures numbers or null, its message a text, its
     reductions an object."""
-    try:
-        record = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError, RecursionError):
-        return None
-    if not isinstance(record, dict):
+    record = _json_object(path)
+    if record is None:
         return None
     for key in _RECORD_NUMBERS:
         value = record.get(key)
