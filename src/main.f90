@@ -84,7 +84,7 @@ program beamstops_main
    character(len=*), parameter :: python_commands(n_python_commands) = [character(len=14) :: 'plot', 'sweep', &
       & 'converge', 'work-precision', 'stability-map', 'compliance', 'contact-laws', 'plan']
    character(len=*), parameter :: python_help(n_python_commands) = [character(len=80) :: &
-      & 'plot the HDF5 output of a run (tip, shape, energy, phase, reaction, stops)', &
+      & 'plot the HDF5 output of a run (tip, energy, stops, impacts, pdf, psd, all, ...)', &
       & 'run a parameter sweep (TOML specification) on local cores or MPI ranks', &
       & 'convergence tables in dt and h (markdown and CSV)', &
       & 'error against CPU time for every method (PNG, markdown, CSV)', &
@@ -184,6 +184,9 @@ contains
                & "file named -)")
             out = trim(arg)
             i = i + 1
+         case ('-h', '--help')
+            ! `beamstops run --help`, `beamstops info -h`: the help, as `beamstops --help` gives it
+            call usage()
          case ('--restart')
             if (command /= 'run') call usage("'--restart' goes with 'run'")
             if (restart) call usage("'--restart' is given twice; allowed: once")

@@ -400,6 +400,16 @@ def test_help_lists_every_command_with_a_description(tmp_path: Path) -> None:
     assert set(listed) - {"run", "info", "--version"} == set(python)
 
 
+@pytest.mark.parametrize("args", [["run", "--help"], ["info", "--help"], ["run", "-h"], ["run", "scene.nml", "--help"]])
+def test_help_after_an_engine_command_is_the_help(args: list[str], tmp_path: Path) -> None:
+    """`beamstops run --help` shows the help (it had been refused as an unexpected argument, exit 2)."""
+    write(tmp_path, SHORT)
+    done = beamstops(*args, cwd=tmp_path)
+    assert done.returncode == 0 and done.stderr == "", done.stderr
+    assert done.stdout == beamstops("--help", cwd=tmp_path).stdout
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.nml"]  # nothing run
+
+
 def test_python_subcommands_run_from_the_program(tmp_path: Path) -> None:
     scene = write(tmp_path, SHORT)
     assert beamstops("run", scene, "-o", "short.h5", cwd=tmp_path).returncode == 0
