@@ -6,6 +6,7 @@ of the shock log and the statistics also from the program's file with /impacts a
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import subprocess
 import sys
@@ -115,6 +116,15 @@ def test_impacts_histograms_count_the_logged_shocks(logged_result: beamstops.Res
     assert labels == [f"lower stop ({np.sum(side == 1)})", f"upper stop ({np.sum(side == -1)})"]
     assert "60 shocks, 1 truncated left out" in impulses.get_title()
     assert len(impulses.patches) == 2 and len(velocities.patches) == 2
+
+
+def test_impacts_histograms_count_in_whole_shocks(logged_result: beamstops.Result) -> None:
+    """The y axis counts shocks: its ticks are whole numbers (not 0.25 of a shock on a short run)."""
+    few = dataclasses.replace(logged_result, impacts={k: v[:3] for k, v in logged_result.impacts.items()})
+    for ax in plots.figure(few, "impacts").axes[:2]:
+        ax.figure.canvas.draw()
+        ticks = ax.get_yticks()
+        assert ticks.size >= 2 and np.all(ticks == np.round(ticks)), ticks
 
 
 def test_impacts_per_stop_along_the_span(logged: Path, tmp_path: Path) -> None:

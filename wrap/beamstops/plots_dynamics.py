@@ -21,6 +21,7 @@ from typing import Optional
 
 import numpy as np
 from matplotlib.axes import Axes
+from matplotlib.ticker import MaxNLocator
 
 from .plotbase import STOP, need_impacts, need_records, new_axes, stop_label, tip_stops
 from .result import Result
@@ -62,6 +63,7 @@ def _histograms(ax: Axes, result: Result, values: np.ndarray, keep: np.ndarray, 
             ax.hist(values[mask], bins=edges.tolist(), histtype="step", linewidth=1.0, label=f"{label} ({mask.sum()})")
     ax.set_xlabel(xlabel)
     ax.set_ylabel("shocks")
+    ax.yaxis.set_major_locator(MaxNLocator(integer=True))  # counts: no tick at 0.25 of a shock
     ax.legend(fontsize="small", loc="best")
     ax.grid(True, linewidth=0.3, alpha=0.5)
 
