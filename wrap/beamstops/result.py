@@ -14,15 +14,16 @@ damped             /energy/damped         energy taken by the Rayleigh damping (
 snapshot_t         /snapshots/t           snapshot times (s)
 snapshot_x         /snapshots/x           node abscissae x_0..x_J (m)
 snapshot_u         /snapshots/u           physical displacement ũ(x, t), (snapshots, J+1) (m)
-stops_x            /stops/x               abscissae of the stops along the span (m) (m)
-stops_node         /stops/node            their node indices 1..J (m)
-stops_lower        /stops/lower           their lower stops (m) (m)
-stops_upper        /stops/upper           their upper stops (m) (m)
+stops_x            /stops/x               abscissae of the stops along the span (m)
+stops_node         /stops/node            their node indices 1..J (float64, whole numbers)
+stops_lower        /stops/lower           their lower stops (m)
+stops_upper        /stops/upper           their upper stops (m)
 stops_u            /stops/u               physical displacement ũ at each stop, (records, m) (m)
 stops_reaction     /stops/reaction        reaction of each stop, (records, m) (N)
 impacts            /impacts/NAME          the engine's shock log: {NAME: one value per shock}
 statistics         /statistics/NAME       the engine's statistics: {NAME: Statistic}
 statistics_attrs   /statistics attributes transient (s), batches, bins, rest_time (s)
+ensemble           /ensemble/NAME         &ensemble members > 1: {NAME: Statistic} across the members
 attrs              root attributes        scene, κ_h, limits, status, steps, cpu_seconds, …
 =================  =====================  =========================================
 
@@ -85,7 +86,7 @@ class IncompleteRunError(ValueError):
 
 @dataclass(eq=False)
 class Result:
-    """Arrays and attributes of one run (see the module's table)."""
+    """Arrays and attributes of one run (the table of :mod:`beamstops.result`: each field, its HDF5 dataset, units)."""
 
     t: np.ndarray
     tip_u: np.ndarray
