@@ -5,7 +5,8 @@ with a 1 s transient and a 20 s pilot window, draws the candidates' CPU per simu
 their estimated error (the tolerance and the choice marked), writes the table, the plan's summary and
 the chosen scene (plan_paper_power.nml). Every candidate is estimated, in order of predicted cost,
 until the budget (150 engine CPU seconds) is spent. Options: -o DIR (default docs/plan), --qoi, --tol,
---window, --budget, --first, --quiet.
+--window, --budget, --first, --quiet; --quick (a 2 s window, 3 engine CPU seconds, stopping at the first
+candidate that qualifies: seconds, for tests) writes to out/plan_quick unless -o is given.
 """
 
 from __future__ import annotations
@@ -66,16 +67,27 @@ def report(result: Plan, command: str, wall: float) -> str:
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
     parser = argparse.ArgumentParser(prog="plan_chart", description=__doc__.splitlines()[0])
-    parser.add_argument("-o", "--output", type=Path, default=Path("docs/plan"))
-    parser.add_argument("--qoi", default="power")
-    parser.add_argument("--tol", default="2%")
-    parser.add_argument("--window", type=float, default=20.0, help="pilot window after the 1 s transient (s)")
-    parser.add_argument("--budget", type=float, default=150.0,
-                        help="engine CPU seconds for the search (default 150)")
+    parser.add_argument("-o", "--output", type=Path, default=None,
+                        help="output folder (default docs/plan; with --quick out/plan_quick)")
+    parser.add_argument("--qoi", default="power", help="quantity, as plan --qoi (default power)")
+    parser.add_argument("--tol", default="2%", help="tolerance, as plan --tol (default 2%%)")
+    parser.add_argument("--window", type=float, default=None,
+                        help="pilot window after the 1 s transient (s; default 20, --quick 2)")
+    parser.add_argument("--budget", type=float, default=None,
+                        help="engine CPU seconds for the search (default 150, --quick 3)")
     parser.add_argument("--first", action="store_true",
                         help="stop at the first candidate that qualifies (default: every candidate within the budget)")
+    parser.add_argument("--quick", action="store_true",
+                        help="seconds: a 2 s window, 3 CPU seconds, --first; into out/plan_quick unless -o")
     parser.add_argument("--quiet", action="store_true")
     args = parser.parse_args(argv)
+    if args.output is None:
+        args.output = Path("out/plan_quick" if args.quick else "docs/plan")
+    if args.window is None:
+        args.window = 2.0 if args.quick else 20.0
+    if args.budget is None:
+        args.budget = 3.0 if args.quick else 150.0
+    args.first = args.first or args.quick
     try:  # every file it writes checked before the search (beamstops.studies.outputs)
         out = StudyFolder.prepare(args.output, "plan_chart", ["plan.png", "plan_paper_power.nml", "plan.md"])
     except (OSError, ValueError) as exc:
