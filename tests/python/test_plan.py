@@ -364,3 +364,12 @@ def test_the_readme_states_the_mesh_ladder_and_the_check_the_code_uses() -> None
     assert [r for j, r in ladder.rungs if r] == [4, 8, 16, 32, 64]
     assert [r for j, r in plan_runs.mesh_ladder(PAPER_SHORT).rungs if r] == [4, 8, 16, 32]  # 32 < 2·19 − 1
     assert ladder.finer[(40, 64)] == (40, 0) and ladder.finer[(40, 0)] == (80, 0)  # what the check runs
+
+
+def test_the_studies_names_of_a_statistic_are_read_as_the_engines() -> None:
+    """`converge --qoi stop_power` and `plan --qoi stop_power` name one quantity (plan refused it, exit 2)."""
+    assert Quantity("stop_power").name == "power" and Quantity("shock_rate").name == "shocks_per_second"
+    with pytest.raises(ValueError, match="stop_power = power"):
+        Quantity("energy")
+    # the option is accepted (not exit 2): what stops the plan is the absent scene (exit 1)
+    assert cli.main(["plan", "absent.nml", "--qoi", "stop_power", "--tol", "2%", "--quiet"], prog="beamstops") == 1

@@ -13,7 +13,7 @@ from typing import Callable
 from .arguments import OptionError, number, output_name, whole
 from .output_files import check, names_no_file, write_text
 from .plan import LAWS, MAX_RUNGS, QUANTITIES, Quantity, parse_tolerance, plan
-from .plan_types import TOLERANCE, parse_laws, window_range
+from .plan_types import ALIASES, TOLERANCE, parse_laws, window_range
 from .scene import NAMELIST_FILE
 
 #: Exit status when the plan does not meet the tolerance (no model qualified, or the check failed).
@@ -93,8 +93,10 @@ def _checked(parse: Callable[[str], object], keep: bool = False) -> Callable[[st
 
 
 def _quantity(text: str) -> str:
+    text = ALIASES.get(text, text)  # the studies' stop_power and shock_rate
     if text not in QUANTITIES:
-        raise ValueError(f"{text!r}: allowed: one of {', '.join(QUANTITIES)}")
+        raise ValueError(f"{text!r}: allowed: one of {', '.join(QUANTITIES)} "
+                         f"({', '.join(f'{a} = {b}' for a, b in ALIASES.items())}, the studies' names)")
     return text
 
 
@@ -123,7 +125,8 @@ def register_plan(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("scene", type=Path, help="namelist file of the scene")
     parser.add_argument("--qoi", required=True, metavar="QUANTITY", type=_checked(_quantity),
                         help=f"{', '.join(QUANTITIES)}; tip: the tip trajectory on [0, --until] (max error); or a statistic of the engine "
-                             "after the scene's transient, with its 95 %% interval")
+                             "after the scene's transient, with its 95 %% interval (the studies' stop_power and "
+                             "shock_rate are power and shocks_per_second)")
     parser.add_argument("--tol", required=True, type=_checked(_tolerance, keep=True),
                         help="tolerance: absolute in the quantity's unit (m, W, N, 1/s, 1), or relative (2%%); "
                              "finite, > 0")

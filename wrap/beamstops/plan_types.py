@@ -12,13 +12,16 @@ from typing import Optional, Union
 from .arguments import bounded
 from .scene import Scene
 
-__all__ = ["QUANTITIES", "STATISTICAL", "LAWS", "Quantity", "Model", "Candidate", "Check", "Plan",
+__all__ = ["QUANTITIES", "ALIASES", "STATISTICAL", "LAWS", "Quantity", "Model", "Candidate", "Check", "Plan",
            "parse_tolerance", "parse_laws", "window_range", "TOLERANCE"]
 
 #: Statistical quantities: the engine's statistic of that name (entry ``stop``).
 STATISTICAL: tuple[str, ...] = ("power", "impulse_rate", "shocks_per_second", "contact_fraction", "tip_rms")
 #: Every quantity ``plan`` accepts.
 QUANTITIES: tuple[str, ...] = ("tip",) + STATISTICAL
+#: The studies' names of the same statistics (``--qoi stop_power`` of converge and work-precision), accepted
+#: for them: the quantity then carries the engine's name.
+ALIASES: dict[str, str] = {"stop_power": "power", "shock_rate": "shocks_per_second"}
 #: Contact models the search may use: scene changes of each.
 LAWS: dict[str, dict[str, str]] = {
     "signorini": {"law": "signorini", "mass": "consistent"},
@@ -86,8 +89,11 @@ class Quantity:
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
             raise TypeError(f"quantity {self.name!r}: allowed: one of {', '.join(QUANTITIES)} (a text)")
+        if self.name in ALIASES:
+            object.__setattr__(self, "name", ALIASES[self.name])
         if self.name not in QUANTITIES:
-            raise ValueError(f"unknown quantity {self.name!r}; choose one of {', '.join(QUANTITIES)}")
+            raise ValueError(f"unknown quantity {self.name!r}; choose one of {', '.join(QUANTITIES)} "
+                             f"({', '.join(f'{a} = {b}' for a, b in ALIASES.items())})")
         if self.deterministic and self.until is None:
             raise ValueError("quantity 'tip' needs a window end until > 0 (s), e.g. --until 0.08")
         if not self.deterministic and self.until is not None:
