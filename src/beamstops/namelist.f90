@@ -857,8 +857,13 @@ contains
             bounds = values(1)
          case default
             if (count /= m) then
-               call fatal_error(error, path//': &stops '//key//' has '//itoa(count)//' values for '//itoa(m)// &
-                  & ' stops; allowed: one value (the same for every stop) or '//itoa(m))
+               if (m == 1) then
+                  call fatal_error(error, path//': &stops '//key//' has '//itoa(count)//' values for 1 stop; '// &
+                     & 'allowed: one value')
+               else
+                  call fatal_error(error, path//': &stops '//key//' has '//itoa(count)//' values for '//itoa(m)// &
+                     & ' stops; allowed: one value (the same for every stop) or '//itoa(m)//', one per stop')
+               end if
                return
             end if
             bounds = values(:m)

@@ -42,7 +42,8 @@ def test_scene_lists_broadcast_and_x_route() -> None:
 
 @pytest.mark.parametrize("changes, needles", [
     ({"x": [0.52]}, ["x(1) = 0.52", "nearest nodes are 10 (x = 0.5)", "11 (x = 0.55)"]),
-    ({"nodes": (3, 5), "lower": (-0.1, -0.1, -0.1)}, ["lower has 3 values for 2 stops"]),
+    ({"nodes": (3, 5), "lower": (-0.1, -0.1, -0.1)}, ["lower has 3 values for 2 stops", "or 2, one per stop"]),
+    ({"nodes": (3,), "upper": (0.1, 0.2)}, ["upper has 2 values for 1 stop; allowed: one value"]),
     ({"lower": (-0.1, -0.2)}, ["lower or upper has several values", "nodes or x"]),
     ({"nodes": (3,), "x": [0.5]}, ["both nodes and x"]),
 ])
