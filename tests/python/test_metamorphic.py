@@ -1,6 +1,7 @@
 """Relations the engine must satisfy whatever the right numbers are (found by a metamorphic audit):
 a lockstep group of the program gives each member the bits of the same scene run alone also where
-the Newmark products by beta round (beta other than 0, 1/4, 1/2)."""
+the Newmark products by beta round (beta other than 0, 1/4, 1/2), and a scene's histogram range
+is the one asked for, through Python as through a namelist file."""
 
 from __future__ import annotations
 
@@ -44,3 +45,24 @@ def test_lockstep_members_equal_their_runs_alone_at_beta_0_3(tmp_path: Path, pro
             assert same_bits(getattr(member, name), getattr(alone, name)), (k, name)
         for key in ("impacts", "contact_phases", "max_violation", "work", "dissipated", "energy_residual"):
             assert member.attrs[key] == alone.attrs[key], (k, key)
+
+
+def test_a_histogram_range_equal_to_the_fields_old_default_is_kept(tmp_path: Path) -> None:
+    """`histogram_lower = -0.1, histogram_upper = 0.1` with stops at +-0.05: the range asked for, from
+    a file, from Scene(...) and after replace() of another key (Python had dropped a value equal to
+    its field's old default, 0.1, and the engine then took the stops' +-0.05)."""
+    path = tmp_path / "scene.nml"
+    path.write_text("&stops lower = -0.05, upper = 0.05 /\n&statistics histogram_lower = -0.1, histogram_upper = 0.1 /\n")
+    wanted = (-0.1, 0.1)
+    read = Scene.from_namelist(path)
+    given = Scene(lower=-0.05, upper=0.05, histogram_lower=-0.1, histogram_upper=0.1)
+    for scene in (read, given, read.replace(t_end=1.0), given.replace(dt=1e-5), Scene.from_text(read.to_text())):
+        assert (scene.histogram_lower, scene.histogram_upper) == wanted
+    # a range left to its default follows the stops, also when they change
+    assert (Scene(lower=-0.05, upper=0.05).histogram_lower, Scene().replace(upper=0.02).histogram_upper) == (-0.05, 0.02)
+    assert Scene(lower=-0.05, upper=0.05).replace(lower=-0.02).histogram_lower == -0.02
+    # a range set apart from the stops is carried over when they change
+    assert read.replace(lower=-0.02).histogram_lower == -0.1
+    short = read.replace(t_end=0.05, dt=1e-4)
+    edges = beamstops.run(short).statistics["tip_histogram_edges"].value
+    assert (edges[0], edges[-1]) == wanted
