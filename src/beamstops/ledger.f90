@@ -10,6 +10,7 @@ module beamstops_ledger
    use beamstops_recorder, only: recorder_type, n_columns, col_t, col_u, col_v, col_reaction, col_energy, &
       & col_work, col_dissipated, col_damped
    use beamstops_band_solve, only: diagonal_matvec, dot
+   use beamstops_newmark, only: newmark_energy, newmark_work
    implicit none
    private
    public :: energy, move_on, book_step, shift_loads, damping_loss, fill_row, take_snapshot, physical_shape, first_events
@@ -24,8 +25,7 @@ contains
       !> d.M d, u.S u, d.S u and u^n.S u^n.
       real(wp), intent(in) :: dmd, usu, dsu, u_old_s_u_old
       real(wp) :: e
-      e = 0.5_wp*dmd/model%dt2 + 0.5_wp*(model%beta*usu + model%beta*u_old_s_u_old &
-         & + (1 - 2*model%beta)*(usu - dsu))
+      e = newmark_energy(model%dt2, model%beta, dmd, usu, dsu, u_old_s_u_old)
    end function energy
 
    !> The sums of a step once u^{n+1} is known, whatever the contact law: impacts, the work of
@@ -53,7 +53,7 @@ contains
       real(wp), intent(in) :: gd, weight, r_step
       if (contact .and. .not. state%in_contact) state%impacts = state%impacts + 1
       state%in_contact = contact
-      state%work = state%work + 0.5_wp*weight*(gd + state%gd_prev)
+      state%work = newmark_work(state%work, weight, gd, state%gd_prev)
       state%reaction = r_step
       state%gd_prev = gd
    end subroutine book_step

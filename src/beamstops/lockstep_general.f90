@@ -26,6 +26,7 @@ module beamstops_lockstep_general
    use beamstops_model, only: model_type
    use beamstops_observe_lanes, only: observer_lanes, gather_observers, scatter_observers, observe_lanes
    use beamstops_band_solve, only: energy_dots
+   use beamstops_newmark, only: newmark_average, newmark_explicit, newmark_work
    use beamstops_band_solve_lockstep, only: lockstep_lanes, lockstep_matvec_rhs, lockstep_forward, &
       & lockstep_matvec_rhs_forward, lockstep_energy_dots, lockstep_back, lockstep_update, lockstep_dot, lockstep_matvec, &
       & lockstep_load_work
@@ -90,10 +91,16 @@ contains
       do step = ms%step, last
          ms%sigma_next = ms%sigma
          call next_loads(ms, scenes, model)
-         ms%weight = model%beta*ms%sigma_next + (1 - 2*model%beta)*ms%sigma_now + model%beta*ms%sigma_prev
+         do k = 1, size(ms%weight)
+            ms%weight(k) = newmark_average(model%beta, ms%sigma_next(k), ms%sigma_now(k), ms%sigma_prev(k))
+         end do
          ! the forward pass (forward_pass with cd, massless rows), a chunk of members after the other
          ms%coef = model%dt2*ms%weight
-         if (law == law_compliance) ms%spring = model%dt2*((1 - 2*model%beta)*ms%p_now + model%beta*ms%p_prev)
+         if (law == law_compliance) then
+            do k = 1, size(ms%spring)
+               ms%spring(k) = newmark_explicit(model%dt2, model%beta, ms%p_now(k), ms%p_prev(k))
+            end do
+         end if
          energy_wanted = pending .or. step == next_record
          do c = 1, ms%chunks
             lo = (c - 1)*lockstep_lanes + 1
@@ -324,7 +331,7 @@ contains
             & 0.0_wp))
          if (ms%contact(k) .and. .not. ms%in_contact(k)) ms%impacts(k) = ms%impacts(k) + 1
          ms%in_contact(k) = ms%contact(k)
-         ms%work(k) = ms%work(k) + 0.5_wp*ms%weight(k)*(ms%gd(k) + ms%gd_prev(k))
+         ms%work(k) = newmark_work(ms%work(k), ms%weight(k), ms%gd(k), ms%gd_prev(k))
          ! recorded only where the stop acts (tip_step_massless)
          ms%reaction(k) = merge(ms%r_step(k), 0.0_wp, ms%contact(k))
          ms%gd_prev(k) = ms%gd(k)

@@ -14,6 +14,7 @@ module beamstops_lockstep_lanes
    use beamstops_forcing, only: load_average
    use beamstops_contact_compliance, only: compliance_step
    use beamstops_band_solve_lockstep, only: lockstep_lanes
+   use beamstops_newmark, only: newmark_average, newmark_explicit, newmark_work
    implicit none
    private
    public :: lanes_type, lanes_restart_loads, lanes_next_loads, lanes_begin_step, lanes_contact, lanes_close
@@ -131,11 +132,18 @@ contains
       integer(ik), intent(in) :: next
       !> Time step (s).
       real(wp), intent(in) :: dt
+      integer :: i
       lanes%sigma_next = lanes%sigma
       call lanes_next_loads(lanes, restart, next, dt)
-      lanes%weight = beta*lanes%sigma_next + (1 - 2*beta)*lanes%sigma_now + beta*lanes%sigma_prev
+      do i = 1, lockstep_lanes
+         lanes%weight(i) = newmark_average(beta, lanes%sigma_next(i), lanes%sigma_now(i), lanes%sigma_prev(i))
+      end do
       lanes%coef = dt2*lanes%weight
-      if (law == law_compliance) lanes%spring = dt2*((1 - 2*beta)*lanes%p_now + beta*lanes%p_prev)
+      if (law == law_compliance) then
+         do i = 1, lockstep_lanes
+            lanes%spring(i) = newmark_explicit(dt2, beta, lanes%p_now(i), lanes%p_prev(i))
+         end do
+      end if
    end subroutine lanes_begin_step
 
    !> The contact law at the tip of every lane (beamstops_contact_tip_contact's contact_law;
@@ -216,7 +224,7 @@ contains
       do i = 1, lockstep_lanes
          if (lanes%contact(i) .and. .not. lanes%in_contact(i)) lanes%impacts(i) = lanes%impacts(i) + 1
          lanes%in_contact(i) = lanes%contact(i)
-         lanes%work(i) = lanes%work(i) + 0.5_wp*lanes%weight(i)*(lanes%gd(i) + lanes%gd_prev(i))
+         lanes%work(i) = newmark_work(lanes%work(i), lanes%weight(i), lanes%gd(i), lanes%gd_prev(i))
          lanes%dissipated(i) = lanes%dissipated(i) - 0.5_wp*lanes%r_step(i)*(d_tip(i) + lanes%d_tip_prev(i))
          lanes%reaction(i) = lanes%r_step(i)
          lanes%gd_prev(i) = lanes%gd(i)

@@ -17,6 +17,7 @@ module beamstops_lockstep_members
    use beamstops_band_solve, only: band_solver, band_diagonals
    use beamstops_band, only: kd
    use beamstops_band_solve_lockstep, only: lockstep_lanes
+   use beamstops_newmark, only: newmark_work
    use beamstops_forcing, only: load_average, support_position, restart_every
    use beamstops_contact_compliance, only: compliance_step
    use beamstops_observe_observer, only: observer_type
@@ -226,7 +227,7 @@ contains
       do k = 1, lockstep_lanes
          if (contact(k) .and. .not. in_contact(k)) impacts(k) = impacts(k) + 1
          in_contact(k) = contact(k)
-         work(k) = work(k) + 0.5_wp*weight(k)*(gd(k) + gd_prev(k))
+         work(k) = newmark_work(work(k), weight(k), gd(k), gd_prev(k))
          dissipated(k) = dissipated(k) - 0.5_wp*r_step(k)*(d_tip(k) + d_tip_prev(k))
          reaction(k) = r_step(k)
          gd_prev(k) = gd(k)

@@ -18,6 +18,7 @@ module beamstops_scheme
       & energy_dots, band_diagonals, diagonal_matvec, diagonal_matvec_rhs, dot, back_substitution_edge, back_substitution_update
    use beamstops_state, only: state_type
    use beamstops_clock, only: thread_cpu_seconds
+   use beamstops_newmark, only: newmark_average
    use beamstops_forcing, only: load_average, load_rotation, start_loads, next_load
    use beamstops_contact_tip_contact, only: spring_term, tip_step, tip_step_massless, update, tip_outcome, tip_law, &
       & fix_tip, settle_tip
@@ -177,7 +178,7 @@ contains
       call first_events(scene, state%step, next_record, next_snapshot)
       do step = state%step, last
          sigma_next = load_average(step + 1, model%dt, scene%omega, scene%centered_load)
-         weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
+         weight = newmark_average(model%beta, sigma_next, state%sigma_now, state%sigma_prev)
          state%rhs = model%dt2*(weight*model%load - state%su)
          if (model%damped) state%rhs = state%rhs - model%dt*state%cd
          state%rhs(tip) = state%rhs(tip) + spring_term(scene, model, state)
@@ -247,7 +248,7 @@ contains
       do step = state%step, last
          sigma_next = loads%sigma
          call next_load(loads)
-         weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
+         weight = newmark_average(model%beta, sigma_next, state%sigma_now, state%sigma_prev)
          call plain_forward_pass(model%stiffness_diagonals, model%mass_diagonals, model%solver, model%n, model%load, &
             & state%u, state%d, model%dt2*weight, model%dt2, spring_term(scene, model, state), &
             & (held .and. step - 1 == next_record) .or. step == next_record, &
@@ -344,7 +345,7 @@ contains
       do step = state%step, last
          sigma_next = loads%sigma
          call next_load(loads)
-         weight = model%beta*sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
+         weight = newmark_average(model%beta, sigma_next, state%sigma_now, state%sigma_prev)
          call forward_pass(model%stiffness_diagonals, model%mass_diagonals, model%solver, model%load, state%u, state%d, &
             & model%dt2*weight, model%dt2, spring_term(scene, model, state), pending .or. step == next_record, &
             & state%su, state%rhs, usu, dsu, dmd, model%massless, model%row_scale, sigma_next, state%cd, model%dt)

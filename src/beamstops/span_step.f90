@@ -8,6 +8,7 @@ module beamstops_span_step
    use beamstops_scene, only: scene_type, law_signorini
    use beamstops_model, only: model_type
    use beamstops_state, only: state_type
+   use beamstops_newmark, only: newmark_average
    use beamstops_band_solve, only: diagonal_matvec, diagonal_row, load_work_product, energy_dots
    use beamstops_contact_mass_redistribution, only: massless_reaction
    use beamstops_contact_tip_contact, only: update
@@ -72,7 +73,7 @@ contains
       lp%sigma_next = lp%loads%sigma
       call next_load(lp%loads)
       lp%phi_next = support_position(real(step + 1, wp)*model%dt, scene%amplitude, scene%omega)
-      lp%weight = model%beta*lp%sigma_next + (1 - 2*model%beta)*state%sigma_now + model%beta*state%sigma_prev
+      lp%weight = newmark_average(model%beta, lp%sigma_next, state%sigma_now, state%sigma_prev)
    end subroutine next_span_step
 
    !> The step after the substitutions (state%rhs holds x = A^{-1} rhs): the record waiting for

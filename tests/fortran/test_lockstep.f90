@@ -64,6 +64,7 @@ contains
          & 'n = 1..25, a band of random values', test_energy_sums), &
          & new_unittest('K = 1, Signorini, beta = 1/2', test_one), &
          & new_unittest('K = 3, no stops, beta = 1/4, different omega and amplitude', test_free_three), &
+         & new_unittest('K = 3, 6, 9, no stops, beta = 0.3, J = 5, different omega and amplitude', test_free_three_beta), &
          & new_unittest('K = 5, Signorini, beta = 1/2, different stops, omega, amplitude, cadences', test_signorini_five), &
          & new_unittest('K = 8, compliance 1e8, beta = 1/4', test_compliance_eight), &
          & new_unittest('K = 13, Signorini, beta = 1/4, paper''s load and Euler start for some, checkpoint_every set', &
@@ -642,6 +643,17 @@ contains
       type(error_type), allocatable, intent(out) :: error
       call compare_group(members_of(base_scene(19, 1.0e-5_wp, 0.25_wp, law_none, 0.2_wp), 3, .true.), error)
    end subroutine test_free_three
+
+   !> beta = 0.3: its products beta*x round (at 1/4 and 1/2 they are exact), so the members'
+   !> load averages and energies must be formed as the one-scene path forms them to the bit.
+   subroutine test_free_three_beta(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: k
+      do k = 3, 9, 3
+         call compare_group(members_of(base_scene(5, 1.0e-5_wp, 0.3_wp, law_none, 0.2_wp), k, .true.), error)
+         if (allocated(error)) return
+      end do
+   end subroutine test_free_three_beta
 
    subroutine test_signorini_five(error)
       type(error_type), allocatable, intent(out) :: error

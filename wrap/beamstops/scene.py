@@ -146,10 +146,11 @@ class Scene:
     """Bins of the tip-displacement histogram."""
     rest_time: float = 0.01
     """Contact phases closer than this are one shock (s)."""
-    histogram_lower: float = -0.1
-    """Lower end of the tip histogram (m; default: the lower stop)."""
-    histogram_upper: float = 0.1
-    """Upper end of the tip histogram (m; default: the upper stop)."""
+    histogram_lower: Optional[float] = None
+    """Lower end of the tip histogram (m; None, the default: the tip's lower stop, as the engine's
+    reader fills it in; a scene always holds the number)."""
+    histogram_upper: Optional[float] = None
+    """Upper end of the tip histogram (m; None, the default: the tip's upper stop)."""
     # &ensemble
     members: int = 1
     """Members of the ensemble (1: the scene alone)."""
@@ -221,6 +222,14 @@ class Scene:
         for route in set(changes) & set(ROUTES):
             for derived in ROUTES[route]:
                 values.pop(derived, None)
+        if set(changes) & _STOP_KEYS:
+            # A histogram range that is the old stops' default follows the new stops; one set
+            # apart from them is carried over like any other key.
+            stops_default = Scene._of_canonical(_canonical(_namelist(
+                {key: value for key, value in values.items() if key not in _HISTOGRAM_KEYS}), _source))
+            for key in _HISTOGRAM_KEYS:
+                if _same(values[key], getattr(stops_default, key)):
+                    values[key] = None
         values.update(changes)
         # The keys not in `changes` are carried over: the engine drops those that would do nothing
         # under the new keys (its rule), where it refuses such a key given anew.
@@ -335,6 +344,11 @@ def _path(value: Any) -> Optional[str]:
         raise TypeError(f"scene key file = {value!r}: allowed: a str or an os.PathLike (the HDF5 output's path), "
                         "or None for the namelist's name with .h5")
     return name
+
+
+#: The tip histogram's range, whose default (None) is the tip's stops, and the keys that give them.
+_HISTOGRAM_KEYS = ("histogram_lower", "histogram_upper")
+_STOP_KEYS = frozenset({"lower", "upper", "nodes", "x", "length", "elements"})
 
 
 def _namelist(values: Mapping[str, Any]) -> str:

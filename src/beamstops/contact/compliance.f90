@@ -3,6 +3,7 @@
 !> Its implicit Newmark part is a piecewise-linear scalar equation, solved exactly.
 module beamstops_contact_compliance
    use beamstops_kinds, only: wp
+   use beamstops_newmark, only: newmark_average
    implicit none
    private
    public :: spring_force, solve_spring_tip, compliance_step
@@ -66,7 +67,7 @@ contains
       tip_value = solve_spring_tip(trial, lower, upper, stiffness, dt2*beta*z_tip)
       p_next = spring_force(tip_value, lower, upper, stiffness)
       c = dt2*beta*p_next
-      r_step = beta*p_next + (1 - 2*beta)*p_now + beta*p_prev
+      r_step = newmark_average(beta, p_next, p_now, p_prev)
       p_prev = p_now
       p_now = p_next
       contact = r_step /= 0

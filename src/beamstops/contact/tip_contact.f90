@@ -14,6 +14,7 @@ module beamstops_contact_tip_contact
    use beamstops_contact_mass_redistribution, only: massless_reaction
    use beamstops_contact_tip_projection, only: project_tip
    use beamstops_contact_compliance, only: compliance_step
+   use beamstops_newmark, only: newmark_explicit
    use beamstops_ledger, only: book_step, shift_loads
    implicit none
    private
@@ -55,7 +56,7 @@ contains
       type(state_type), intent(in) :: state
       real(wp) :: f
       f = 0
-      if (scene%law == law_compliance) f = model%dt2*((1 - 2*model%beta)*state%p_now + model%beta*state%p_prev)
+      if (scene%law == law_compliance) f = newmark_explicit(model%dt2, model%beta, state%p_now, state%p_prev)
    end function spring_term
 
    !> The contact law at the tip: from the trial tip value u^n_tip + (A^{-1} rhs + d^{n-1})_tip,
