@@ -439,6 +439,29 @@ contains
          given_by = 0
          do i = 1, size(starts)
             key = key_at(body, starts(i))
+            last = len(body)
+            if (i < size(starts)) last = starts(i + 1) - 1
+            ! a value with no key name before its = (`&time = 1e-5 /`, `&time (1) = 2 /`): the
+            ! messages below would name an empty key (`allowed:  = a real number`, `unknown key `)
+            if (len(key) == 0) then
+               call fatal_error(error, source//': &'//trim(group_names(g))//' '// &
+                  & assignment_text(body(starts(i):min(last, starts(i) + 120)))//' is malformed: no key name '// &
+                  & 'before =; allowed: key = value, the keys of &'//trim(group_names(g))//': '// &
+                  & trim(group_keys(g)))
+               return
+            end if
+            ! a key is a whole word: `d-t = 2` (read as the key t), `dt = 1e-5 = 2` (as 5 = 2, the
+            ! message quoting `dt=1e-`) and `dt%x = 2` have none
+            if (starts(i) > 1) then
+               if (scan(body(starts(i) - 1:starts(i) - 1), ' ,;"'''//achar(9)//new_line('a')) == 0) then
+                  j = scan(body(:starts(i) - 1), ' ,;="'''//achar(9)//new_line('a'), back=.true.) + 1
+                  call fatal_error(error, source//': &'//trim(group_names(g))//' '// &
+                     & assignment_text(body(merge(starts(max(i - 1, 1)), j, i > 1):min(last, j + 120)))// &
+                     & ' is malformed: `'//body(j:starts(i) + len(key) - 1)//'` before = is not a key name; '// &
+                     & 'allowed: key = value, the keys of &'//trim(group_names(g))//': '//trim(group_keys(g)))
+                  return
+               end if
+            end if
             j = starts(i) + len(key)
             if (verify(body(j:), ' ') == 0) cycle
             j = j - 1 + verify(body(j:), ' ')
@@ -1040,6 +1063,16 @@ contains
                   call fatal_error(error, source//': line '//itoa(line_no)//': group &'//name// &
                      & ' appears twice; allowed: each group once')
                   return
+               end if
+               ! the name ends at a blank, a comma, the group's / or a comment: gfortran did not
+               ! find `&time=1e-5, beta=0.3 /` as the group &time and kept every default unsaid
+               if (j <= len(line)) then
+                  if (scan(line(j:j), ' ,/!'//achar(9)//achar(13)) == 0) then
+                     call fatal_error(error, source//': line '//itoa(line_no)//': group &'//name// &
+                        & ' is followed by `'//trim(line(j:min(len(line), j + 40)))//'` with no blank; allowed: '// &
+                        & 'a blank after the group name (e.g. `&'//name//' key = value /`)')
+                     return
+                  end if
                end if
                present(g) = .true.
                current = g

@@ -373,3 +373,50 @@ def test_the_studies_names_of_a_statistic_are_read_as_the_engines() -> None:
         Quantity("energy")
     # the option is accepted (not exit 2): what stops the plan is the absent scene (exit 1)
     assert cli.main(["plan", "absent.nml", "--qoi", "stop_power", "--tol", "2%", "--quiet"], prog="beamstops") == 1
+
+
+SHORT_STATISTICS = beamstops.Scene(t_end=0.05, dt=1e-4)
+
+
+@pytest.mark.parametrize("window", ["1e-16", "1e-5"])
+def test_cli_max_window_shorter_than_a_step_is_an_option_error(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                               window: str) -> None:
+    """--max-window below one step of the scene ran the search into the engine's 'scene: &time t_end =
+    1e-16 is out of range' (or 'dt = 0.0001 ... <= t_end'), exit 1, not naming the option."""
+    scene_file = tmp_path / "short.nml"
+    SHORT_STATISTICS.to_namelist(scene_file)
+    with pytest.raises(SystemExit) as exit_:
+        cli.main(["plan", str(scene_file), "--qoi", "tip_rms", "--tol", "1e-3", "--max-window", window, "--quiet"],
+                 prog="beamstops")
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("beamstops plan: error: argument --max-window: "), err
+    assert "allowed: a window of at least one step of the scene (dt = 0.0001 s)" in err[0], err
+    assert not (tmp_path / "short_plan.nml").exists()
+    with pytest.raises(ValueError, match=r"^max_window 1e-05 s: .*refused by the engine"):
+        plan(SHORT_STATISTICS, "tip_rms", 1e-3, max_window=1e-5, quiet=True)
+
+
+def test_a_tolerance_whose_window_the_engine_refuses_says_so(tmp_path: Path,
+                                                             capsys: pytest.CaptureFixture[str]) -> None:
+    """A tolerance so tight that the scaled window makes a scene the engine refuses ended in the
+    engine's 'scene: &output record_every = 273200000000000 is out of range', naming neither the
+    tolerance nor the window."""
+    scene_file = tmp_path / "short.nml"
+    SHORT_STATISTICS.to_namelist(scene_file)
+    assert cli.main(["plan", str(scene_file), "--qoi", "tip_rms", "--tol", "1e-9", "--quiet"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("beamstops: error: the window after the transient that the "
+                                               "tolerance 1e-09 m needs"), err
+    assert "allowed: a larger tolerance" in err[0] and "--max-window" in err[0], err
+    assert not (tmp_path / "short_plan.nml").exists()
+
+
+def test_a_stop_beyond_the_statistics_entries_names_the_option_and_its_range(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--stop 5 on a scene with the tip's stops only said "statistic 'power' has 1 entries; no stop 5"."""
+    scene_file = tmp_path / "short.nml"
+    SHORT_STATISTICS.to_namelist(scene_file)
+    assert cli.main(["plan", str(scene_file), "--qoi", "power", "--tol", "1", "--stop", "5", "--quiet"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "stop 5 (--stop)" in err[0] and "allowed: 0 <= stop <= 0" in err[0], err

@@ -172,6 +172,18 @@ REFUSED = [
     ("&damping stiffness_coefficient=1e300 /", ["&damping stiffness_coefficient = 1e+300 is out of range"]),
     ("&time dt=1e-170, t_end=1e-170 /", ["&time t_end = 1e-170", "1e-15 <= t_end"]),
     ("&stops law='compliance', stiffness=1e5, stiffness_per_mass=1e6 /", ["both given"]),
+    # a group name joined to what follows: gfortran did not find the group and kept every default
+    ("&time=1e-5, beta=0.3 /", ["line 1: group &time is followed by `=1e-5, beta=0.3 /` with no blank",
+                                "allowed: a blank after the group name"]),
+    ("&output='x.h5' /", ["group &output is followed by"]),
+    # a value with no key name before its =: the message named an empty key ('allowed:  = a real number')
+    ("&time =1e-5 /", ["&time =1e-5 is malformed: no key name before =", "the keys of &time: dt, t_end"]),
+    ("&output ='x.h5' /", ["&output ='x.h5' is malformed: no key name", "the keys of &output: file"]),
+    ("&time (1)=2 /", ["&time (1)=2 is malformed: no key name before ="]),
+    ("&time dt=1e-5, =2 /", ["&time =2 is malformed: no key name before ="]),
+    # a key that is not a whole word: read as its last part (`unknown key t`) or blamed on the value before
+    ("&time d-t=2 /", ["&time d-t=2 is malformed: `d-t` before = is not a key name", "keys of &time"]),
+    ("&time dt=1e-5 =2 /", ["&time dt=1e-5 =2 is malformed: `1e-5` before = is not a key name"]),
 ]
 
 

@@ -43,7 +43,7 @@ from .scene import Scene
 from .studies.common import progress
 
 __all__ = ["QUANTITIES", "STATISTICAL", "LAWS", "Quantity", "Model", "Candidate", "Check", "Plan", "plan",
-           "parse_tolerance", "reduced_available"]
+           "parse_tolerance", "reduced_available", "window_scene"]
 
 #: Most rungs of the Δt ladder either way: Δt·2^20 or Δt/2^20 (a million times the scene's steps).
 MAX_RUNGS = 20
@@ -93,6 +93,9 @@ def plan(scene: Union[Scene, str, "os.PathLike[str]"], qoi: Union[str, Quantity]
                              f"scene's Δt: the Δt ladder runs from dt·2^coarser to dt/2^finer)")
     if max_window is not None:
         bounded(max_window, "a window after the transient in s", name="max_window")
+        if not quantity.deterministic:
+            window_scene(scene.replace(snapshot_every=0, checkpoint_every=0, members=1, enabled=True), max_window,
+                         "max_window")
     reference_law = "redistributed" if (scene.law == "signorini" and scene.mass == "redistributed") else scene.law
     chosen_laws = parse_laws(laws) if laws is not None else [reference_law]
     if "compliance" in chosen_laws and not scene.stiffness_per_mass > 0:
@@ -141,9 +144,16 @@ def plan(scene: Union[Scene, str, "os.PathLike[str]"], qoi: Union[str, Quantity]
         needed = float(f"{needed:.3g}")
         out.window = needed
         if needed != window:
-            t_end = base.transient + needed
-            base = base.replace(t_end=t_end, record_every=max(1, math.ceil(t_end / min(dts) / RECORDS)))
-            dts = [dt for dt in ladder if dt <= t_end]  # a longer window may take coarser rungs back
+            try:
+                base = window_scene(base, needed, "window", min(dts))
+            except ValueError as exc:  # the engine's words on a scene the user never wrote: say where it came from
+                raise ValueError(f"the window after the transient that the tolerance {tolerance:g} {unit} needs, "
+                                 f"{needed:g} s (the scene's {window:g} s times (its half-width "
+                                 f"{pilot.half_width:.3g} / half the tolerance)^2"
+                                 f"{', at most max_window' if max_window is not None else ''}), makes a scene the "
+                                 f"engine refuses ({exc}); allowed: a larger tolerance, or a window the engine "
+                                 "accepts by max_window (--max-window)") from None
+            dts = [dt for dt in ladder if dt <= base.t_end]  # a longer window may take coarser rungs back
             pilot_runner, runner = runner, Runner(base, quantity, grid, budget)
             runner.cpu, runner.rate, runner.shock_rate = pilot_runner.cpu, pilot_runner.rate, pilot_runner.shock_rate
     done: set[Model] = set()
@@ -206,6 +216,22 @@ def plan(scene: Union[Scene, str, "os.PathLike[str]"], qoi: Union[str, Quantity]
                          f"{first[1]})")
     out.cpu_seconds, out.runs = runner.cpu, len(runner.cache) + (runner is not pilot_runner)
     return out
+
+
+def window_scene(base: Scene, window: float, name: str, finest_dt: Optional[float] = None) -> Scene:
+    """``base`` run over ``window`` s after its transient (at most RECORDS records a run, steps of
+    ``finest_dt``, by default its own dt); a ValueError naming ``name`` when the engine refuses that
+    scene (a window shorter than one step, or one beyond the engine's t_end)."""
+    t_end = base.transient + window
+    every = max(1, math.ceil(t_end / (finest_dt if finest_dt is not None else base.dt) / RECORDS))
+    try:
+        return base.replace(t_end=t_end, record_every=every)
+    except ValueError as exc:
+        if name == "window":
+            raise
+        raise ValueError(f"{name + ' ' if name else ''}{window!r} s: the scene run {window!r} s after its transient "
+                         f"({base.transient!r} s) is refused by the engine ({exc}); allowed: a window of at least "
+                         f"one step of the scene (dt = {base.dt!r} s) that ends within the engine's t_end") from None
 
 
 def _cost(model: Model) -> float:

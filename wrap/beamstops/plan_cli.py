@@ -12,7 +12,7 @@ from typing import Callable
 
 from .arguments import OptionError, number, output_name, whole
 from .output_files import check, names_no_file, write_text
-from .plan import LAWS, MAX_RUNGS, QUANTITIES, Quantity, parse_tolerance, plan
+from .plan import LAWS, MAX_RUNGS, QUANTITIES, Quantity, parse_tolerance, plan, window_scene
 from .plan_types import ALIASES, TOLERANCE, parse_laws, window_range
 from .scene import NAMELIST_FILE
 
@@ -63,6 +63,12 @@ def _handler(args: argparse.Namespace) -> int:
     scene = Scene.from_namelist(args.scene)
     if args.until is not None:
         window_range(args.until, scene.t_end, scene.dt, name="--until")
+    if args.max_window is not None and args.qoi != "tip":
+        try:  # a window the engine refuses (shorter than a step): the option's own error, before any run
+            window_scene(scene.replace(snapshot_every=0, checkpoint_every=0, members=1, enabled=True),
+                         args.max_window, "")
+        except ValueError as exc:
+            raise OptionError(f"argument --max-window: {exc}") from None
     out = _output(args)
     result = plan(scene, Quantity(args.qoi, until=args.until, stop=args.stop), args.tol, budget=args.budget,
                   laws=args.laws, safety=args.safety, coarser=args.coarser, finer=args.finer, exhaustive=args.all,

@@ -172,8 +172,9 @@ class Runner:
         if statistic is None:
             raise ValueError(f"the engine gave no statistic {self.quantity.name!r} (is &statistics enabled?)")
         if self.quantity.stop >= len(statistic):
-            raise ValueError(f"statistic {self.quantity.name!r} has {len(statistic)} entries; no stop "
-                             f"{self.quantity.stop}")
+            raise ValueError(f"stop {self.quantity.stop} (--stop): statistic {self.quantity.name!r} has "
+                             f"{len(statistic)} entries, one per stop of the scene; allowed: 0 <= stop <= "
+                             f"{len(statistic) - 1}")
         return Run(float(statistic.value[self.quantity.stop]), float(statistic.half_width[self.quantity.stop]),
                     None, cpu, scene.t_end, statistic.unit)
 

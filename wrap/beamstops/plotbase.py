@@ -108,6 +108,9 @@ def need_snapshots(result: Result) -> None:
 
 def need_impacts(result: Result) -> None:
     if not result.impacts:
+        if result.attrs.get("enabled") == 0:  # the scene turned the shock log off, not an older beamstops
+            raise ValueError("no shock log: the run was made with &statistics enabled = .false. (no /impacts); run it "
+                             "with &statistics enabled = .true. (the default)")
         raise ValueError("no shock log: the run has no /impacts (written by a beamstops that did not log shocks)")
     if result.shocks == 0:
         raise ValueError("no shocks: the shock log /impacts is empty (the beam never touched a stop)")
