@@ -1,9 +1,9 @@
 !> The Newmark-weighted sums of a step (the load average, the explicit part of the compliance
-!> spring, the work of the load, the discrete energy), formed out of line in
-!> src/beamstops/newmark.c so that every loop (one scene, lockstep, span stops) rounds them the
-!> same way: where gfortran inlined them it fused their products by beta into the sums
-!> differently from one loop to the other (beta other than 0, 1/4, 1/2), and a lockstep member
-!> parted from the same scene run alone.
+!> spring, the work of the load, the discrete energy), formed in src/beamstops/newmark.c with every
+!> fused multiply-add written out, so that every loop (one scene, lockstep, span stops) rounds them
+!> the same way wherever they are inlined: written in Fortran, gfortran fused their products by beta
+!> into the sums differently from one loop to the other (beta other than 0, 1/4, 1/2), and a
+!> lockstep member parted from the same scene run alone.
 module beamstops_newmark
    use, intrinsic :: iso_c_binding, only: c_double
    implicit none
