@@ -25,6 +25,10 @@ SCENES = {
     "none": SHORT.replace(law="none", beta=0.1, dt=5e-6, t_end=0.1, record_every=7),
     "material": SHORT.replace(youngs_modulus=2e11, density=8e3, outer_diameter=0.01, wall_thickness=5e-4,
                               elements=8, snapshot_every=1),
+    # the massless tip row (the README once had the program round it apart from the extension)
+    "redistributed": SHORT.replace(mass="redistributed", record_every=2),
+    # products by beta that round (the Newmark sums of src/beamstops/newmark.c)
+    "beta_0.3": SHORT.replace(beta=0.3, law="compliance", stiffness_per_mass=1e8, dt=5e-6, t_end=0.1),
 }
 
 

@@ -124,3 +124,19 @@ def test_a_model_refusal_names_the_file(tmp_path, program) -> None:  # type: ign
     assert done.returncode == 1 and len(lines) == 1
     assert lines[0].startswith(f"beamstops: error: {scene}: &damping ratio = 0.02, 0 "), lines
     assert not (tmp_path / "out.h5").exists()
+
+
+@pytest.mark.parametrize("key", ["mass_coefficient", "stiffness_coefficient"])
+def test_the_ledger_closes_at_the_damping_bounds(key: str) -> None:
+    """The README's 'Why these bounds': at a coefficient's upper bound (read from the engine's own
+    refusal of a larger one) the paper's scene still balances its energy ledger to a small part of
+    the damping term; far beyond it (a = 1e14 1/s) it missed by the whole term."""
+    scene = Scene(t_end=0.5, dt=1e-4)
+    with pytest.raises(ValueError, match=rf"allowed: 0 <= {key} <= ") as refused:
+        beamstops.run(scene.replace(**{key: 1e300}))
+    bound = float(str(refused.value).split(f"<= {key} <= ")[1].split()[0])
+    result = beamstops.run(scene.replace(**{key: bound}))
+    e, w, d, c = result.energy, result.work, result.dissipated, result.damped
+    assert c[-1] > 0.5 * (w[-1] - d[-1])  # the damping takes most of the support's work
+    assert np.abs((e - e[0]) - (w - d - c)).max() < 1e-6 * c[-1]
+    assert abs(result.attrs["energy_residual"]) < 1e-6 * c[-1]
