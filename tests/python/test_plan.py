@@ -420,3 +420,20 @@ def test_a_stop_beyond_the_statistics_entries_names_the_option_and_its_range(
     assert cli.main(["plan", str(scene_file), "--qoi", "power", "--tol", "1", "--stop", "5", "--quiet"]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "stop 5 (--stop)" in err[0] and "allowed: 0 <= stop <= 0" in err[0], err
+
+
+def test_a_scaled_window_is_announced_before_the_search(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A tight tolerance scales the window (here 4x) and the search could run for hours with no word:
+    the window and the cost of one run over it are said before the first candidate runs."""
+    scene_file = tmp_path / "short.nml"
+    SHORT_STATISTICS.to_namelist(scene_file)
+    pilot = plan(SHORT_STATISTICS, "tip_rms", 1.0, quiet=True)  # the pilot's half-width, from the engine
+    assert pilot.pilot_half_width is not None and pilot.pilot_half_width > 0
+    tol = pilot.pilot_half_width  # half the tolerance is half the half-width: a window 4 times the scene's
+    cli.main(["plan", str(scene_file), "--qoi", "tip_rms", "--tol", f"{tol!r}", "--budget", "1",
+              "-o", str(tmp_path / "p.nml")])
+    err = capsys.readouterr().err
+    note = next(line for line in err.splitlines() if line.startswith("plan: the tolerance"))
+    window = SHORT_STATISTICS.t_end - SHORT_STATISTICS.transient
+    assert f"needs a window of {float(f'{4 * window:.3g}'):g} s after the transient" in note, note
+    assert "CPU s" in note and "--budget" not in note  # a budget was given: no advice to give one

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 import os
+import sys
 from collections.abc import Sequence
 from typing import Any, Optional, Union
 
@@ -153,6 +154,13 @@ def plan(scene: Union[Scene, str, "os.PathLike[str]"], qoi: Union[str, Quantity]
                                  f"{', at most max_window' if max_window is not None else ''}), makes a scene the "
                                  f"engine refuses ({exc}); allowed: a larger tolerance, or a window the engine "
                                  "accepts by max_window (--max-window)") from None
+            if not quiet and needed > window:  # a long search says so before it starts, not after hours
+                per_run = pilot.cpu / pilot.simulated * base.t_end
+                print(f"plan: the tolerance {tolerance:g} {unit} needs a window of {needed:g} s after the transient "
+                      f"(the scene's {window:g} s gave a half-width of {pilot.half_width:.3g} {unit}); the scene's "
+                      f"own model runs it in about {per_run:.3g} CPU s, and each candidate takes a few such runs"
+                      f"{'' if budget is not None else ' (bound the search with --budget or --max-window)'}",
+                      file=sys.stderr, flush=True)
             dts = [dt for dt in ladder if dt <= base.t_end]  # a longer window may take coarser rungs back
             pilot_runner, runner = runner, Runner(base, quantity, grid, budget)
             runner.cpu, runner.rate, runner.shock_rate = pilot_runner.cpu, pilot_runner.rate, pilot_runner.shock_rate
