@@ -403,3 +403,16 @@ def test_to_namelist_writes_over_its_own_scenes_only(tmp_path: Path) -> None:
             Scene().to_namelist(path)
         assert path.read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["hand.nml", "link.nml", "own.nml", "run.h5"]
+
+
+def test_the_constructor_reads_keys_as_replace_does() -> None:
+    """Scene(dtt=1e-5) gave Python's bare 'unexpected keyword argument' and Scene(youngs_modulus=...)
+    refused a key that replace() and the namelist take: the constructor now names the allowed keys
+    and resolves a route as replace() does."""
+    with pytest.raises(TypeError, match=r"unknown scene key\(s\) dtt; allowed: .*\bdt\b"):
+        Scene(dtt=1e-5)
+    material = dict(youngs_modulus=2e11, density=8e3, outer_diameter=0.01, wall_thickness=5e-4)
+    assert Scene(**material, elements=8) == Scene().replace(**material, elements=8) != Scene(elements=8)
+    assert Scene(stiffness=1e6, law="compliance").stiffness_per_mass == \
+        Scene().replace(stiffness=1e6, law="compliance").stiffness_per_mass
+    assert Scene(dt=1e-5) == Scene().replace(dt=1e-5)

@@ -287,6 +287,27 @@ class Scene:
 
 #: The fields of a Scene, in order (to_dict).
 _FIELD_NAMES: tuple[str, ...] = tuple(field.name for field in dataclasses.fields(Scene))
+_FIELDS_INIT = Scene.__init__
+
+
+def _scene_init(self: Scene, *args: Any, **keys: Any) -> None:
+    """The dataclass's constructor, but a key that is no field is what :meth:`Scene.replace` makes
+    of it: a route (``youngs_modulus=``, ``stiffness=``, ``x=``...) is resolved by the engine from the
+    defaults, and an unknown key is refused with the keys allowed (Python's own message named only
+    the key)."""
+    others = set(keys) - set(_FIELD_NAMES)
+    if not others:
+        _FIELDS_INIT(self, *args, **keys)
+        return
+    unknown = sorted(others - set(_GROUP_OF))
+    if unknown:
+        raise TypeError(f"unknown scene key(s) {', '.join(unknown)}; allowed: {', '.join(_GROUP_OF)}")
+    if args:
+        raise TypeError(f"Scene takes keys by name only with a route ({', '.join(sorted(others))})")
+    _adopt(self, Scene().replace(**keys).to_text())
+
+
+Scene.__init__ = _scene_init  # type: ignore[method-assign]
 
 
 # ---------------------------------------------------------------------- text
