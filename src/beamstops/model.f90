@@ -346,11 +346,19 @@ contains
       character(len=*), intent(in) :: source
       !> Set when dt exceeds the limit.
       type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: kappa, what
       if (scene%allow_unstable .or. scene%beta >= 0.25_wp) return
       if (scene%dt < model%dt_newmark) return
+      if (model%kappa_contact == model%kappa_h) then
+         kappa = 'kappa_h'
+         what = ''
+      else  ! normal compliance: the stops' spring stiffens the tip's row
+         kappa = 'kappa'
+         what = ', the largest eigenvalue of S with the stops'' spring at the tip, against M'
+      end if
       call fatal_error(error, source//': &time dt = '//fmt_real(scene%dt)//' is out of range; allowed: dt < '// &
-         & fmt_real(model%dt_newmark, 6, 'down')//' s, the linear stability limit 2/sqrt((1-4 beta) kappa_h) for '// &
-         & 'beta = '//fmt_real(scene%beta)//' (kappa_h = '//fmt_real(model%kappa_contact, 6)//' 1/s^2); set &time allow_unstable=.true.'// &
-         & ' to run it anyway')
+         & fmt_real(model%dt_newmark, 6, 'down')//' s, the linear stability limit 2/sqrt((1-4 beta) '//kappa//') for '// &
+         & 'beta = '//fmt_real(scene%beta)//' ('//kappa//' = '//fmt_real(model%kappa_contact, 6)//' 1/s^2'//what// &
+         & '); set &time allow_unstable=.true. to run it anyway')
    end subroutine check_stability
 end module beamstops_model

@@ -140,3 +140,19 @@ def test_the_ledger_closes_at_the_damping_bounds(key: str) -> None:
     assert c[-1] > 0.5 * (w[-1] - d[-1])  # the damping takes most of the support's work
     assert np.abs((e - e[0]) - (w - d - c)).max() < 1e-6 * c[-1]
     assert abs(result.attrs["energy_residual"]) < 1e-6 * c[-1]
+
+
+@pytest.mark.parametrize(("stops", "kappa"), [("", "kappa_h"), ("&stops law = 'compliance', stiffness_per_mass = 1e12 /\n",
+                                                                  "kappa")])
+def test_the_explicit_limit_names_the_eigenvalue_it_takes(stops: str, kappa: str, tmp_path: Path,
+                                                            program: str) -> None:
+    """Under normal compliance the limit takes the largest eigenvalue with the stops' spring, which
+    the message called kappa_h (the paper's bound of S alone, 7000 times smaller here)."""
+    path = tmp_path / "fast.nml"
+    path.write_text(stops + "&time beta = 0, dt = 1e-4 /\n")
+    done = subprocess.run([program, "run", str(path)], capture_output=True, text=True, cwd=tmp_path)
+    assert done.returncode == 1 and done.stderr.count("\n") == 1, done.stderr
+    assert f"the linear stability limit 2/sqrt((1-4 beta) {kappa}) for beta = 0 ({kappa} = " in done.stderr
+    limits = beamstops.stability(Scene.from_namelist(path))
+    value = float(done.stderr.split(f"({kappa} = ")[1].split()[0])
+    assert value == pytest.approx(4 / limits.dt_limit_newmark ** 2, rel=1e-5)  # the limit's own eigenvalue
