@@ -217,6 +217,8 @@ contains
    contains
 
       !> A part of the subscript into `value` (kept when the part is blank); whether it is read.
+      !> A whole number beyond the integer kind is read as a quarter of the kind's largest, of its
+      !> sign: outside every list (so out of range, not malformed), and no overflow in outside_list.
       logical function part(text, value)
          character(len=*), intent(in) :: text
          integer, intent(inout) :: value
@@ -226,7 +228,7 @@ contains
          part = whole_number_text(text)
          if (.not. part) return
          read (text, *, iostat=stat) value
-         part = stat == 0
+         if (stat /= 0) value = sign(huge(value)/4, merge(-1, 1, index(text, '-') > 0))
       end function part
    end subroutine section_of
 

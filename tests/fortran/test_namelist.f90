@@ -928,16 +928,19 @@ contains
    !> inside the list, and empty sections, are not refused for their subscript.
    subroutine test_element_outside(error)
       type(error_type), allocatable, intent(out) :: error
-      character(len=*), parameter :: bad(6) = [character(len=48) :: '&stops nodes(1001) = 1001 /', &
+      ! subscripts beyond the integer kind too (they were malformed): a whole number is out of range
+      character(len=*), parameter :: bad(8) = [character(len=64) :: '&stops nodes(1001) = 1001 /', &
          & '&stops nodes(0) = 3 /', '&stops lower(999) = -0.1, -0.1, -0.1 /', '&damping ratio(3) = 0.1 /', &
-         & '&damping ratio(1:3:2) = 0.1, 0.2 /', '&damping modes(2:0:-1) = 1, 2 /']
-      character(len=*), parameter :: shown(6) = [character(len=40) :: '&stops nodes(1001) = 1001', &
+         & '&damping ratio(1:3:2) = 0.1, 0.2 /', '&damping modes(2:0:-1) = 1, 2 /', &
+         & '&stops nodes(99999999999999999999) = 2 /', '&damping ratio(-99999999999999999999:2) = 0.1 /']
+      character(len=*), parameter :: shown(8) = [character(len=56) :: '&stops nodes(1001) = 1001', &
          & '&stops nodes(0) = 3', '&stops lower(999) = -0.1, -0.1, -0.1', '&damping ratio(3) = 0.1', &
-         & '&damping ratio(1:3:2) = 0.1, 0.2', '&damping modes(2:0:-1) = 1, 2']
-      character(len=*), parameter :: bounds(6) = [character(len=40) :: 'nodes(1) to nodes(1000)', &
+         & '&damping ratio(1:3:2) = 0.1, 0.2', '&damping modes(2:0:-1) = 1, 2', &
+         & '&stops nodes(99999999999999999999) = 2', '&damping ratio(-99999999999999999999:2) = 0.1']
+      character(len=*), parameter :: bounds(8) = [character(len=40) :: 'nodes(1) to nodes(1000)', &
          & 'nodes(1) to nodes(1000)', 'lower(1) to lower(1000)', 'ratio(1) to ratio(2)', 'ratio(1) to ratio(2)', &
-         & 'modes(1) to modes(2)']
-      character(len=64) :: needles(2)
+         & 'modes(1) to modes(2)', 'nodes(1) to nodes(1000)', 'ratio(1) to ratio(2)']
+      character(len=80) :: needles(2)
       type(scene_type) :: scene
       integer :: i
       do i = 1, size(bad)
