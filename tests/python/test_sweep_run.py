@@ -666,3 +666,24 @@ def test_a_tampered_point_record_is_made_again(tmp_path: Path, write_spec: Calla
     assert (again.ran, again.skipped, again.complete) == (1, 1, 2)
     row = read_summary(tmp_path / "out")[0]
     assert row["u"] == first["reductions"]["u"] and row["cpu_seconds"] == first["cpu_seconds"]
+
+
+@pytest.mark.parametrize("folder", ["/proc/beamstops-no-such-folder", "/dev/null/sweep"])
+def test_an_output_folder_that_cannot_be_made_is_one_clear_line(folder: str, write_spec: Callable[..., Path],
+                                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    """`sweep -o /proc/xx` ended in Python's '[Errno 2] No such file or directory: '/proc/xx''."""
+    from beamstops import cli
+
+    assert cli.main(["sweep", str(write_spec(SMALL)), "-o", folder, "-q"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"beamstops: error: {folder}: the sweep's output folder cannot be "
+                                               "created or written ("), err
+    assert "[Errno" not in err[0] and "allowed: -o a folder" in err[0]
+
+
+def test_an_os_error_reads_as_its_file_and_what_went_wrong() -> None:
+    from beamstops.cli import _described
+
+    assert _described(FileNotFoundError(2, "No such file or directory", "/a/b")) == "/a/b: No such file or directory"
+    assert _described(OSError(18, "Invalid cross-device link", "/a", None, "/b")) == "/a and /b: Invalid cross-device link"
+    assert _described(ValueError("x.nml: bad")) == "x.nml: bad"

@@ -123,6 +123,15 @@ def quiet_font_lookup() -> None:
     logging.getLogger("matplotlib.font_manager").setLevel(logging.ERROR)
 
 
+def _described(exc: Exception) -> str:
+    """An error in one line: an OSError as 'FILE: what went wrong' (its str() reads '[Errno 2] No
+    such file or directory: 'FILE''), anything else as its message."""
+    if isinstance(exc, OSError) and exc.strerror:
+        files = " and ".join(str(f) for f in (exc.filename, exc.filename2) if f is not None)
+        return f"{files}: {exc.strerror}" if files else exc.strerror
+    return str(exc)
+
+
 def main(argv: Optional[Sequence[str]] = None, prog: str = "python -m beamstops") -> int:
     """Run a subcommand; ``prog`` names the command in messages (``beamstops`` when the
     program hands a subcommand on)."""
@@ -137,5 +146,5 @@ def main(argv: Optional[Sequence[str]] = None, prog: str = "python -m beamstops"
         _subcommands(parser).choices[args.command].error(str(exc))
         return 2  # not reached: error() exits with status 2
     except (OSError, ValueError) as exc:
-        print(f"beamstops: error: {exc}", file=sys.stderr)
+        print(f"beamstops: error: {_described(exc)}", file=sys.stderr)
         return 1

@@ -250,8 +250,13 @@ class FolderLock:
     def acquire(self) -> "FolderLock":
         import fcntl
 
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:  # the folder cannot be made or written: say which, not '[Errno 2] ...'
+            raise ValueError(f"{self.path.parent}: the sweep's output folder cannot be created or written "
+                             f"({exc.strerror or exc}{': ' + str(exc.filename) if exc.filename else ''}); "
+                             "allowed: -o a folder in a place you can write") from None
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as exc:
