@@ -19,6 +19,7 @@ import pytest
 import synthetic
 import beamstops
 from beamstops import Scene, plots
+from beamstops.plotbase import NO_SNAPSHOTS
 from beamstops.transforms import frame_indices, stroboscopic, welch
 
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -354,8 +355,12 @@ def test_command_line_missing_data_is_one_line(program: str, tmp_path: Path) -> 
     output = tmp_path / "bare.h5"
     done = subprocess.run([sys.executable, "-m", "beamstops", "plot", str(output), "--kind", "impacts",
                            "-o", str(tmp_path / "x.png")], capture_output=True, text=True, timeout=120, env=headless())
-    assert done.returncode == 1
-    assert done.stderr.startswith("beamstops: error: no shock log") and "Traceback" not in done.stderr
+    assert done.returncode == 1 and done.stderr.count("\n") == 1
+    # the message names the file that lacks the data (it said only 'no shock log ...')
+    assert done.stderr.startswith(f"beamstops: error: {output}: no shock log") and "Traceback" not in done.stderr
+    done = subprocess.run([sys.executable, "-m", "beamstops", "plot", str(output), "--kind", "shape",
+                           "-o", str(tmp_path / "y.png")], capture_output=True, text=True, timeout=120, env=headless())
+    assert done.returncode == 1 and done.stderr == f"beamstops: error: {output}: {NO_SNAPSHOTS}\n"
 
 
 def test_command_line_errors_are_one_line(tmp_path: Path) -> None:

@@ -40,7 +40,13 @@ def _plot(args: argparse.Namespace) -> int:
         options = {"frames": args.frames, "fps": args.fps}
     else:
         options = {"transient": args.transient} if args.transient is not None else {}
-    print(plots.save(result, out, kind=args.kind, dpi=args.dpi, **options))
+    try:
+        written = plots.save(result, out, kind=args.kind, dpi=args.dpi, **options)
+    except ValueError as exc:  # what the file lacks for this kind ("no snapshots: ..."): name the file
+        message = str(exc)
+        named = message.startswith(str(args.file)) or str(out) in message  # the image's own refusals name it
+        raise ValueError(message if named else f"{args.file}: {message}") from None
+    print(written)
     return 0
 
 
