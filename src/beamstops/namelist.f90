@@ -354,8 +354,13 @@ contains
       subroutine damping_forms()
          if (ratio(1) == unset .and. ratio(2) == unset .and. is_carried('damping:modes')) modes = unset_node
          if (modes(1) /= unset_node .or. modes(2) /= unset_node) then
-            if (modes(1) == unset_node .or. modes(2) == unset_node) then
-               call fatal_error(error, source//': &damping modes = '//itoa(maxval(modes))//' (one value) is out of '// &
+            if (modes(1) == unset_node) then  ! modes(2) = j alone
+               call fatal_error(error, source//': &damping modes(2) = '//itoa(modes(2))//' is given but modes(1) '// &
+                  & 'is not; allowed: modes = i, j, two distinct mode numbers (1 <= mode <= 2*elements)')
+               return
+            end if
+            if (modes(2) == unset_node) then
+               call fatal_error(error, source//': &damping modes = '//itoa(modes(1))//' (one value) is out of '// &
                   & 'range; allowed: modes = i, j, two distinct mode numbers (1 <= mode <= 2*elements)')
                return
             end if

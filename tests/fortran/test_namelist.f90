@@ -473,6 +473,10 @@ contains
       if (allocated(error)) return
       call expect_error('modes.nml', [character(len=ll) :: '&damping modes = 2, 3 /'], &
          & [character(len=48) :: '&damping modes = 2, 3 is given without ratio', 'modes only with ratio'], error)
+      if (allocated(error)) return
+      ! the second alone was told as one value, 3, as if modes = 3
+      call expect_error('modes.nml', [character(len=ll) :: '&damping ratio = 0.01, modes(2) = 3 /'], &
+         & [character(len=48) :: '&damping modes(2) = 3 is given but modes(1)', 'two distinct mode numbers'], error)
    end subroutine test_damping_modes
 
    !> members = 3 with the statistics off ran three members and wrote no /ensemble.
