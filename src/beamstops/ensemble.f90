@@ -16,7 +16,9 @@ module beamstops_ensemble
    use beamstops_start, only: start_state
    use beamstops_scheme, only: run_scheme
    use beamstops_recorder, only: recorder_type, n_columns
-   use beamstops_summary, only: run_summary, status_complete
+   use beamstops_summary, only: run_summary, status_complete, status_interrupted
+   use beamstops_stop_signals, only: stop_signal, signal_name
+   use beamstops_strings, only: fmt_int
    use beamstops_lockstep, only: check_lockstep, simulate_lockstep
    use beamstops_observe_statistics, only: statistics_table, ensemble_table
    implicit none
@@ -73,6 +75,7 @@ contains
          end do
          call simulate_lockstep(scenes, model, recorders, members, error, initial_displacement=u0)
          if (allocated(error)) return
+         if (interrupted()) return
          do k = 1, size(members)
             if (members(k)%status /= status_complete) cycle
             summary%ensemble_members = summary%ensemble_members + 1
@@ -86,12 +89,26 @@ contains
             if (allocated(error)) return
             member = run_summary()
             call run_scheme(member_scene, member_model, state, recorder, member)
+            if (interrupted()) return
             if (member%status /= status_complete) cycle
             summary%ensemble_members = summary%ensemble_members + 1
             tables(summary%ensemble_members) = member%statistics
          end do
       end if
       call ensemble_table(tables(:summary%ensemble_members), summary%ensemble, error)
+
+   contains
+
+      !> Whether a stop signal was caught (close_run catches them while the members run): then
+      !> the run is 'interrupted', member 1's records whole and no ensemble table.
+      logical function interrupted()
+         interrupted = stop_signal() /= 0
+         if (.not. interrupted) return
+         summary%status = status_interrupted
+         summary%message = 'stopped by '//signal_name(stop_signal())//' while the ensemble''s members 2..'// &
+            & fmt_int(int(scene%members, ik))//' ran (member 1 complete, its records flushed; the members have no '// &
+            & 'checkpoint: they run again from their start)'
+      end function interrupted
    end subroutine run_members
 
    !> delta*xi at the nodal values (odd unknowns; slopes 0), xi uniform in [-1, 1], from the

@@ -172,14 +172,14 @@ contains
       logical, intent(in), optional :: stop_signals
       call run_blocks(scene, recorder, summary, error, checkpoint, stop_signals, model=model, state=state)
       if (allocated(error)) return
-      call close_run(scene, model, recorder, summary, error)
+      call close_run(scene, model, recorder, summary, error, stop_signals)
    end subroutine continue_run
 
    !> What follows the time loop of a run (continue_run's, or a lockstep group's for each of its
    !> members): a complete run of an &ensemble runs its members 2..K (members that cannot run make
-   !> it 'failed' with their message); a recorder that could not write makes the run 'failed' with
-   !> the recorder's message.
-   subroutine close_run(scene, model, recorder, summary, error)
+   !> it 'failed' with their message; a stop signal caught while they run, 'interrupted'); a
+   !> recorder that could not write makes the run 'failed' with the recorder's message.
+   subroutine close_run(scene, model, recorder, summary, error, stop_signals)
       !> Validated scene.
       type(scene_type), intent(in) :: scene
       !> Its model.
@@ -190,9 +190,17 @@ contains
       type(run_summary), intent(inout) :: summary
       !> Set when the ensemble's members cannot run or the recorder could not write.
       type(error_type), allocatable, intent(out) :: error
+      !> Catch SIGINT and SIGTERM while the members run, to stop them politely between two of
+      !> their blocks (as continue_run's; default: a signal has its usual effect).
+      logical, intent(in), optional :: stop_signals
+      logical :: catch
       if (summary%status == status_complete .and. scene%members > 1 .and. scene%statistics .and. &
          & .not. recorder%failed) then
+         catch = .false.
+         if (present(stop_signals)) catch = stop_signals
+         if (catch) call catch_stop_signals()
          call run_members(scene, model, summary, error)
+         if (catch) call release_stop_signals()
          if (allocated(error)) then
             ! the output says so: its status was written 'complete' though the run failed
             summary%status = status_failed

@@ -152,3 +152,35 @@ def test_a_superblock_behind_its_indexes_is_mended_on_load_and_restart(tmp_path:
     resumed = run("run", scene, "--restart", cwd=tmp_path)
     assert resumed.returncode == 0, resumed.stderr
     assert_identical(tmp_path / "stopped.h5", tmp_path / "reference.h5")
+
+
+def test_a_signal_while_an_ensembles_members_run_stops_them_politely(tmp_path: Path) -> None:
+    """SIGTERM after member 1 of an &ensemble, while members 2..K ran, killed the program silently
+    (exit 143, its partial file left 'running', no line); it now stops them between two blocks:
+    one line, the partial file 'interrupted' with member 1 whole, and running the scene again gives
+    the uninterrupted output."""
+    text = ("&time dt=1e-5, t_end=2.0 /\n&output file='{file}', record_every=10 /\n"
+            "&ensemble members=200, perturbation=1e-6 /\n")
+    reference, scene = tmp_path / "reference.nml", tmp_path / "ensemble.nml"
+    reference.write_text(text.format(file="reference.h5"))
+    scene.write_text(text.format(file="ensemble.h5"))
+    assert run("run", reference, cwd=tmp_path).returncode == 0
+    process = subprocess.Popen([PROGRAM, "run", str(scene)], cwd=tmp_path, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    time.sleep(0.35)  # member 1 (200,000 steps) takes some 30 ms, the 199 others about a second
+    process.send_signal(signal.SIGTERM)
+    out, err = process.communicate(timeout=120)
+    if process.returncode == 0:
+        pytest.skip("the ensemble ended before the signal")
+    if "while the ensemble's members" not in err:
+        pytest.skip("the signal came before member 1 ended")
+    assert process.returncode == 128 + signal.SIGTERM, err
+    assert err.count("\n") == 1 and "ensemble.h5: run interrupted: stopped by SIGTERM while the ensemble's " \
+                                   "members 2..200 ran (member 1 complete" in err, err
+    assert f"beamstops run {scene} runs it again" in err
+    partial = beamstops.load(tmp_path / "ensemble.h5.partial", allow_incomplete=True)
+    full = beamstops.load(tmp_path / "reference.h5")
+    assert partial.status == "interrupted" and not partial.ensemble
+    assert np.array_equal(partial.tip_u.view(np.uint64), full.tip_u.view(np.uint64))  # member 1 whole
+    assert run("run", scene, cwd=tmp_path).returncode == 0
+    assert_identical(tmp_path / "ensemble.h5", tmp_path / "reference.h5")
