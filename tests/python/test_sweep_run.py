@@ -687,3 +687,7 @@ def test_an_os_error_reads_as_its_file_and_what_went_wrong() -> None:
     assert _described(FileNotFoundError(2, "No such file or directory", "/a/b")) == "/a/b: No such file or directory"
     assert _described(OSError(18, "Invalid cross-device link", "/a", None, "/b")) == "/a and /b: Invalid cross-device link"
     assert _described(ValueError("x.nml: bad")) == "x.nml: bad"
+    from beamstops.output_files import WriteError
+
+    failed = WriteError(27, "File too large", "old.png")  # an OSError that words itself
+    assert _described(failed) == str(failed) and str(failed).startswith("cannot write old.png")

@@ -132,10 +132,11 @@ def quiet_font_lookup() -> None:
 def _described(exc: Exception) -> str:
     """An error in one line: an OSError as 'FILE: what went wrong' (its str() reads '[Errno 2] No
     such file or directory: 'FILE''), anything else as its message."""
-    if isinstance(exc, OSError) and exc.strerror:
+    text = str(exc)
+    if isinstance(exc, OSError) and exc.strerror and text.startswith("[Errno"):  # not one that words itself
         files = " and ".join(str(f) for f in (exc.filename, exc.filename2) if f is not None)
         return f"{files}: {exc.strerror}" if files else exc.strerror
-    return str(exc)
+    return text
 
 
 def main(argv: Optional[Sequence[str]] = None, prog: str = "python -m beamstops") -> int:
