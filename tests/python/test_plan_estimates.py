@@ -34,3 +34,16 @@ def test_richardson_with_two_rungs_uses_the_nominal_order() -> None:
     runs = [_tip(1 + t * 0.04), _tip(1 + t * 0.01), None]  # p = 2, r = 2: error 0.04 at t = 1
     assert richardson(runs, [2.0], nominal=2.0, safety=1.0) == pytest.approx(0.04)
     assert richardson(runs[:2], [2.0], nominal=2.0, safety=1.0) == pytest.approx(0.04)
+
+
+def test_a_statistics_check_restates_the_estimates_difference() -> None:
+    # README: for a statistic the check's finer run is the estimate's own (next mesh, Δt/2, the scene's
+    # law), so its measured difference is the estimate's |v − v_finer| term
+    import beamstops
+    from beamstops.plan import plan
+
+    scene = beamstops.Scene(elements=4, t_end=1.5, transient=0.5, dt=1e-4, beta=0.5)
+    p = plan(scene, "impulse_rate", 0.5, quiet=True)
+    assert p.choice is not None and p.check is not None
+    assert p.check.difference == p.choice.parts["difference"]
+    assert p.check.difference <= p.choice.error
