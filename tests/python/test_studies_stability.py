@@ -35,3 +35,19 @@ def test_map_and_answer() -> None:
                         (0.25, 2e-4): "stable"}
     text = stability_map.answer(table)
     assert "1 runs, 0 unstable" in text and "beyond the linear Newmark limit: 1 runs, 1 unstable" in text
+
+
+def test_a_large_starting_energy_is_no_growth() -> None:
+    # β ≥ 1/4 is unconditionally stable: at a coarse Δt on a fine mesh the discrete energy starts high
+    # (½ β Δt² v0ᵀ S v0 of the start v0 = −2h), stays there, and is no instability
+    scene = Scene(elements=54, t_end=0.2, beta=0.25, dt=1e-3)
+    result = beamstops.run(scene.replace(allow_unstable=True, record_every=1))
+    scale = stability_map.energy_scale(scene)
+    assert abs(result.energy[0]) > 10 * scale  # the start alone is above the threshold of the scale
+    assert abs(result.energy).max() <= 1.1 * abs(result.energy[0])  # and the run does not grow beyond it
+    verdict, growth = stability_map.classify(result, scale)
+    assert verdict == "stable" and growth < 2
+    # a run that grows from its start is still caught
+    explicit = BASE.replace(beta=0.0)
+    limit = beamstops.stability(explicit).dt_limit_newmark
+    assert _verdict(explicit.replace(dt=1.2 * limit)) == "unstable"

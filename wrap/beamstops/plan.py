@@ -10,8 +10,8 @@ Quantities (:data:`QUANTITIES`):
 
 - ``tip`` (deterministic): the tip trajectory on [0, until], distance max |u_tip − u'_tip| over a
   common record grid. A candidate's error is a Richardson estimate in Δt plus one in the mesh,
-  each ``safety · |q_h − q_fine| / (r^p − 1)`` with r the refinement ratio and p the order
-  observed from three rungs (bounded to [1, 4]; the nominal order when a third rung is missing),
+  each ``safety · |q_h − q_fine| · r^p / (r^p − 1)`` (the candidate's own error, not the finer
+  run's) with r the refinement ratio and p the order observed from three rungs (bounded to [1, 4]; the nominal order when a third rung is missing),
   plus, for a law other than the scene's, the measured distance to the scene's law at the same
   mesh and Δt.
 - ``power``, ``impulse_rate``, ``shocks_per_second``, ``contact_fraction``, ``tip_rms``

@@ -188,8 +188,12 @@ def distance(a: Run, b: Run) -> float:
 
 
 def richardson(runs: Sequence[Optional[Run]], ratios: Sequence[float], nominal: float, safety: float) -> float:
-    """safety |q_0 − q_1| / (r^p − 1) from rungs q_0 (candidate), q_1, q_2 (finer, finer still);
-    p observed from the three, bounded; the nominal order without a third rung."""
+    """The candidate's error, safety · |q_0 − q_1| · r^p / (r^p − 1), from rungs q_0 (the candidate),
+    q_1, q_2 (finer, finer still; r = q_0's refinement ratio to q_1); p observed from the three,
+    bounded; the nominal order without a third rung.
+
+    With q_h = q + C h^p, |q_0 − q_1| = |C| h_0^p (1 − r^−p), so |q_0 − q| = |q_0 − q_1| r^p/(r^p − 1);
+    |q_0 − q_1|/(r^p − 1) alone would be the error of the finer rung q_1, r^p times too small."""
     if runs[0] is None or runs[1] is None:
         return math.inf
     d1 = distance(runs[0], runs[1])
@@ -201,7 +205,8 @@ def richardson(runs: Sequence[Optional[Run]], ratios: Sequence[float], nominal: 
         if d2 > 0 and math.isfinite(d2):
             p = math.log(d1 / d2) / math.log(ratios[1] if len(ratios) > 1 else ratios[0])
     p = min(max(p, _P_BOUNDS[0]), _P_BOUNDS[1])
-    return safety * d1 / (ratios[0] ** p - 1.0)
+    gain = ratios[0] ** p
+    return safety * d1 * gain / (gain - 1.0)
 
 
 def ratio(coarse: Rung, fine: Rung) -> float:

@@ -51,7 +51,8 @@ def rows(labelled: Sequence[tuple[Sequence[Any], Measured]], reference: tuple[Se
     """One row per run, then the reference's row, then (members > 1) the reference's ensemble row.
 
     The ensemble row's CPU is members × the engine's cpu_seconds of member 1 (the engine times
-    member 1's loop; the members run one after the other, same scene, same steps); its T* uses
+    member 1's loop; members 2..K run after it, in lockstep when they can share one loop, each
+    then cheaper than member 1 alone: the row's CPU is an upper bound of the ensemble's); its T* uses
     the members' half-width with the window, i.e. more members or a longer window alike.
     """
     ref_first, ref_run = reference
