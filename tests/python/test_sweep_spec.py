@@ -146,6 +146,8 @@ BAD: list[tuple[str, str, str]] = [
     ("periods omega 0", "[axes]\nomega = [0.0, 1.0]\n[periods]\nt_end = 3", "needs omega > 0; point 0"),
     ("periods key", "[axes]\nomega = [1.0]\n[periods]\nt_end = 3\nrecords = 4", "unknown key 'records' in [periods]"),
     ("periods t_end", "[axes]\nomega = [1.0]\n[periods]\nt_end = -3", "[periods] t_end = -3"),
+    ("periods and a dt axis", "[axes]\nomega = [1.0]\ndt = [1e-4, 2e-4]\n[periods]\nt_end = 3\nrecords_per_period = 4",
+     "an axis of dt would not be the step run"),
     ("periods and t_end", "[scene]\nt_end = 1\n[axes]\nomega = [1.0]\n[periods]\nt_end = 3", "remove t_end"),
     ("reduction kind", "[axes]\nomega = [1]\n[reductions.x]\nkind = 'median'", "kind = 'median'"),
     ("reduction key", "[axes]\nomega = [1]\n[reductions.x]\nkind = 'max'\nwhen = 3", "unknown key 'when'"),
