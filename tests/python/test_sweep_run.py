@@ -692,3 +692,22 @@ def test_an_os_error_reads_as_its_file_and_what_went_wrong() -> None:
 
     failed = WriteError(27, "File too large", "old.png")  # an OSError that words itself
     assert _described(failed) == str(failed) and str(failed).startswith("cannot write old.png")
+
+
+def test_a_point_whose_worker_died_keeps_its_time_grid_in_the_summary(tmp_path: Path,
+                                                                       write_spec: Callable[..., Path]) -> None:
+    # a worker that dies leaves its points a record of status and message only; their rows still give the
+    # time grid each point runs (its scene's), as a pending or complete point's row does
+    from beamstops.sweep.runner import write_summary
+
+    spec = load_spec(write_spec(SMALL))
+    (tmp_path / "out").mkdir()
+    died = {0: {"point": 0, "params": spec.points[0].params, "status": "failed",
+                "message": "worker failed: BrokenProcessPool: ...", "reductions": {}}}
+    write_summary(spec, tmp_path / "out", died)
+    rows = read_summary(tmp_path / "out")
+    for row, point in zip(rows, spec.points):
+        assert (row["dt"], row["t_end"], row["record_every"]) == \
+            (point.scene.dt, point.scene.t_end, point.scene.record_every)
+        assert row["file"] == f"points/{point.name}.h5"
+    assert [r["status"] for r in rows] == ["failed", "pending", "pending", "pending"]
