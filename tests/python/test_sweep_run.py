@@ -110,6 +110,8 @@ beta = 0.0
 allow_unstable = true
 [axes]
 dt = [1e-4, 1e-3]
+[reductions.u_final]
+kind = "final"
 """))
     outcome = run_sweep(spec, tmp_path / "out", jobs=2, stream=None)
     assert (outcome.complete, outcome.diverged, outcome.failed) == (1, 1, 0)
@@ -117,6 +119,12 @@ dt = [1e-4, 1e-3]
     result = beamstops.load(tmp_path / "out" / row["file"], allow_incomplete=True)
     assert row["status"] == result.status == "diverged" and "blew up" in row["message"]
     assert row["message"] == result.attrs["message"]  # the engine's message, not its stderr line naming the file
+    # every column in every row of summary.json, in the order of summary.csv; a diverged point has no reductions
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    header = (tmp_path / "out" / "summary.csv").read_text().splitlines()[0].split(",")
+    assert summary["columns"] == header and all(list(r) == header for r in summary["points"])
+    complete = beamstops.load(tmp_path / "out" / "points" / "00000.h5")
+    assert row["u_final"] is None and read_summary(tmp_path / "out")[0]["u_final"] == complete.tip_u[-1]
     # the engine went to its end: resuming does not run it again
     assert run_sweep(spec, tmp_path / "out", stream=None).ran == 0
 

@@ -581,7 +581,8 @@ def _cell(value: Any) -> str:
 def write_summary(spec: Spec, folder: Path, records: dict[int, dict[str, Any]]) -> Path:
     """summary.csv and summary.json of every point (status 'pending' for those not run yet)."""
     names = _columns(spec)
-    rows = [_row(spec, point.index, records.get(point.index)) for point in spec.points]
+    # every row holds every column (None for none: a pending, failed or diverged point has no reductions)
+    rows = [dict.fromkeys(names) | _row(spec, point.index, records.get(point.index)) for point in spec.points]
     text = io.StringIO()
     writer = csv.writer(text, lineterminator="\n")
     writer.writerow(names)
