@@ -173,6 +173,42 @@ def test_a_sweep_in_lockstep_batches_gives_the_results_of_one_point_at_a_time(
         assert a == b, f"point {point.index} differs"
 
 
+DIVERGING = """
+[sweep]
+lockstep = {lockstep}
+[scene]
+elements = 6
+dt = 2e-4
+beta = 0.0
+allow_unstable = true
+t_end = 0.2
+[axes]
+amplitude = [0.0, 0.1, 0.0, 0.2]
+[reductions.u]
+kind = "final"
+"""
+
+
+def test_a_diverged_point_has_one_row_in_lockstep_or_alone(
+        tmp_path: Path, write_spec: Callable[..., Path], program: str,
+        without_timing: Callable[[list[dict[str, Any]]], list[dict[str, Any]]]) -> None:
+    # explicit steps beyond their limit: the forced points diverge, the unforced ones stay at rest; in a
+    # lockstep group of 4 and one at a time, each diverged row carries the engine's message (the file's
+    # `message`), not a line of stderr naming the folder it ran in
+    rows = {}
+    for lockstep in (8, 1):
+        spec = load_spec(write_spec(DIVERGING.format(lockstep=lockstep), f"l{lockstep}.toml"))
+        outcome = run_sweep(spec, tmp_path / f"l{lockstep}", jobs=1, stream=None, program=program)
+        assert (outcome.complete, outcome.diverged, outcome.lockstep) == (2, 2, 4 if lockstep == 8 else 0)
+        rows[lockstep] = read_summary(tmp_path / f"l{lockstep}")
+        for row in rows[lockstep]:
+            with h5py.File(tmp_path / f"l{lockstep}" / row["file"], "r") as f:
+                message = f.attrs["message"].decode() if row["status"] == "diverged" else ""
+            assert row["message"] == message
+    assert [r["status"] for r in rows[1]] == ["complete", "diverged", "complete", "diverged"]
+    assert without_timing(rows[8]) == without_timing(rows[1])
+
+
 def test_a_batch_refused_as_a_whole_runs_its_points_alone(tmp_path: Path, write_spec: Callable[..., Path],
                                                           program: str) -> None:
     # a folder is where point 1 would write its partial output: the program refuses the batch's

@@ -110,12 +110,21 @@ beta = 0.0
 allow_unstable = true
 [axes]
 dt = [1e-4, 1e-3]
+[reductions.u_final]
+kind = "final"
 """))
     outcome = run_sweep(spec, tmp_path / "out", jobs=2, stream=None)
     assert (outcome.complete, outcome.diverged, outcome.failed) == (1, 1, 0)
     row = read_summary(tmp_path / "out")[1]
-    assert row["status"] == "diverged" and "diverged" in row["message"]
-    assert beamstops.load(tmp_path / "out" / row["file"], allow_incomplete=True).status == "diverged"
+    result = beamstops.load(tmp_path / "out" / row["file"], allow_incomplete=True)
+    assert row["status"] == result.status == "diverged" and "blew up" in row["message"]
+    assert row["message"] == result.attrs["message"]  # the engine's message, not its stderr line naming the file
+    # every column in every row of summary.json, in the order of summary.csv; a diverged point has no reductions
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    header = (tmp_path / "out" / "summary.csv").read_text().splitlines()[0].split(",")
+    assert summary["columns"] == header and all(list(r) == header for r in summary["points"])
+    complete = beamstops.load(tmp_path / "out" / "points" / "00000.h5")
+    assert row["u_final"] is None and read_summary(tmp_path / "out")[0]["u_final"] == complete.tip_u[-1]
     # the engine went to its end: resuming does not run it again
     assert run_sweep(spec, tmp_path / "out", stream=None).ran == 0
 
@@ -691,3 +700,22 @@ def test_an_os_error_reads_as_its_file_and_what_went_wrong() -> None:
 
     failed = WriteError(27, "File too large", "old.png")  # an OSError that words itself
     assert _described(failed) == str(failed) and str(failed).startswith("cannot write old.png")
+
+
+def test_a_point_whose_worker_died_keeps_its_time_grid_in_the_summary(tmp_path: Path,
+                                                                       write_spec: Callable[..., Path]) -> None:
+    # a worker that dies leaves its points a record of status and message only; their rows still give the
+    # time grid each point runs (its scene's), as a pending or complete point's row does
+    from beamstops.sweep.runner import write_summary
+
+    spec = load_spec(write_spec(SMALL))
+    (tmp_path / "out").mkdir()
+    died = {0: {"point": 0, "params": spec.points[0].params, "status": "failed",
+                "message": "worker failed: BrokenProcessPool: ...", "reductions": {}}}
+    write_summary(spec, tmp_path / "out", died)
+    rows = read_summary(tmp_path / "out")
+    for row, point in zip(rows, spec.points):
+        assert (row["dt"], row["t_end"], row["record_every"]) == \
+            (point.scene.dt, point.scene.t_end, point.scene.record_every)
+        assert row["file"] == f"points/{point.name}.h5"
+    assert [r["status"] for r in rows] == ["failed", "pending", "pending", "pending"]

@@ -146,6 +146,8 @@ BAD: list[tuple[str, str, str]] = [
     ("periods omega 0", "[axes]\nomega = [0.0, 1.0]\n[periods]\nt_end = 3", "needs omega > 0; point 0"),
     ("periods key", "[axes]\nomega = [1.0]\n[periods]\nt_end = 3\nrecords = 4", "unknown key 'records' in [periods]"),
     ("periods t_end", "[axes]\nomega = [1.0]\n[periods]\nt_end = -3", "[periods] t_end = -3"),
+    ("periods and a dt axis", "[axes]\nomega = [1.0]\ndt = [1e-4, 2e-4]\n[periods]\nt_end = 3\nrecords_per_period = 4",
+     "an axis of dt would not be the step run"),
     ("periods and t_end", "[scene]\nt_end = 1\n[axes]\nomega = [1.0]\n[periods]\nt_end = 3", "remove t_end"),
     ("reduction kind", "[axes]\nomega = [1]\n[reductions.x]\nkind = 'median'", "kind = 'median'"),
     ("reduction key", "[axes]\nomega = [1]\n[reductions.x]\nkind = 'max'\nwhen = 3", "unknown key 'when'"),
@@ -284,6 +286,43 @@ def test_strobe_samples_and_period_detection() -> None:
     t = np.arange(0, 4001) * 1e-3
     times, samples, offset = strobe(t, np.cos(omega * t), omega, transient_periods=2)
     assert 0 < offset <= 0.5e-3 + 1e-15 and samples.size == int(4.0 / period) - 1
+
+
+def test_reductions_follow_the_readme_definitions() -> None:
+    """reduce() against the README's words, on random records: the strobe's k from transient_periods
+    while (k + phase) T is not after the last record, each the nearest record (the earlier of two as
+    near); the period p <= n/2 of n samples; mean, rms = sqrt(mean x^2), peak_to_peak over t >= after."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from beamstops.sweep.reductions import reduce
+
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        omega = float(rng.uniform(5, 60))
+        period = 2 * math.pi / omega
+        step = float(rng.uniform(0.01, 0.3)) * period
+        t = np.arange(int(rng.integers(1, 200))) * step
+        x = rng.normal(size=t.size)
+        k0, phase, after = int(rng.integers(0, 4)), float(rng.choice([0.0, 0.25, 0.5, 0.9])), float(rng.uniform(0, 3))
+        result = SimpleNamespace(attrs={"omega": omega}, t=t, tip_u=x, tip_v=x)
+        got = reduce(result, {"s": {"kind": "strobe", "quantity": "tip_u", "transient_periods": k0, "phase": phase,
+                                    "tolerance": 1e-6, "max_period": 16},
+                              "r": {"kind": "rms", "quantity": "tip_v", "after": after, "after_periods": None},
+                              "m": {"kind": "mean", "quantity": "tip_v", "after": None, "after_periods": 1.0}})
+        targets = [(k + phase) * period for k in range(k0, 1000) if (k + phase) * period <= t[-1]]
+        nearest = [int(np.argmin(np.abs(t - target))) for target in targets]
+        assert got["s"] == [float(x[i]) for i in nearest]
+        assert got["s_offset"] == (max(abs(t[i] - c) for i, c in zip(nearest, targets)) if targets else None)
+        window = x[t >= after]
+        assert got["r"] == (pytest.approx(math.sqrt(float(np.mean(window**2))), rel=1e-14) if window.size else None)
+        assert got["m"] == pytest.approx(float(np.mean(x[t >= period]))) if (t >= period).any() else got["m"] is None
+    # a period p needs n >= 2p samples: [a, b, c, a] is no period 3 (0); [a, b, a, b] is period 2
+    from beamstops.sweep.reductions import _period
+
+    assert _period(np.array([1.0, 2.0, 3.0, 1.0]), 1e-9, 16) == 0
+    assert _period(np.array([1.0, 2.0, 1.0, 2.0]), 1e-9, 16) == 2
 
 
 def test_damping_ratio_in_scene_and_axis_and_damped_reduction(write_spec: Callable[..., Path]) -> None:

@@ -553,15 +553,17 @@ def _columns(spec: Spec) -> list[str]:
 def _row(spec: Spec, index: int, record: Optional[dict[str, Any]]) -> dict[str, Any]:
     point = spec.points[index]
     row: dict[str, Any] = {"point": index, **point.params}
+    # the point's time grid is its scene's (what it runs, whatever became of it: a failed point's too)
+    for key in ("dt", "t_end", "record_every"):
+        if key not in point.params:
+            row[key] = getattr(point.scene, key)
+    row["file"] = f"points/{point.name}.h5"
     if record is None:
-        row.update({"status": "pending", "dt": point.scene.dt, "t_end": point.scene.t_end,
-                    "record_every": point.scene.record_every, "file": f"points/{point.name}.h5"})
+        row["status"] = "pending"
         return row
     for key in ("status", "cpu_seconds", "wall_seconds", "steps", "impacts", "max_violation", "dissipated",
-                "message", "dt", "t_end", "record_every"):
-        if key not in point.params:
-            row[key] = record.get(key)
-    row["file"] = f"points/{point.name}.h5"
+                "message"):
+        row[key] = record.get(key)
     row.update(record.get("reductions") or {})
     return row
 
@@ -579,7 +581,8 @@ def _cell(value: Any) -> str:
 def write_summary(spec: Spec, folder: Path, records: dict[int, dict[str, Any]]) -> Path:
     """summary.csv and summary.json of every point (status 'pending' for those not run yet)."""
     names = _columns(spec)
-    rows = [_row(spec, point.index, records.get(point.index)) for point in spec.points]
+    # every row holds every column (None for none: a pending, failed or diverged point has no reductions)
+    rows = [dict.fromkeys(names) | _row(spec, point.index, records.get(point.index)) for point in spec.points]
     text = io.StringIO()
     writer = csv.writer(text, lineterminator="\n")
     writer.writerow(names)

@@ -23,7 +23,7 @@ A specification (``input/sweeps/*.toml``)::
 
     [periods]                     # optional: lengths in forcing periods T = 2π/ω (needs ω > 0)
     t_end = 100                   # t_end = 100 T at every point
-    records_per_period = 16       # lock the time grid to the forcing (see below)
+    records_per_period = 16       # lock the time grid to the forcing (see below; not with a dt axis)
     # shared_grid = true          # or: one dt and one t_end for every point (see below)
 
     [reductions.strobe]           # user-chosen reductions, each a column of the summary
@@ -567,6 +567,10 @@ def _periods(table: Any, fixed: dict[str, Any], axes: dict[str, list[Any]], fail
             raise fail(f"[periods] records_per_period = {_show(records)}; allowed: an integer 1 ... 1000000")
         if "record_every" in fixed or "record_every" in axes:
             raise fail("[periods] records_per_period sets record_every; remove record_every from [scene] and [axes]")
+        if "dt" in axes:  # the summary's dt column would be the axis value, not the step the point ran
+            raise fail("[periods] records_per_period sets each point's dt (T/(r m), the largest such step not "
+                       "above the scene's dt); an axis of dt would not be the step run: give dt in [scene], or "
+                       "sweep dt without records_per_period")
     shared = table.get("shared_grid", False)
     if not isinstance(shared, bool):
         raise fail(f"[periods] shared_grid = {_show(shared)}; allowed: true or false")

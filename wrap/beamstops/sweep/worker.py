@@ -369,8 +369,10 @@ def _read(task: dict[str, Any], h5: Path, record: dict[str, Any]) -> None:
         record["message"] = record["message"] or f"the output says status {status!r}"
         return
     record["status"] = status
-    if status != "complete" and not record["message"]:
-        record["message"] = str(attrs.get("message", ""))
+    if status != "complete":
+        # the engine's own message, as the file holds it: the same whether the point ran alone (whose
+        # stderr line also names the file's path) or in a batch
+        record["message"] = str(attrs.get("message", "")) or record["message"]
     for key in ("cpu_seconds", "max_violation"):
         if key in attrs:
             record[key] = _clean(float(attrs[key]))
