@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import re
+import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -416,3 +417,17 @@ def test_the_constructor_reads_keys_as_replace_does() -> None:
     assert Scene(stiffness=1e6, law="compliance").stiffness_per_mass == \
         Scene().replace(stiffness=1e6, law="compliance").stiffness_per_mass
     assert Scene(dt=1e-5) == Scene().replace(dt=1e-5)
+
+
+@pytest.mark.parametrize("file", ["a!b.h5", "x &time dt = 1 /", 'say "hi" !', "x $statistics bins = 5 $end"])
+def test_a_quoted_value_hides_no_group_after_it(file: str, tmp_path: Path, program: str) -> None:
+    # gfortran looked for each group through the whole text, the groups before it read as
+    # comments: a `!` in &output file hid every later group, a quoted `&time` was taken for &time
+    scene = Scene(file=file, bins=3, seed=7, dt=1e-4)
+    assert (scene.file, scene.bins, scene.seed, scene.dt) == (file, 3, 7, 1e-4)
+    text = f"&output file = '{file}' /\n&statistics bins = 3 /\n&ensemble seed = 7 /\n&time dt = 1e-4 /\n"
+    assert Scene.from_text(text) == scene
+    path = write(tmp_path, text)
+    assert Scene.from_namelist(path) == scene
+    shown = subprocess.run([program, "info", str(path)], capture_output=True, text=True, check=True).stdout
+    assert re.search(r"^&time dt +0\.0001 s$", shown, re.M) and re.search(r"^ +seed +7 *$", shown, re.M)
