@@ -453,3 +453,13 @@ def test_replace_with_a_field_as_a_list_is_no_change() -> None:
             assert scene.replace(**{field.name: list(value)}) == scene
             assert scene.replace(**{field.name: np.array(value)}) == scene
     assert Scene().replace(damping_modes=list(Scene().damping_modes)) == Scene()
+
+
+def test_a_route_given_as_nothing_replaces_nothing() -> None:
+    # `ratio=()` is the coefficients' form, which the scene has: its coefficients were dropped
+    damped = Scene(mass_coefficient=1.0, stiffness_coefficient=1e-4)
+    for nothing in ((), [], None, np.array([])):
+        assert damped.replace(ratio=nothing) == damped
+    spanned = Scene(nodes=(3, 9))
+    assert spanned.replace(x=()) == spanned and spanned.replace(x=None) == spanned
+    assert Scene(ratio=0.1).replace(ratio=()) == Scene()

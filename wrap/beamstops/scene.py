@@ -213,13 +213,16 @@ class Scene:
         A route replaces the fields it gives (the material replaces ``k2`` and
         ``mass_per_length``, ``stiffness`` replaces ``stiffness_per_mass``, ``x`` replaces
         ``nodes``, the damping ``ratio`` replaces the Rayleigh coefficients and they replace it);
-        the engine resolves it with the scene's (new) other keys.
+        the engine resolves it with the scene's (new) other keys. A route given as nothing (``ratio=()``,
+        ``x=None``) replaces nothing.
         """
         unknown = sorted(set(changes) - set(_GROUP_OF))
         if unknown:
             raise TypeError(f"unknown scene key(s) {', '.join(unknown)}; allowed: {', '.join(_GROUP_OF)}")
         values = self.to_dict()
         for route in set(changes) & set(ROUTES):
+            if _not_given(changes[route]):
+                continue  # `ratio=()`, `x=None`: no route taken, the fields it would give are kept
             for derived in ROUTES[route]:
                 values.pop(derived, None)
         if set(changes) & _STOP_KEYS:
@@ -392,6 +395,11 @@ def _namelist(values: Mapping[str, Any]) -> str:
             name = f"{name}(1:{_count(value)})"
         groups.setdefault(group, []).append(f"  {name} = {namelist_value(value, key)}")
     return "".join(f"&{group}\n" + "\n".join(lines) + "\n/\n" for group, lines in groups.items()) or "&time /\n"
+
+
+def _not_given(value: Any) -> bool:
+    """None or an empty list: a key left out of the text (its default, or nothing)."""
+    return value is None or (_is_list(value) and _count(value) == 0)
 
 
 def _is_default(value: Any, default: Any) -> bool:
