@@ -403,12 +403,17 @@ contains
          if (present(carried)) is_carried = index(' '//carried//' ', ' '//key//' ') > 0
       end function is_carried
 
-      !> Read group g from `text` into the namelist variables.
-      subroutine read_group(g, text, stat, msg)
+      !> Read group g of `cleaned` (the groups' text) into the namelist variables: gfortran is
+      !> handed that group alone, `&name body /`. Handed every group, it looked for the group
+      !> through the others as through comments: a `!` in another group's quoted value
+      !> (`file = 'a!b.h5'`) hid every group after it, which kept its defaults unsaid.
+      subroutine read_group(g, cleaned, stat, msg)
          integer, intent(in) :: g
-         character(len=*), intent(in) :: text
+         character(len=*), intent(in) :: cleaned
          integer, intent(out) :: stat
          character(len=*), intent(out) :: msg
+         character(len=:), allocatable :: text
+         text = '&'//trim(group_names(g))//' '//group_body(cleaned, trim(group_names(g)))//' /'
          msg = ''
          select case (g)
          case (1); read (text, nml=beam, iostat=stat, iomsg=msg)

@@ -416,7 +416,9 @@ contains
       end select
    end function value_kind
 
-   !> The text of a group in `cleaned` after its name, up to its closing / (outside quotes).
+   !> The text of a group in `cleaned` after its name, up to its closing / (outside quotes). The
+   !> group's name is looked for outside quotes too: a quoted value of another group holding
+   !> `&name` (`file = 'x &time dt = 1 /'`) is not the group.
    function group_body(cleaned, name) result(body)
       character(len=*), intent(in) :: cleaned, name
       character(len=:), allocatable :: body, low
@@ -426,8 +428,15 @@ contains
       low = lower(cleaned)
       body = ''
       start = 0
+      quoted = .false.
+      quote = ' '
       do i = 1, len(low) - len(name)
-         if ((low(i:i) == '&' .or. low(i:i) == '$') .and. low(i + 1:i + len(name)) == name) then
+         if (quoted) then
+            if (low(i:i) == quote) quoted = .false.
+         else if (low(i:i) == '"' .or. low(i:i) == "'") then
+            quoted = .true.
+            quote = low(i:i)
+         else if ((low(i:i) == '&' .or. low(i:i) == '$') .and. low(i + 1:i + len(name)) == name) then
             if (scan(low(i + len(name) + 1:i + len(name) + 1), 'abcdefghijklmnopqrstuvwxyz0123456789_') == 0) then
                start = i + len(name) + 1
                exit

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import re
+import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -416,3 +417,49 @@ def test_the_constructor_reads_keys_as_replace_does() -> None:
     assert Scene(stiffness=1e6, law="compliance").stiffness_per_mass == \
         Scene().replace(stiffness=1e6, law="compliance").stiffness_per_mass
     assert Scene(dt=1e-5) == Scene().replace(dt=1e-5)
+
+
+@pytest.mark.parametrize("file", ["a!b.h5", "x &time dt = 1 /", 'say "hi" !', "x $statistics bins = 5 $end"])
+def test_a_quoted_value_hides_no_group_after_it(file: str, tmp_path: Path, program: str) -> None:
+    # gfortran looked for each group through the whole text, the groups before it read as
+    # comments: a `!` in &output file hid every later group, a quoted `&time` was taken for &time
+    scene = Scene(file=file, bins=3, seed=7, dt=1e-4)
+    assert (scene.file, scene.bins, scene.seed, scene.dt) == (file, 3, 7, 1e-4)
+    text = f"&output file = '{file}' /\n&statistics bins = 3 /\n&ensemble seed = 7 /\n&time dt = 1e-4 /\n"
+    assert Scene.from_text(text) == scene
+    path = write(tmp_path, text)
+    assert Scene.from_namelist(path) == scene
+    shown = subprocess.run([program, "info", str(path)], capture_output=True, text=True, check=True).stdout
+    assert re.search(r"^&time dt +0\.0001 s$", shown, re.M) and re.search(r"^ +seed +7 *$", shown, re.M)
+
+
+@pytest.mark.parametrize("changes", [{"damping_modes": [1, 2]}, {"damping_modes": np.array([1, 2])},
+                                     {"stiffness_per_mass": 0}, {"stiffness_per_mass": np.float64(0.0)},
+                                     {"mass_coefficient": np.float32(0.0), "ratio": 0.1}, {"beta": np.float64(0.5)}])
+def test_a_default_in_another_dress_is_the_default(changes: dict) -> None:
+    # a list for the default tuple, a numpy scalar or an int for the default real: the default,
+    # left out as the default itself is (they were written, and the engine refused `modes` without
+    # ratio, a spring without the compliance law, or a Rayleigh coefficient beside the ratios)
+    plain = {key: (tuple(value) if isinstance(value, (list, np.ndarray)) else float(value)) for key, value in changes.items()}
+    assert Scene(**changes) == Scene(**plain) == Scene().replace(**changes)
+    assert Scene().replace(**changes).differences(Scene().replace(**plain)) == ""
+
+
+def test_replace_with_a_field_as_a_list_is_no_change() -> None:
+    scene = Scene(nodes=(3, 9), lower=(-0.1, -0.2), upper=0.2, ratio=(0.01, 0.02), damping_modes=(1, 3))
+    for field in dataclasses.fields(Scene):
+        value = getattr(scene, field.name)
+        if isinstance(value, tuple):
+            assert scene.replace(**{field.name: list(value)}) == scene
+            assert scene.replace(**{field.name: np.array(value)}) == scene
+    assert Scene().replace(damping_modes=list(Scene().damping_modes)) == Scene()
+
+
+def test_a_route_given_as_nothing_replaces_nothing() -> None:
+    # `ratio=()` is the coefficients' form, which the scene has: its coefficients were dropped
+    damped = Scene(mass_coefficient=1.0, stiffness_coefficient=1e-4)
+    for nothing in ((), [], None, np.array([])):
+        assert damped.replace(ratio=nothing) == damped
+    spanned = Scene(nodes=(3, 9))
+    assert spanned.replace(x=()) == spanned and spanned.replace(x=None) == spanned
+    assert Scene(ratio=0.1).replace(ratio=()) == Scene()

@@ -213,13 +213,16 @@ class Scene:
         A route replaces the fields it gives (the material replaces ``k2`` and
         ``mass_per_length``, ``stiffness`` replaces ``stiffness_per_mass``, ``x`` replaces
         ``nodes``, the damping ``ratio`` replaces the Rayleigh coefficients and they replace it);
-        the engine resolves it with the scene's (new) other keys.
+        the engine resolves it with the scene's (new) other keys. A route given as nothing (``ratio=()``,
+        ``x=None``) replaces nothing.
         """
         unknown = sorted(set(changes) - set(_GROUP_OF))
         if unknown:
             raise TypeError(f"unknown scene key(s) {', '.join(unknown)}; allowed: {', '.join(_GROUP_OF)}")
         values = self.to_dict()
         for route in set(changes) & set(ROUTES):
+            if _not_given(changes[route]):
+                continue  # `ratio=()`, `x=None`: no route taken, the fields it would give are kept
             for derived in ROUTES[route]:
                 values.pop(derived, None)
         if set(changes) & _STOP_KEYS:
@@ -382,7 +385,7 @@ def _namelist(values: Mapping[str, Any]) -> str:
             value = _path(value)
         if value is None or (isinstance(value, (tuple, list)) and len(value) == 0):
             continue
-        if key in defaults and type(value) is type(defaults[key]) and value == defaults[key]:
+        if key in defaults and _is_default(value, defaults[key]):
             continue
         group, name = _group_key(key)
         if _is_list(value):
@@ -392,6 +395,33 @@ def _namelist(values: Mapping[str, Any]) -> str:
             name = f"{name}(1:{_count(value)})"
         groups.setdefault(group, []).append(f"  {name} = {namelist_value(value, key)}")
     return "".join(f"&{group}\n" + "\n".join(lines) + "\n/\n" for group, lines in groups.items()) or "&time /\n"
+
+
+def _not_given(value: Any) -> bool:
+    """None or an empty list: a key left out of the text (its default, or nothing)."""
+    return value is None or (_is_list(value) and _count(value) == 0)
+
+
+def _is_default(value: Any, default: Any) -> bool:
+    """Whether a value is a field's default in another dress, and so left out of the text as the
+    default itself is: a list or an array for a tuple (``damping_modes=[1, 2]``), a numpy scalar, an
+    int for a real (``stiffness_per_mass=0``). A logical stands for a logical only, a number for a
+    number only (``True`` is not 1), and -0.0 is not 0.0."""
+    if getattr(value, "ndim", None) == 0 and hasattr(value, "item"):
+        value = value.item()
+    if isinstance(default, tuple):
+        if not _is_list(value):
+            return False
+        items = [v.item() if getattr(v, "ndim", None) == 0 and hasattr(v, "item") else v for v in value]
+        return len(items) == len(default) and all(_is_default(v, d) for v, d in zip(items, default))
+    if isinstance(default, bool) or isinstance(value, bool):
+        return isinstance(default, bool) and isinstance(value, bool) and value == default
+    if isinstance(default, numbers.Real) and not isinstance(default, numbers.Integral):
+        return (isinstance(value, numbers.Real) and value == default
+                and math.copysign(1.0, float(value)) == math.copysign(1.0, default))
+    if isinstance(default, numbers.Integral):
+        return isinstance(value, numbers.Integral) and value == default
+    return type(value) is type(default) and bool(value == default)
 
 
 def _is_list(value: Any) -> bool:

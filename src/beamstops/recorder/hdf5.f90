@@ -209,8 +209,11 @@ contains
          end if
       end if
       call self%stop_keeping(row(col_t))
-      ! the stops' values of this row came just before it
-      if (self%stops > 0 .and. self%stops_fill > 0) self%stops_fill = self%stops_fill - 1
+      ! the stops' values of this row came just before it: the stops keep as many rows as the
+      ! series (once, not one fewer at each record after it: the steps to the block's end, up to
+      ! 8,191 records, had emptied /stops/u and /stops/reaction of a run that diverged)
+      if (self%stops > 0) self%stops_fill = int(max(0_hsize_t, min(int(self%stops_fill, hsize_t), &
+         & self%written + int(self%fill, hsize_t) - self%stops_written)))
    end subroutine record
 
    !> Buffer the stops' values of the row that follows; write the buffers when full.
