@@ -216,9 +216,7 @@ class Scene:
         the engine resolves it with the scene's (new) other keys. A route given as nothing (``ratio=()``,
         ``x=None``) replaces nothing.
         """
-        unknown = sorted(set(changes) - set(_GROUP_OF))
-        if unknown:
-            raise TypeError(f"unknown scene key(s) {', '.join(unknown)}; allowed: {', '.join(_GROUP_OF)}")
+        _refuse_unknown(changes)
         values = self.to_dict()
         for route in set(changes) & set(ROUTES):
             if _not_given(changes[route]):
@@ -302,15 +300,20 @@ def _scene_init(self: Scene, *args: Any, **keys: Any) -> None:
     if not others:
         _FIELDS_INIT(self, *args, **keys)
         return
-    unknown = sorted(others - set(_GROUP_OF))
-    if unknown:
-        raise TypeError(f"unknown scene key(s) {', '.join(unknown)}; allowed: {', '.join(_GROUP_OF)}")
+    _refuse_unknown(others)
     if args:
         raise TypeError(f"Scene takes keys by name only with a route ({', '.join(sorted(others))})")
     _adopt(self, Scene().replace(**keys).to_text())
 
 
 Scene.__init__ = _scene_init  # type: ignore[method-assign]
+
+
+def _refuse_unknown(keys: Iterable[str]) -> None:
+    """TypeError naming the keys that are neither a field nor a route, and the keys allowed."""
+    unknown = sorted(set(keys) - set(_GROUP_OF))
+    if unknown:
+        raise TypeError(f"unknown scene key(s) {', '.join(unknown)}; allowed: {', '.join(_GROUP_OF)}")
 
 
 # ---------------------------------------------------------------------- text
@@ -412,7 +415,7 @@ def _is_default(value: Any, default: Any) -> bool:
     if isinstance(default, tuple):
         if not _is_list(value):
             return False
-        items = [v.item() if getattr(v, "ndim", None) == 0 and hasattr(v, "item") else v for v in value]
+        items = list(value)  # each item unwrapped from numpy by the call on it
         return len(items) == len(default) and all(_is_default(v, d) for v, d in zip(items, default))
     if isinstance(default, bool) or isinstance(value, bool):
         return isinstance(default, bool) and isinstance(value, bool) and value == default
