@@ -44,7 +44,7 @@ from .scene import Scene
 from .studies.common import progress
 
 __all__ = ["QUANTITIES", "STATISTICAL", "LAWS", "Quantity", "Model", "Candidate", "Check", "Plan", "plan",
-           "parse_tolerance", "reduced_available", "window_scene"]
+           "parse_tolerance", "reduced_available", "window_scene", "check_max_window"]
 
 #: Most rungs of the Δt ladder either way: Δt·2^20 or Δt/2^20 (a million times the scene's steps).
 MAX_RUNGS = 20
@@ -95,8 +95,7 @@ def plan(scene: Union[Scene, str, "os.PathLike[str]"], qoi: Union[str, Quantity]
     if max_window is not None:
         bounded(max_window, "a window after the transient in s", name="max_window")
         if not quantity.deterministic:
-            window_scene(scene.replace(snapshot_every=0, checkpoint_every=0, members=1, enabled=True), max_window,
-                         "max_window")
+            check_max_window(scene, max_window, "max_window")
     reference_law = "redistributed" if (scene.law == "signorini" and scene.mass == "redistributed") else scene.law
     chosen_laws = parse_laws(laws) if laws is not None else [reference_law]
     if "compliance" in chosen_laws and not scene.stiffness_per_mass > 0:
@@ -146,7 +145,7 @@ def plan(scene: Union[Scene, str, "os.PathLike[str]"], qoi: Union[str, Quantity]
         out.window = needed
         if needed != window:
             try:
-                base = window_scene(base, needed, "window", min(dts))
+                base = window_scene(base, needed, min(dts))
             except ValueError as exc:  # the engine's words on a scene the user never wrote: say where it came from
                 raise ValueError(f"the window after the transient that the tolerance {tolerance:g} {unit} needs, "
                                  f"{needed:g} s (the scene's {window:g} s times (its half-width "
@@ -226,20 +225,25 @@ def plan(scene: Union[Scene, str, "os.PathLike[str]"], qoi: Union[str, Quantity]
     return out
 
 
-def window_scene(base: Scene, window: float, name: str, finest_dt: Optional[float] = None) -> Scene:
+def window_scene(base: Scene, window: float, finest_dt: Optional[float] = None) -> Scene:
     """``base`` run over ``window`` s after its transient (at most RECORDS records a run, steps of
-    ``finest_dt``, by default its own dt); a ValueError naming ``name`` when the engine refuses that
-    scene (a window shorter than one step, or one beyond the engine's t_end)."""
+    ``finest_dt``, by default its own dt); the engine's ValueError when it refuses that scene."""
     t_end = base.transient + window
     every = max(1, math.ceil(t_end / (finest_dt if finest_dt is not None else base.dt) / RECORDS))
+    return base.replace(t_end=t_end, record_every=every)
+
+
+def check_max_window(scene: Scene, max_window: float, name: str) -> None:
+    """A ValueError naming ``name`` (none when empty) when the engine refuses the statistical scene
+    run ``max_window`` s after its transient (a window shorter than one step, or one beyond the
+    engine's t_end): checked before any run, by :func:`plan` and by the command line."""
     try:
-        return base.replace(t_end=t_end, record_every=every)
+        window_scene(scene.replace(snapshot_every=0, checkpoint_every=0, members=1, enabled=True), max_window)
     except ValueError as exc:
-        if name == "window":
-            raise
-        raise ValueError(f"{name + ' ' if name else ''}{window!r} s: the scene run {window!r} s after its transient "
-                         f"({base.transient!r} s) is refused by the engine ({exc}); allowed: a window of at least "
-                         f"one step of the scene (dt = {base.dt!r} s) that ends within the engine's t_end") from None
+        raise ValueError(f"{name + ' ' if name else ''}{max_window!r} s: the scene run {max_window!r} s after its "
+                         f"transient ({scene.transient!r} s) is refused by the engine ({exc}); allowed: a window of "
+                         f"at least one step of the scene (dt = {scene.dt!r} s) that ends within the engine's "
+                         "t_end") from None
 
 
 def _cost(model: Model) -> float:

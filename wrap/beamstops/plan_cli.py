@@ -12,8 +12,8 @@ from typing import Callable
 
 from .arguments import OptionError, number, output_name, whole
 from .output_files import check, names_no_file, write_text
-from .plan import LAWS, MAX_RUNGS, QUANTITIES, Quantity, parse_tolerance, plan, window_scene
-from .plan_types import ALIASES, TOLERANCE, parse_laws, window_range
+from .plan import LAWS, MAX_RUNGS, QUANTITIES, Quantity, check_max_window, parse_tolerance, plan
+from .plan_types import ALIASES, ALIASES_TEXT, TOLERANCE, parse_laws, window_range
 from .scene import NAMELIST_FILE
 
 #: Exit status when the plan does not meet the tolerance (no model qualified, or the check failed).
@@ -65,8 +65,7 @@ def _handler(args: argparse.Namespace) -> int:
         window_range(args.until, scene.t_end, scene.dt, name="--until")
     if args.max_window is not None and args.qoi != "tip":
         try:  # a window the engine refuses (shorter than a step): the option's own error, before any run
-            window_scene(scene.replace(snapshot_every=0, checkpoint_every=0, members=1, enabled=True),
-                         args.max_window, "")
+            check_max_window(scene, args.max_window, "")
         except ValueError as exc:
             raise OptionError(f"argument --max-window: {exc}") from None
     out = _output(args)
@@ -101,8 +100,7 @@ def _checked(parse: Callable[[str], object], keep: bool = False) -> Callable[[st
 def _quantity(text: str) -> str:
     text = ALIASES.get(text, text)  # the studies' stop_power and shock_rate
     if text not in QUANTITIES:
-        raise ValueError(f"{text!r}: allowed: one of {', '.join(QUANTITIES)} "
-                         f"({', '.join(f'{a} = {b}' for a, b in ALIASES.items())}, the studies' names)")
+        raise ValueError(f"{text!r}: allowed: one of {', '.join(QUANTITIES)} ({ALIASES_TEXT}, the studies' names)")
     return text
 
 

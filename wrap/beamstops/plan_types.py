@@ -12,8 +12,8 @@ from typing import Optional, Union
 from .arguments import bounded
 from .scene import Scene
 
-__all__ = ["QUANTITIES", "ALIASES", "STATISTICAL", "LAWS", "Quantity", "Model", "Candidate", "Check", "Plan",
-           "parse_tolerance", "parse_laws", "window_range", "TOLERANCE"]
+__all__ = ["QUANTITIES", "ALIASES", "ALIASES_TEXT", "STATISTICAL", "LAWS", "Quantity", "Model", "Candidate", "Check",
+           "Plan", "parse_tolerance", "parse_laws", "window_range", "TOLERANCE"]
 
 #: Statistical quantities: the engine's statistic of that name (entry ``stop``).
 STATISTICAL: tuple[str, ...] = ("power", "impulse_rate", "shocks_per_second", "contact_fraction", "tip_rms")
@@ -22,6 +22,8 @@ QUANTITIES: tuple[str, ...] = ("tip",) + STATISTICAL
 #: The studies' names of the same statistics (``--qoi stop_power`` of converge and work-precision), accepted
 #: for them: the quantity then carries the engine's name.
 ALIASES: dict[str, str] = {"stop_power": "power", "shock_rate": "shocks_per_second"}
+#: The aliases as messages name them: ``stop_power = power, shock_rate = shocks_per_second``.
+ALIASES_TEXT = ", ".join(f"{alias} = {name}" for alias, name in ALIASES.items())
 #: Contact models the search may use: scene changes of each.
 LAWS: dict[str, dict[str, str]] = {
     "signorini": {"law": "signorini", "mass": "consistent"},
@@ -92,8 +94,7 @@ class Quantity:
         if self.name in ALIASES:
             object.__setattr__(self, "name", ALIASES[self.name])
         if self.name not in QUANTITIES:
-            raise ValueError(f"unknown quantity {self.name!r}; choose one of {', '.join(QUANTITIES)} "
-                             f"({', '.join(f'{a} = {b}' for a, b in ALIASES.items())})")
+            raise ValueError(f"unknown quantity {self.name!r}; choose one of {', '.join(QUANTITIES)} ({ALIASES_TEXT})")
         if self.deterministic and self.until is None:
             raise ValueError("quantity 'tip' needs a window end until > 0 (s), e.g. --until 0.08")
         if not self.deterministic and self.until is not None:
