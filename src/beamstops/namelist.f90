@@ -183,7 +183,7 @@ contains
       end do
       do g = 1, size(group_names)
          if (.not. has_group(g)) cycle
-         call read_group(g, cleaned, stat, msg)
+         call read_group(g, group_text(g), stat, msg)
          if (stat /= 0) then
             call malformed_key(g, stat, msg)
             return
@@ -403,17 +403,23 @@ contains
          if (present(carried)) is_carried = index(' '//carried//' ', ' '//key//' ') > 0
       end function is_carried
 
-      !> Read group g of `cleaned` (the groups' text) into the namelist variables: gfortran is
-      !> handed that group alone, `&name body /`. Handed every group, it looked for the group
-      !> through the others as through comments: a `!` in another group's quoted value
-      !> (`file = 'a!b.h5'`) hid every group after it, which kept its defaults unsaid.
-      subroutine read_group(g, cleaned, stat, msg)
+      !> Group g alone, `&name body /`, from `cleaned` (the groups' text): what read_group hands
+      !> gfortran. Handed every group, gfortran looked for the group through the others as through
+      !> comments: a `!` in another group's quoted value (`file = 'a!b.h5'`) hid every group after
+      !> it, which kept its defaults unsaid.
+      function group_text(g) result(text)
          integer, intent(in) :: g
-         character(len=*), intent(in) :: cleaned
-         integer, intent(out) :: stat
-         character(len=*), intent(out) :: msg
          character(len=:), allocatable :: text
          text = '&'//trim(group_names(g))//' '//group_body(cleaned, trim(group_names(g)))//' /'
+      end function group_text
+
+      !> Read group g from `text`, the group alone (group_text, or one assignment of it), into the
+      !> namelist variables.
+      subroutine read_group(g, text, stat, msg)
+         integer, intent(in) :: g
+         character(len=*), intent(in) :: text
+         integer, intent(out) :: stat
+         character(len=*), intent(out) :: msg
          msg = ''
          select case (g)
          case (1); read (text, nml=beam, iostat=stat, iomsg=msg)
@@ -604,7 +610,7 @@ contains
          do g = 1, size(group_names)
             if (.not. has_group(g)) cycle
             if (all(trim(group_names(g)) /= [character(len=10) :: 'beam', 'stops', 'damping', 'statistics'])) cycle
-            call read_group(g, cleaned, stat, msg)
+            call read_group(g, group_text(g), stat, msg)
          end do
          do i = 1, max_stops
             if (nodes(i) == unset_node) then
